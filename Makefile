@@ -1,0 +1,53 @@
+# lugrip — the two set-up commands of the README: `make demo` and `make test`.
+PYTHON ?= python3
+VENV   ?= .venv
+VPY    := $(VENV)/bin/python
+JOBS   ?= 2
+CPP_BUILD := build/cpp
+OUT    ?= out
+
+SOURCES := $(shell find src include bindings python -type f \( -name '*.cpp' -o -name '*.hpp' -o -name '*.py' \)) pyproject.toml CMakeLists.txt
+
+.PHONY: all install demo test test-cpp test-python bench sanitize clean
+
+all: install
+
+$(VPY):
+	$(PYTHON) -m venv $(VENV)
+	$(VPY) -m pip install -q --upgrade pip
+
+# Build dependencies are installed into the venv and the build runs without isolation, so the
+# CMake build directory (build/<wheel tag>) is reused and rebuilds are incremental.
+$(VENV)/.installed: $(VPY) $(SOURCES)
+	$(VPY) -m pip install -q "scikit-build-core>=0.10" "nanobind>=2.4"
+	$(VPY) -m pip install -q --no-build-isolation ".[test,io]"
+	@touch $@
+
+install: $(VENV)/.installed
+
+demo: install
+	$(VENV)/bin/lugrip demo --out $(OUT)
+
+test: test-cpp test-python
+
+test-cpp:
+	cmake -S . -B $(CPP_BUILD) -DCMAKE_BUILD_TYPE=Release -DLUGRIP_BUILD_TESTS=ON -DLUGRIP_BUILD_BENCHMARKS=ON > /dev/null
+	cmake --build $(CPP_BUILD) -j $(JOBS)
+	cd $(CPP_BUILD) && ctest --output-on-failure -j $(JOBS)
+
+test-python: install
+	$(VPY) -m pytest -q tests/python
+
+# Debug build of the C++ tests with AddressSanitizer and UBSan.
+sanitize:
+	cmake -S . -B build/asan -DCMAKE_BUILD_TYPE=Debug -DLUGRIP_BUILD_TESTS=ON -DLUGRIP_SANITIZE=ON > /dev/null
+	cmake --build build/asan -j $(JOBS)
+	cd build/asan && ctest --output-on-failure -j $(JOBS)
+
+bench: install
+	cmake -S . -B $(CPP_BUILD) -DCMAKE_BUILD_TYPE=Release -DLUGRIP_BUILD_TESTS=ON -DLUGRIP_BUILD_BENCHMARKS=ON > /dev/null
+	cmake --build $(CPP_BUILD) -j $(JOBS)
+	$(VPY) benchmarks/run_benchmarks.py --cpp-dir $(CPP_BUILD)/benchmarks --out BENCHMARKS.md
+
+clean:
+	rm -rf build $(OUT)

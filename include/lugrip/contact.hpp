@@ -1,0 +1,111 @@
+// lugrip — contact quantities (paper eqs. 3-4, 7-10, 16-18) and CoR estimation (eqs. 13-15).
+#pragma once
+
+#include <vector>
+
+#include "lugrip/limit_surface.hpp"
+#include "lugrip/params.hpp"
+#include "lugrip/status.hpp"
+
+namespace lugrip {
+
+//! Limit surface plus the parameter-dependent maps of one contact. Immutable after
+//! construction; every method is noexcept and allocation-free.
+class ContactModel {
+ public:
+  //! Validates `params` (throws std::invalid_argument naming every bad field) and builds the
+  //! limit-surface tables and the sigma_LS inverse table (a few tens of ms).
+  explicit ContactModel(const ContactParams& params);
+
+  const ContactParams& params() const noexcept { return p_; }
+  const LimitSurface& limit_surface() const noexcept { return ls_; }
+  double xi() const noexcept { return ls_.xi(); }
+
+  double rho(double f_n) const noexcept;      //!< contact radius delta f_n^gamma [m]
+  double ft_max(double f_n) const noexcept;   //!< mu f_n [N] (eq. 3)
+  double tau_max(double f_n) const noexcept;  //!< mu xi delta f_n^(gamma+1) [N m] (eq. 4)
+  //! Viscous/dry ratio of eqs. 9-10, K = pi delta^3 beta_A f_n^(3 gamma - 1) / mu [s/rad].
+  double viscous_ratio(double f_n) const noexcept;
+  //! Viscous coefficient about the CoR, pi beta_A rho^4 (c~^2 + 1/2) [N m s/rad] (eq. 17).
+  double sigma_1(double f_n, double c_tilde) const noexcept;
+  //! Maximum dry friction torque about the CoR, mu f_n rho G(|c~|) [N m] (eq. 18), > 0.
+  double g(double f_n, double c_tilde) const noexcept;
+
+  //! |c~| on the limit surface for a given |sigma| (eq. 13, first line); monotone inverse of
+  //! sigma_LS, not clipped. Bracketed safeguarded Newton; `iterations` (optional) counts steps.
+  double invert_sigma(double sigma_abs, int* iterations = nullptr) const noexcept;
+  //! Root of h(a) = f - F(a) - 2 xi a (t - T(a)) on [0, c_max] (eq. 13, second line,
+  //! MODEL.md 5.4); returns c_max when h(c_max) > 0.
+  //! `guess` (optional, e.g. the inside-LS estimate) starts the iteration.
+  double solve_outside(double ft_abs, double tau_abs, int* iterations = nullptr,
+                       double guess = -1.0) const noexcept;
+
+ private:
+  ContactParams p_;
+  LimitSurface ls_;
+  double inv_s0_ = 0.0, inv_s1_ = 0.0;  // log sigma_LS at a = 1e-4 and a = 1e4
+  std::vector<double> inv_;  // (kInverseIntervals + 1) x 3: log a, h d(log a)/d(log sigma), a
+
+ public:
+  static constexpr int kInverseIntervals = 2048;
+};
+
+//! Per-sample settings of the CoR estimator (defaults in one place).
+struct CorSettings {
+  double f_n_min = 0.03;         //!< [N] below this normal force: NoContact (paper's code: 0.03)
+  double force_limit = 1.0e4;    //!< [N] |f_n| or |f_t| above: InvalidSample (sensor range)
+  double torque_limit = 1.0e3;   //!< [N m] |tau| above: InvalidSample
+  double zero_force = 1.0e-4;    //!< f~_t below this counts as zero (pure rotation)
+  double zero_torque = 1.0e-4;   //!< |tau~| below this counts as zero: |c~| = c_max, sign held
+};
+
+//! Checks the settings; one line per bad field in *message. Returns true when valid.
+bool validate(const CorSettings& s, std::string* message);
+
+//! One fingertip sample as the sensor gives it.
+struct CorInput {
+  double f_n = 0.0;  //!< normal force [N], > 0 in contact
+  double f_t = 0.0;  //!< tangential force [N]: in-plane magnitude (>= 0) or a signed component
+  double tau = 0.0;  //!< torsional moment about the contact normal [N m], signed
+};
+
+//! Result for one sample. On NoContact / InvalidSample the previous values are kept.
+struct CorOutput {
+  double c_tilde = 0.0;    //!< signed normalized CoR c/rho [-], |c~| <= c_max
+  double c = 0.0;          //!< signed CoR position [m] (rho at the current f_n)
+  double ft_tilde = 0.0;   //!< f_t / (mu f_n) [-] (signed like f_t)
+  double tau_tilde = 0.0;  //!< tau / tau_max [-]
+  double sigma = 0.0;      //!< eq. 14, sign of tau [-]
+  double rho = 0.0;        //!< contact radius [m]
+  double g = 0.0;          //!< max dry torque about the CoR [N m] (eq. 18)
+  double sigma_1 = 0.0;    //!< viscous coefficient about the CoR [N m s/rad] (eq. 17)
+  double y = 0.0;          //!< friction torque about the CoR, tau - c f_t [N m] (eqs. 16, 20)
+  bool inside = true;      //!< wrench strictly inside the limit surface (eq. 15)
+  bool saturated = false;  //!< |c~| was clipped at c_max
+  int iterations = 0;      //!< root-finding iterations spent on this sample
+  Status status = Status::NoContact;
+};
+
+//! CoR estimator (MODEL.md 5.7): virtual CoR inside the LS, viscous-LS CoR outside, sign rule
+//! sign(c~) = -sign(f_t) sign(tau), saturation at c_max. Holds the previous estimate for the
+//! undefined cases (zero wrench: previous c~; torque below threshold: previous sign).
+class CorEstimator {
+ public:
+  explicit CorEstimator(const ContactParams& params, const CorSettings& settings = CorSettings());
+  //! Reuses an existing model (copies its tables; no quadrature).
+  explicit CorEstimator(const ContactModel& model, const CorSettings& settings = CorSettings());
+
+  //! Estimate from one sample; never throws, never allocates, outputs always finite.
+  Status step(const CorInput& in, CorOutput& out) noexcept;
+  void reset() noexcept;
+
+  const ContactModel& model() const noexcept { return model_; }
+  const CorSettings& settings() const noexcept { return s_; }
+
+ private:
+  ContactModel model_;
+  CorSettings s_;
+  CorOutput last_;
+};
+
+}  // namespace lugrip

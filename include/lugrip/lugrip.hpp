@@ -1,0 +1,8 @@
+// lugrip — model-based slip detection, slip avoidance and pivoting for force/torque fingertips.
+#pragma once
+
+#include "lugrip/contact.hpp"
+#include "lugrip/limit_surface.hpp"
+#include "lugrip/params.hpp"
+#include "lugrip/status.hpp"
+#include "lugrip/version.hpp"

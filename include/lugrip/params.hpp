@@ -1,0 +1,40 @@
+// lugrip — physical contact parameters (paper Table 1/2) and their validation.
+#pragma once
+
+#include <string>
+
+namespace lugrip {
+
+//! Physical parameters of one fingertip/object contact (SI units).
+//! No silent defaults for the physical fields: a default-constructed struct fails validation.
+struct ContactParams {
+  double mu = 0.0;       //!< Coulomb friction coefficient [-], (0, 10]
+  double beta_a = -1.0;  //!< viscous friction per unit area and speed [N s/m^3], >= 0 (paper prints "Ns/m")
+  double sigma0 = 0.0;   //!< micro-asperity (bristle) stiffness [N m/rad], > 0
+  double sigma_z = -1.0; //!< micro-asperity damping [N m s/rad], >= 0
+  double delta = 0.0;    //!< contact-radius law rho = delta f_n^gamma [m/N^gamma], > 0
+  double gamma = 0.0;    //!< contact-radius exponent [-], 0 < gamma < 1/3
+  double k = 4.0;        //!< pressure exponent p ~ (1-(r/rho)^k)^(1/k) [-], (0, inf]; 4 gives xi = 0.6354
+  double c_max = 1.5;    //!< saturation of the normalized CoR |c~| [-], > 0 (paper: 1.5)
+};
+
+//! Checks every field. Returns true when valid; otherwise writes one line per bad field
+//! ("mu = -1: must be finite and > 0") into *message (if not null) and returns false.
+bool validate(const ContactParams& p, std::string* message);
+
+//! Throws std::invalid_argument with the message of validate() when invalid.
+void validate_or_throw(const ContactParams& p);
+
+//! Paper Table 1 (cardboard slider): mu 0.47, beta_A 4.9e9, sigma0 16.66, sigma_z 2,
+//! delta 0.0018, gamma 0.254, k = 4.
+ContactParams table1_params() noexcept;
+
+//! Table 1 with the object's mu and beta_A from paper Table 2.
+//! name: "big_resin_block", "small_resin_block", "plastic_bottle", "aluminium_can".
+//! Throws std::invalid_argument for an unknown name.
+ContactParams object_params(const std::string& name);
+
+//! Python-assignment style dump at full precision (for bug reports).
+std::string to_string(const ContactParams& p);
+
+}  // namespace lugrip

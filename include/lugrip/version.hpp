@@ -1,0 +1,5 @@
+#pragma once
+#define LUGRIP_VERSION_MAJOR 0
+#define LUGRIP_VERSION_MINOR 1
+#define LUGRIP_VERSION_PATCH 0
+#define LUGRIP_VERSION "0.1.0"

@@ -1,0 +1,34 @@
+"""lugrip: model-based slip detection, slip avoidance and pivoting for parallel grippers with
+force/torque fingertips (limit surface + revisited LuGre friction, MODEL.md).
+
+The real-time core is C++17 (``lugrip._core``); this package is numpy in, numpy out.
+"""
+
+from ._core import __version__
+from ._contact import (
+    CorEstimate,
+    LimitSurface,
+    Status,
+    contact_radius,
+    estimate_cor,
+    g,
+    normalized_wrench,
+    shape_factor,
+    sigma_1,
+)
+from ._params import PRESETS, ContactParams
+
+__all__ = [
+    "__version__",
+    "ContactParams",
+    "PRESETS",
+    "LimitSurface",
+    "Status",
+    "CorEstimate",
+    "estimate_cor",
+    "contact_radius",
+    "g",
+    "sigma_1",
+    "normalized_wrench",
+    "shape_factor",
+]

@@ -1,0 +1,273 @@
+#include "lugrip/contact.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <stdexcept>
+#include <string>
+
+namespace lugrip {
+
+namespace {
+constexpr double kPi = 3.14159265358979323846;
+constexpr int kInvHalf = 200;   // inverse table: a = 10^((j - 200)/50), j = 0..400
+constexpr int kMaxIter = 60;
+constexpr int kInvTable = ContactModel::kInverseIntervals;
+
+// Safeguarded Newton for a root of fn bracketed by [lo, hi] (fn(lo), fn(hi) of opposite signs;
+// `increasing` tells which side is which). A Newton step leaving the bracket is replaced by
+// bisection, so it always converges; at most max_iter evaluations, counted in *iterations.
+template <class Fn>
+double bracketed_newton(Fn&& fn, double a, double lo, double hi, bool increasing, double x_rel,
+                        double x_abs, double f_tol, int max_iter, int* iterations) {
+  for (int it = 1; it <= max_iter; ++it) {
+    if (iterations) *iterations = it;
+    double d = 0.0;
+    const double v = fn(a, d);
+    if (std::fabs(v) <= f_tol) return a;
+    if ((v > 0.0) == increasing) hi = a; else lo = a;
+    const double tol = x_abs + x_rel * std::fabs(a);
+    double next = a - v / d;
+    if (next > lo && next < hi) {
+      if (std::fabs(next - a) <= tol) return next;
+    } else {
+      next = 0.5 * (lo + hi);
+    }
+    if (hi - lo <= tol) return next;
+    a = next;
+  }
+  return a;
+}
+
+const ContactParams& checked(const ContactParams& p) {
+  validate_or_throw(p);
+  return p;
+}
+}  // namespace
+
+ContactModel::ContactModel(const ContactParams& params) : p_(checked(params)), ls_(params.k) {
+  // Bracketed Newton inversion of log sigma_LS on a log-spaced grid of a (construction only),
+  // then a uniform table of log a against log sigma with Hermite slopes for the run time.
+  const int n = 2 * kInvHalf + 1;
+  std::vector<double> grid_a(n), grid_s(n);
+  const double gp1 = p_.gamma + 1.0;
+  for (int j = 0; j < n; ++j) {
+    const double a = std::pow(10.0, static_cast<double>(j - kInvHalf) / 50.0);
+    const LsPoint q = ls_.eval(a);
+    grid_a[j] = a;
+    grid_s[j] = gp1 * std::log(q.F) - std::log(q.T);
+    if (j > 0 && !(grid_s[j] > grid_s[j - 1]))
+      throw std::logic_error("ContactModel: sigma_LS is not increasing at a = " + std::to_string(a));
+  }
+  inv_s0_ = grid_s.front();
+  inv_s1_ = grid_s.back();
+  inv_.assign(3 * (kInvTable + 1), 0.0);
+  const double hs = (inv_s1_ - inv_s0_) / kInvTable;
+  for (int i = 0; i <= kInvTable; ++i) {
+    const double target = i == kInvTable ? inv_s1_ : inv_s0_ + i * hs;
+    const auto it = std::upper_bound(grid_s.begin(), grid_s.end(), target);
+    const int j = std::min(std::max(static_cast<int>(it - grid_s.begin()) - 1, 0), n - 2);
+    auto phi = [&](double a, double& d) {
+      const LsPoint q = ls_.eval(a);
+      d = gp1 * q.dF / q.F - q.dT / q.T;
+      return gp1 * std::log(q.F) - std::log(q.T) - target;
+    };
+    const double lo = grid_a[j], hi = grid_a[j + 1];
+    const double a = bracketed_newton(phi, std::sqrt(lo * hi), lo, hi, true, 1e-15, 0.0, 1e-15, 200, nullptr);
+    const LsPoint q = ls_.eval(a);
+    // d(log a)/d(log sigma) = 1 / (a dphi/da)
+    const double slope = 1.0 / (a * (gp1 * q.dF / q.F - q.dT / q.T));
+    inv_[3 * i] = std::log(a);
+    inv_[3 * i + 1] = slope * hs;
+    inv_[3 * i + 2] = a;
+  }
+}
+
+double ContactModel::rho(double f_n) const noexcept { return p_.delta * std::pow(f_n, p_.gamma); }
+double ContactModel::ft_max(double f_n) const noexcept { return p_.mu * f_n; }
+double ContactModel::tau_max(double f_n) const noexcept {
+  return p_.mu * ls_.xi() * p_.delta * std::pow(f_n, p_.gamma + 1.0);
+}
+double ContactModel::viscous_ratio(double f_n) const noexcept {
+  return kPi * p_.delta * p_.delta * p_.delta * p_.beta_a * std::pow(f_n, 3.0 * p_.gamma - 1.0) / p_.mu;
+}
+double ContactModel::sigma_1(double f_n, double c_tilde) const noexcept {
+  const double r = rho(f_n), r2 = r * r;
+  return kPi * p_.beta_a * r2 * r2 * (c_tilde * c_tilde + 0.5);
+}
+double ContactModel::g(double f_n, double c_tilde) const noexcept {
+  return p_.mu * f_n * rho(f_n) * ls_.G(c_tilde);
+}
+
+double ContactModel::invert_sigma(double s, int* iterations) const noexcept {
+  if (iterations) *iterations = 0;
+  s = std::fabs(s);
+  if (!(s > 0.0)) return std::isnan(s) ? s : 0.0;
+  if (std::isinf(s)) return s;
+  const double gp1 = p_.gamma + 1.0;
+  const double target = std::log(s);
+  if (target >= inv_s1_) return ls_.tail_torque() * s;  // sigma_LS ~ a / A_tau (a > 1e4)
+  double lo, hi, a;
+  if (target <= inv_s0_) {  // a < 1e-4: sigma_LS ~ (s_k a)^(gamma+1)
+    lo = 0.0;
+    hi = inv_[2];
+    a = std::min(std::pow(s, 1.0 / gp1) / ls_.small_slope(), hi);
+  } else {  // Hermite interpolation of log a in log sigma, bracketed by the two nodes
+    const double x = (target - inv_s0_) / (inv_s1_ - inv_s0_) * kInvTable;
+    int i = static_cast<int>(x);
+    i = i >= kInvTable ? kInvTable - 1 : i;
+    const double t = x - i, t2 = t * t, omt = 1.0 - t;
+    const double h00 = (1.0 + 2.0 * t) * omt * omt, h10 = t * omt * omt, h11 = t2 * (t - 1.0);
+    const double* r = &inv_[3 * i];
+    const double la = h00 * r[0] + h10 * r[1] + (1.0 - h00) * r[3] + h11 * r[4];
+    lo = r[2];
+    hi = r[5];
+    a = std::min(std::max(std::exp(la), lo), hi);
+  }
+  // Newton polish inside the bracket (one step from the table; more only from the tails).
+  auto phi = [&](double x, double& d) {
+    const LsPoint q = ls_.eval(x);
+    d = gp1 * q.dF / q.F - q.dT / q.T;
+    return gp1 * std::log(q.F) - std::log(q.T) - target;
+  };
+  a = bracketed_newton(phi, a, lo, hi, true, 1e-9, 0.0, 1e-12, kMaxIter, iterations);
+  return a;
+}
+
+double ContactModel::solve_outside(double f, double t, int* iterations, double guess) const noexcept {
+  const double xi2 = 2.0 * ls_.xi();
+  const double c_max = p_.c_max;
+  auto h = [&](double a, double& dh) {
+    const LsPoint q = ls_.eval(a);
+    dh = -q.dF - xi2 * (t - q.T) + xi2 * a * q.dT;
+    return f - q.F - xi2 * a * (t - q.T);
+  };
+  double dummy;
+  const double h_hi = h(c_max, dummy);
+  if (h_hi > 0.0) {  // root beyond the clip
+    if (iterations) *iterations = 1;
+    return c_max;
+  }
+  const double h_lo = f;  // h(0) = f >= 0
+  double a = (guess > 0.0 && guess < c_max) ? guess : (h_lo - h_hi > 0.0 ? c_max * h_lo / (h_lo - h_hi) : 0.5 * c_max);
+  a = bracketed_newton(h, a, 0.0, c_max, false, 0.0, 1e-13, 1e-14, kMaxIter, iterations);
+  if (iterations) *iterations += 1;
+  return a;
+}
+
+bool validate(const CorSettings& s, std::string* message) {
+  std::string msg;
+  auto positive = [&](const char* name, double v) {
+    if (!(std::isfinite(v) && v > 0.0))
+      msg += std::string(name) + " = " + std::to_string(v) + ": must be finite and > 0\n";
+  };
+  positive("f_n_min", s.f_n_min);
+  positive("force_limit", s.force_limit);
+  positive("torque_limit", s.torque_limit);
+  positive("zero_force", s.zero_force);
+  positive("zero_torque", s.zero_torque);
+  if (message) *message = msg;
+  return msg.empty();
+}
+
+namespace {
+const CorSettings& checked(const CorSettings& s) {
+  std::string msg;
+  if (!validate(s, &msg)) throw std::invalid_argument("invalid CorSettings:\n" + msg);
+  return s;
+}
+}  // namespace
+
+CorEstimator::CorEstimator(const ContactParams& params, const CorSettings& settings)
+    : model_(params), s_(checked(settings)) {
+  reset();
+}
+
+CorEstimator::CorEstimator(const ContactModel& model, const CorSettings& settings)
+    : model_(model), s_(checked(settings)) {
+  reset();
+}
+
+void CorEstimator::reset() noexcept {
+  last_ = CorOutput();
+  last_.status = Status::NoContact;
+}
+
+Status CorEstimator::step(const CorInput& in, CorOutput& out) noexcept {
+  const bool finite = std::isfinite(in.f_n) && std::isfinite(in.f_t) && std::isfinite(in.tau);
+  if (!finite || std::fabs(in.f_n) > s_.force_limit || std::fabs(in.f_t) > s_.force_limit ||
+      std::fabs(in.tau) > s_.torque_limit) {
+    out = last_;
+    out.iterations = 0;
+    return out.status = Status::InvalidSample;
+  }
+  if (!(in.f_n >= s_.f_n_min)) {
+    out = last_;
+    out.iterations = 0;
+    return out.status = Status::NoContact;
+  }
+  const ContactParams& p = model_.params();
+  const LimitSurface& ls = model_.limit_surface();
+  const double f_n = in.f_n;
+  const double rho = model_.rho(f_n);
+  const double ft_t = in.f_t / (p.mu * f_n);
+  const double tau_t = in.tau / (p.mu * ls.xi() * rho * f_n);
+  const double f = std::fabs(ft_t), t = std::fabs(tau_t);
+  const double prev = last_.c_tilde;
+
+  CorOutput r;
+  r.ft_tilde = ft_t;
+  r.tau_tilde = tau_t;
+  r.rho = rho;
+  const double f_pow = f * std::pow(f, p.gamma);  // |f~_t|^(gamma+1)
+  r.sigma = t > 0.0 ? std::copysign(f_pow / t, in.tau)
+                    : (f > 0.0 ? std::numeric_limits<double>::max() : 0.0);
+  double a = 0.0, sign = 1.0;
+  Status status = Status::Ok;
+  int iters = 0;
+  if (f < s_.zero_force && t < s_.zero_torque) {  // no wrench: the CoR is undefined
+    a = std::fabs(prev);
+    sign = prev < 0.0 ? -1.0 : 1.0;
+    r.inside = true;
+    status = Status::Degenerate;
+  } else if (f < s_.zero_force) {  // pure torque: rotation about the patch centre
+    a = 0.0;
+    r.inside = t < 1.0;
+  } else {
+    const bool no_torque = t < s_.zero_torque;
+    const double a_sigma = t > 0.0 ? model_.invert_sigma(f_pow / t, &iters)
+                                   : std::numeric_limits<double>::infinity();
+    const LsPoint q = ls.eval(a_sigma);
+    r.inside = f * f + t * t < q.F * q.F + q.T * q.T;
+    if (r.inside) {
+      a = a_sigma;
+    } else {
+      int it2 = 0;
+      a = model_.solve_outside(f, t, &it2, a_sigma);
+      iters += it2;
+    }
+    if (no_torque)  // sign of a torque below the noise: hold the previous side (hysteresis)
+      sign = prev < 0.0 ? -1.0 : 1.0;
+    else
+      sign = -(in.f_t < 0.0 ? -1.0 : 1.0) * (in.tau < 0.0 ? -1.0 : 1.0);
+  }
+  if (a >= p.c_max) {
+    r.saturated = a > p.c_max || status != Status::Degenerate;
+    a = p.c_max;
+    if (status == Status::Ok) status = Status::Saturated;
+  }
+  r.c_tilde = sign * a;
+  r.c = r.c_tilde * rho;
+  const LsPoint q = ls.eval(a);
+  const double r2 = rho * rho;
+  r.g = p.mu * f_n * rho * (ls.xi() * q.T + a * q.F);
+  r.sigma_1 = kPi * p.beta_a * r2 * r2 * (r.c_tilde * r.c_tilde + 0.5);
+  r.y = in.tau - r.c * in.f_t;
+  r.iterations = iters;
+  r.status = status;
+  last_ = r;
+  out = r;
+  return status;
+}
+
+}  // namespace lugrip
