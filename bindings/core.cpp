@@ -141,7 +141,15 @@ NB_MODULE(_core, m) {
       .def("sigma_1", [](const ContactModel& cm, const In1& fn, const In1& c) { return map2(fn, c, [&](double x, double y) { return cm.sigma_1(x, y); }); })
       .def("g", [](const ContactModel& cm, const In1& fn, const In1& c) { return map2(fn, c, [&](double x, double y) { return cm.g(x, y); }); })
       .def("invert_sigma", [](const ContactModel& cm, const In1& s) { return map1(s, [&](double x) { return cm.invert_sigma(x); }); })
-      .def("solve_outside", [](const ContactModel& cm, const In1& f, const In1& t) { return map2(f, t, [&](double x, double y) { return cm.solve_outside(x, y); }); });
+      .def("solve_outside", [](const ContactModel& cm, const In1& f, const In1& t) { return map2(f, t, [&](double x, double y) { return cm.solve_outside(x, y); }); })
+      .def("wrench_at", [](const ContactModel& cm, const In1& fn, const In1& c, const In1& y) {
+        same_size(fn, c);
+        same_size(fn, y);
+        const size_t n = fn.shape(0);
+        auto ft = new_array<double>(n), tau = new_array<double>(n);
+        for (size_t i = 0; i < n; ++i) cm.wrench_at(fn.data()[i], c.data()[i], y.data()[i], ft.data()[i], tau.data()[i]);
+        return nb::make_tuple(ft, tau);
+      }, "f_n"_a, "c_tilde"_a, "y"_a, "Sensor wrench (f_t, tau) with CoR |c~| and torque y about it.");
 
   nb::class_<CorOutput>(m, "CorOutput")
       .def(nb::init<>())

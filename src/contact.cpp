@@ -155,6 +155,30 @@ double ContactModel::solve_outside(double f, double t, int* iterations, double g
   return a;
 }
 
+void ContactModel::wrench_at(double f_n, double c_tilde, double y, double& f_t, double& tau) const noexcept {
+  const double a = std::fabs(c_tilde), sign = y < 0.0 ? -1.0 : 1.0;
+  const double rho_n = rho(f_n), unit = p_.mu * f_n * rho_n;  // g = unit * G(a)
+  const double xi = ls_.xi();
+  const LsPoint q = ls_.eval(a);
+  const double G = xi * q.T + a * q.F;
+  const double r = std::fabs(y) / unit;
+  if (r > G) {  // sliding: LS point plus viscous excess lambda (2 xi a, 1)
+    const double lambda = (r - G) / (xi * (1.0 + 2.0 * a * a));
+    f_t = p_.mu * f_n * (q.F + 2.0 * xi * a * lambda);
+    tau = sign * p_.mu * xi * rho_n * f_n * (q.T + lambda);
+    return;
+  }
+  // Inside: virtual normal force u f_n with a F u + xi T u^(gamma+1) = r, u in [0, 1].
+  auto phi = [&](double u, double& d) {
+    const double up = std::pow(u, p_.gamma);
+    d = a * q.F + (p_.gamma + 1.0) * xi * q.T * up;
+    return a * q.F * u + xi * q.T * up * u - r;
+  };
+  const double u = r <= 0.0 ? 0.0 : bracketed_newton(phi, r / G, 0.0, 1.0, true, 1e-15, 0.0, 1e-16, kMaxIter, nullptr);
+  f_t = p_.mu * f_n * u * q.F;
+  tau = sign * p_.mu * xi * rho_n * f_n * std::pow(u, p_.gamma + 1.0) * q.T;
+}
+
 bool validate(const CorSettings& s, std::string* message) {
   std::string msg;
   auto positive = [&](const char* name, double v) {
