@@ -244,7 +244,8 @@ Status CorEstimator::step(const CorInput& in, CorOutput& out) noexcept {
   r.tau_tilde = tau_t;
   r.rho = rho;
   const double f_pow = f * std::pow(f, p.gamma);  // |f~_t|^(gamma+1)
-  r.sigma = t > 0.0 ? std::copysign(f_pow / t, in.tau)
+  // |sigma| overflows for a denormal torque: report it as the largest finite value, like t = 0.
+  r.sigma = t > 0.0 ? std::copysign(std::fmin(f_pow / t, std::numeric_limits<double>::max()), in.tau)
                     : (f > 0.0 ? std::numeric_limits<double>::max() : 0.0);
   double a = 0.0, sign = 1.0;
   Status status = Status::Ok;
