@@ -460,7 +460,9 @@ TEST(CorEstimator, WrenchAtRoundTrip) {
         est.step({f_n, f_t, tau}, o);
         SCOPED_TRACE("a = " + std::to_string(a) + ", |y|/g = " + std::to_string(util));
         EXPECT_NEAR(std::fabs(o.c_tilde), a, 1e-7);
-        if (a > 0.0) EXPECT_EQ(o.c_tilde < 0.0, y > 0.0);  // sign(c~) = -sign(y)
+        if (a > 0.0) {
+          EXPECT_EQ(o.c_tilde < 0.0, y > 0.0);  // sign(c~) = -sign(y)
+        }
         EXPECT_NEAR(o.y, y, 1e-7 * std::fabs(y));
         EXPECT_EQ(o.inside, util < 1.0);
       }
@@ -740,8 +742,9 @@ TEST(CorEstimatorProperty, MillionRandomSamples) {
         outside += !o.inside;
         ASSERT_GT(o.g, 0.0);
         ASSERT_EQ(o.saturated, s == Status::Saturated);
-        if (std::fabs(o.tau_tilde) >= est.settings().zero_torque && std::fabs(o.ft_tilde) >= est.settings().zero_force)
+        if (std::fabs(o.tau_tilde) >= est.settings().zero_torque && std::fabs(o.ft_tilde) >= est.settings().zero_force) {
           ASSERT_EQ(o.c_tilde < 0.0, (in.f_t < 0.0) == (in.tau < 0.0)) << in.f_n << " " << in.f_t << " " << in.tau;
+        }
         if (i % 97 == 0 && std::fabs(o.tau_tilde) >= est.settings().zero_torque) {
           CorEstimator fresh(m);
           CorOutput f;
