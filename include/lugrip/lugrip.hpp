@@ -2,6 +2,7 @@
 #pragma once
 
 #include "lugrip/contact.hpp"
+#include "lugrip/grasp_controller.hpp"
 #include "lugrip/limit_surface.hpp"
 #include "lugrip/params.hpp"
 #include "lugrip/status.hpp"

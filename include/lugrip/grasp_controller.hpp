@@ -1,0 +1,267 @@
+// lugrip — grasp-force controller: slipping avoidance and pivoting (paper eqs. 34-37, MODEL.md 9)
+// and the static grasp force a constant load settles at.
+#pragma once
+
+#include <array>
+#include <string>
+
+#include "lugrip/contact.hpp"
+#include "lugrip/params.hpp"
+#include "lugrip/status.hpp"
+
+namespace lugrip {
+
+//! Number of fingertips the controller combines (parallel gripper).
+constexpr int kMaxFingers = 2;
+
+//! Settings of GraspController; every default is here. All forces per finger [N] (a parallel
+//! gripper applies the same normal force on both fingertips). Fields marked (*) may be changed
+//! at run time through GraspController::set_settings() (validated again).
+struct GraspControllerSettings {
+  // --- rates ----------------------------------------------------------------------------------
+  double sensor_rate = 500.0;  //!< [Hz] rate of step() calls (tactile/observer rate), > 0
+  int command_ratio = 10;      //!< step() calls per force command (500 Hz / 50 Hz), >= 1
+
+  // --- dynamic part f_nd = |C_d omega_hat|, C_d(s) = k_cd (s + z_cd)/(s + p_cd) (eqs. 35-36) --
+  double k_cd = 10.0;   //!< [N s/rad] high-frequency gain, > 0
+  double p_cd = 7.0;    //!< [rad/s] pole, > 0
+  double z_cd = 250.0;  //!< [rad/s] zero, > p_cd (lag network, DC gain k_cd z_cd / p_cd)
+  bool dynamic_enabled = true;  //!< (*) dynamic part active in slipping avoidance
+
+  // --- static part in slipping avoidance: PI on e = S - s_ref (MODEL.md 9.4) -----------------
+  double s_ref = 0.8;  //!< (*) reference of the slippage indicator S-bar_a, in (0, 1)
+  double k_p = 4.0;    //!< (*) [N] proportional gain (e > 0 raises the force), > 0
+  double k_i = 10.0;   //!< (*) [N/s] integral gain, > 0
+  bool anti_windup = true;  //!< (*) back-calculation I = f_ns,clipped - k_p e when clipped
+  //! (*) [N] gain scheduling, not in the paper; 0 = off (paper). When > 0, k_p and k_i are scaled
+  //! by (last command / gain_schedule_force), which keeps the loop gain k_p |dS/df_n| (S ~ 1/f_n)
+  //! the same at every force. Without it the 50 Hz loop on a quasi-static S(f_n) is unstable
+  //! when (k_p - k_i T) |dS/df_n| > 1, i.e. below ~3 N for a translational load (S = 0.8 f*/f_n),
+  //! and limit-cycles there (tests: ClosedLoop.*). >= 0, finite.
+  double gain_schedule_force = 0.0;
+
+  // --- force range and rate limits (MODEL.md 9.5) --------------------------------------------
+  double f_min = 0.1;   //!< [N] minimum force (keeps contact), > 0
+  double f_max = 20.0;  //!< [N] maximum force (gripper limit), > f_min
+  double max_rate_up = 200.0;    //!< (*) [N/s] limit on command increase, > 0 (inf: off)
+  double max_rate_down = 200.0;  //!< (*) [N/s] limit on command decrease, > 0 (inf: off)
+  //! (*) [N] added to the held command at each command issued while the input is invalid
+  //! (NaN/Inf, InvalidSample, SensorFault, NoContact); 0 = hold. >= 0, finite.
+  double invalid_raise_step = 0.0;
+
+  // --- pivoting mode (MODEL.md 9.6) -----------------------------------------------------------
+  double s_pivot = 1.3;      //!< (*) reference S-bar_p, > 1
+  double tau_pivot = 2.0;    //!< (*) [s] time constant tau_p of the pivoting filter, > 0
+  double k_f = 4.0;          //!< (*) [N] gain of the pivoting filter (paper: k_f = k_p), > 0
+  double pivot_floor_factor = 1.1;  //!< (*) floor max(f_min, factor f_t / mu), >= 1
+  double pivot_end_c_tilde = 1.0;   //!< (*) pivoting ends when mean |c~_i| exceeds this, > 0
+  int pivot_end_samples = 3;        //!< (*) ... on this many consecutive samples, >= 1
+  double pivot_timeout = 10.0;      //!< (*) [s] pivoting ends after this time, > 0 (inf: never)
+};
+
+//! Checks every field; one line per bad field ("k_p = -1: must be finite and > 0") in *message
+//! (if not null). Returns true when valid.
+bool validate(const GraspControllerSettings& s, std::string* message);
+
+//! Python-assignment style dump at full precision.
+std::string to_string(const GraspControllerSettings& s);
+
+//! Operating mode. Stable integer values.
+enum class ControllerMode : int {
+  SlippingAvoidance = 0,  //!< f_nd + PI on S (both parts active)
+  Pivoting = 1,           //!< f_nd = 0, first-order filter driving S toward S-bar_p > 1
+};
+
+//! Why pivoting ended (reported in the call where it ends). Stable integer values.
+enum class PivotEnd : int {
+  None = 0,          //!< pivoting did not end in this call
+  CorThreshold = 1,  //!< mean |c~| > pivot_end_c_tilde on pivot_end_samples consecutive samples
+  Timeout = 2,       //!< pivot_timeout elapsed
+  Requested = 3,     //!< request_slipping_avoidance() while pivoting
+};
+
+const char* to_string(ControllerMode m) noexcept;
+const char* to_string(PivotEnd e) noexcept;
+
+//! One fingertip's observer values for one sensor sample (filled from the observer output;
+//! the controller does not depend on the observer type).
+struct FingerInput {
+  double omega_hat = 0.0;  //!< estimated sliding velocity about the CoR [rad/s]
+  double slippage = 0.0;   //!< slippage indicator S = sigma0 |z^| / g [-], >= 0 (eq. 37)
+  double c_tilde = 0.0;    //!< normalized CoR c / rho [-] (signed or magnitude)
+  double f_t = 0.0;        //!< tangential force [N] (magnitude is used; pivoting floor)
+  Status status = Status::Ok;  //!< observer status of this sample
+  bool present = true;     //!< false: this finger is not used (one-finger operation)
+};
+
+//! Input of one step(): the two fingertips at one sensor sample.
+struct GraspControllerInput {
+  std::array<FingerInput, kMaxFingers> fingers{};
+};
+
+//! Output of one step() (caller-owned, reused). The command fields are those of the last
+//! command issued (zero-order hold between commands); the *_sample fields belong to this call.
+struct GraspControllerOutput {
+  double force = 0.0;          //!< commanded grasp force f_n [N], in [f_min, f_max], finite
+  double static_force = 0.0;   //!< static part f_ns at the last command [N]
+  double dynamic_force = 0.0;  //!< dynamic part f_nd at the last command, after clipping [N]
+  double floor = 0.0;          //!< lower bound applied at the last command [N]
+  double slippage = 0.0;       //!< combined S = max_i S_i used at the last command [-]
+  double error = 0.0;          //!< S - S-bar (S-bar_a or S-bar_p) at the last command [-]
+  double integrator = 0.0;     //!< PI integrator I after the last command [N]
+  //! signed C_d omega_hat_i of each finger at this sample [N] (0 for absent fingers)
+  std::array<double, kMaxFingers> dynamic_sample{};
+  double dynamic_peak = 0.0;   //!< peak of max_i |C_d omega_hat_i| since the last command [N]
+  double mean_c_tilde = 0.0;   //!< mean |c~_i| over valid fingers at this sample [-]
+  double pivot_time = 0.0;     //!< [s] time spent in the current pivoting manoeuvre
+  ControllerMode mode = ControllerMode::SlippingAvoidance;  //!< mode after this call
+  PivotEnd pivot_end = PivotEnd::None;  //!< reason, when pivoting ended in this call
+  bool pivot_finished = false;  //!< event: pivoting ended in this call
+  bool command_issued = false;  //!< a new command was computed in this call
+  bool saturated = false;       //!< last command: static part or total clipped at a limit
+  bool rate_limited = false;    //!< last command: the rate limit was active
+  bool held = false;            //!< last command: safe hold/raise because of invalid input
+  //! this sample: Ok, or the worst finger status (SensorFault > InvalidSample > NoContact) when
+  //! a present finger is invalid (NaN/Inf/out of range counts as InvalidSample); NoContact when
+  //! no finger is present.
+  Status status = Status::Ok;
+};
+
+//! First-order filter k (s + z)/(s + p) discretised by Tustin (bilinear, no prewarping) at
+//! sample time T: y[n] = b0 u[n] + b1 u[n-1] - a1 y[n-1], with K = 2/T,
+//! b0 = k (K + z)/(K + p), b1 = k (z - K)/(K + p), a1 = (p - K)/(K + p).
+//! DC gain k z / p and gain k at Nyquist are exact; |H(e^{jwT})| = |C(j K tan(wT/2))|.
+class LagFilter {
+ public:
+  LagFilter() = default;
+  LagFilter(double k, double z, double p, double sample_time) noexcept;
+  double step(double u) noexcept {
+    const double y = b0_ * u + b1_ * u_ - a1_ * y_;
+    u_ = u;
+    y_ = y;
+    return y;
+  }
+  void reset() noexcept { u_ = y_ = 0.0; }  //!< zero state (output starts from 0)
+  double b0() const noexcept { return b0_; }
+  double b1() const noexcept { return b1_; }
+  double a1() const noexcept { return a1_; }
+  double output() const noexcept { return y_; }
+
+ private:
+  double b0_ = 0.0, b1_ = 0.0, a1_ = 0.0, u_ = 0.0, y_ = 0.0;
+};
+
+//! Two-mode grasp-force controller f_n = f_ns + f_nd (eq. 34, MODEL.md 9).
+//!
+//! * step() runs at the sensor rate. Every call updates one C_d filter per present finger
+//!   (Tustin at the sensor rate) and the peak of max_i |C_d omega_hat_i|; every command_ratio-th
+//!   call (the first call after construction/reset included) computes a new command, which is
+//!   held in between (zero-order hold).
+//! * Slipping avoidance: f_ns = k_p e + I, e = S - s_ref, forward-Euler integrator at the command
+//!   rate; f_ns clipped to [f_min, f_max] with back-calculation anti-windup; f_nd = the peak of
+//!   |C_d omega_hat| over the last command period clipped to [0, f_max - f_ns].
+//! * Pivoting: f_nd = 0; tau_p df/dt = -f + k_f (S - s_pivot), exact discretisation at the
+//!   command rate, started from the last command; floor max(f_min, factor max_i |f_t,i| / mu)
+//!   on the output and the filter state; ends on mean |c~_i| > pivot_end_c_tilde for
+//!   pivot_end_samples consecutive sensor samples, on timeout or on request, then returns to
+//!   slipping avoidance bumplessly (I = last command - k_p e at the next command, C_d reset).
+//! * Two fingers (MODEL.md 9.8): S = max_i S_i, f_nd from max_i |C_d omega_hat_i|, pivot end on
+//!   the mean of |c~_i|; absent fingers are ignored.
+//! * Rate limits act on the total command after the force range; the floor wins over them.
+//! * Invalid input (a present finger with NaN/Inf/out-of-range values or status InvalidSample,
+//!   SensorFault, NoContact): its C_d state is held; a command due in such a call holds the last
+//!   command (plus invalid_raise_step), never lower, and the static law restarts bumplessly.
+class GraspController {
+ public:
+  //! Validates params (uses mu) and settings; throws std::invalid_argument naming bad fields.
+  GraspController(const ContactParams& params, const GraspControllerSettings& settings = {});
+
+  //! One sensor sample. Never throws, never allocates; out.force is finite, in [f_min, f_max].
+  void step(const GraspControllerInput& in, GraspControllerOutput& out) noexcept;
+
+  //! Back to slipping avoidance with zeroed filters; current_force [N] (clipped to the range,
+  //! f_min if not finite) is the command held until the next step(), which issues a command
+  //! and starts the PI bumplessly from it.
+  void reset(double current_force) noexcept;
+  void reset() noexcept { reset(s_.f_min); }
+
+  //! Latched requests, applied at the next step(). Pivoting starts from the last command.
+  void request_pivoting() noexcept;
+  void request_slipping_avoidance() noexcept;
+
+  //! Enables/disables the dynamic part; re-enabling resets the C_d states.
+  void set_dynamic_enabled(bool enabled) noexcept;
+  //! Replaces the settings marked (*) (rates, C_d and force range must not change); throws
+  //! std::invalid_argument when invalid or when a fixed field differs.
+  void set_settings(const GraspControllerSettings& settings);
+
+  ControllerMode mode() const noexcept { return mode_; }
+  double command() const noexcept { return command_; }
+  double command_period() const noexcept { return t_cmd_; }  //!< [s]
+  const GraspControllerSettings& settings() const noexcept { return s_; }
+  const LagFilter& dynamic_filter(int finger) const noexcept { return cd_[finger]; }
+  double mu() const noexcept { return mu_; }
+
+ private:
+  enum class Request { None, Pivot, Avoid };
+  void end_pivot(PivotEnd why, GraspControllerOutput& out) noexcept;
+  void reset_dynamic() noexcept;
+  void issue_command(bool valid, double slip) noexcept;
+
+  GraspControllerSettings s_;
+  double mu_ = 1.0;
+  double dt_ = 0.002, t_cmd_ = 0.02, pivot_decay_ = 0.0;
+  std::array<LagFilter, kMaxFingers> cd_{};
+  ControllerMode mode_ = ControllerMode::SlippingAvoidance;
+  Request request_ = Request::None;
+  bool init_static_ = true;   // bumpless (re)start of the static law at the next command
+  int phase_ = 0;             // calls since the last command
+  double command_ = 0.0;      // last command [N]
+  double integrator_ = 0.0;   // PI integrator I [N]
+  double pivot_state_ = 0.0;  // pivoting filter state [N]
+  double peak_ = 0.0;         // running peak of max_i |C_d omega_i| [N]
+  long pivot_samples_ = 0;    // samples since pivoting started
+  int pivot_count_ = 0;       // consecutive samples with mean |c~| above the threshold
+  double last_f_t_ = 0.0;     // last valid max_i |f_t,i| [N] (pivot floor)
+  GraspControllerOutput last_{};  // command fields of the last command
+};
+
+//! Static utilization and static grasp force for a constant load (MODEL.md 6, 9.4).
+//!
+//! S_static(f_n) = |tau - c f_t| / g(f_n, c) = (|tau| + |c| f_t) / g(f_n, c), with c~ from the
+//! CoR estimator at f_n (same estimator and c_max clip as the closed loop), is what S settles
+//! to in stick. (For a torque below the estimator's zero threshold, whose sign the estimator
+//! holds from history, the load-motion sign rule is applied instead: at most 1e-4 tau_max.)
+//! It decreases with f_n, so the force where the static controller settles, S_static = s_ref,
+//! is found by a bracket (doubling) and a safeguarded secant (Illinois) on log f_n.
+struct StaticForceResult {
+  double force = 0.0;     //!< f_n [N] with S_static(f_n) = s_ref (0 for a zero load, NaN if invalid)
+  double c_tilde = 0.0;   //!< |c~| estimated at that force [-]
+  double slippage = 0.0;  //!< S_static at that force [-]
+  int iterations = 0;     //!< S_static evaluations spent
+  bool converged = false; //!< relative tolerance 1e-12 on f_n reached within the bound
+};
+
+class StaticForceSolver {
+ public:
+  //! Copies the model's tables into its own CoR estimator (allocates; construction only).
+  explicit StaticForceSolver(const ContactModel& model);
+  explicit StaticForceSolver(const ContactParams& params);
+
+  //! S_static at normal force f_n [N] for a load f_t [N] (magnitude used), tau [N m]. Never
+  //! allocates. NaN for a non-finite or non-positive f_n.
+  double slippage(double f_n, double f_t, double tau, double* c_tilde = nullptr) noexcept;
+  //! Per-finger static grasp force for the load (f_t, tau) and reference s_ref in (0, 1].
+  StaticForceResult solve(double f_t, double tau, double s_ref = 0.8) noexcept;
+
+  const ContactModel& model() const noexcept { return est_.model(); }
+
+ private:
+  CorEstimator est_;
+};
+
+//! Convenience: per-finger static grasp force [N] (builds a ContactModel; prefer
+//! StaticForceSolver for many loads). Throws std::invalid_argument for invalid params or s_ref.
+double static_grasp_force(const ContactParams& params, double f_t, double tau, double s_ref = 0.8);
+
+}  // namespace lugrip

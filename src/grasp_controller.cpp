@@ -1,0 +1,480 @@
+#include "lugrip/grasp_controller.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <limits>
+#include <stdexcept>
+
+namespace lugrip {
+
+namespace {
+
+// Observer values beyond these magnitudes are treated as invalid samples (keeps every internal
+// state finite: the C_d filter is stable and the PI error bounded).
+constexpr double kMaxSlippage = 1.0e3;
+constexpr double kMaxInput = 1.0e6;
+
+std::string fmt(double v) {
+  char buf[40];
+  std::snprintf(buf, sizeof buf, "%.17g", v);
+  return buf;
+}
+
+double clamp(double v, double lo, double hi) noexcept { return v < lo ? lo : (v > hi ? hi : v); }
+
+// Severity for the combined sample status.
+int severity(Status s) noexcept {
+  switch (s) {
+    case Status::SensorFault: return 3;
+    case Status::InvalidSample: return 2;
+    case Status::NoContact: return 1;
+    default: return 0;
+  }
+}
+
+bool finger_valid(const FingerInput& f) noexcept {
+  return is_valid(f.status) && std::isfinite(f.omega_hat) && std::fabs(f.omega_hat) <= kMaxInput &&
+         std::isfinite(f.slippage) && f.slippage >= 0.0 && f.slippage <= kMaxSlippage &&
+         std::isfinite(f.c_tilde) && std::fabs(f.c_tilde) <= kMaxInput && std::isfinite(f.f_t) &&
+         std::fabs(f.f_t) <= kMaxInput;
+}
+
+const GraspControllerSettings& checked(const GraspControllerSettings& s) {
+  std::string msg;
+  if (!validate(s, &msg)) throw std::invalid_argument("invalid GraspControllerSettings:\n" + msg);
+  return s;
+}
+
+}  // namespace
+
+// --- settings --------------------------------------------------------------------------------
+
+bool validate(const GraspControllerSettings& s, std::string* message) {
+  std::string msg;
+  auto bad = [&](const char* name, double v, const char* rule) {
+    msg += std::string(name) + " = " + fmt(v) + ": " + rule + "\n";
+  };
+  auto positive = [&](const char* name, double v) {
+    if (!(std::isfinite(v) && v > 0.0)) bad(name, v, "must be finite and > 0");
+  };
+  auto positive_or_inf = [&](const char* name, double v) {
+    if (!(v > 0.0)) bad(name, v, "must be > 0 (inf: off)");
+  };
+  positive("sensor_rate", s.sensor_rate);
+  if (!(std::isfinite(s.gain_schedule_force) && s.gain_schedule_force >= 0.0))
+    bad("gain_schedule_force", s.gain_schedule_force, "must be finite and >= 0 (0: off)");
+  if (!(s.command_ratio >= 1)) bad("command_ratio", s.command_ratio, "must be >= 1");
+  positive("k_cd", s.k_cd);
+  positive("p_cd", s.p_cd);
+  if (!(std::isfinite(s.z_cd) && s.z_cd > s.p_cd)) bad("z_cd", s.z_cd, "must be finite and > p_cd (lag network)");
+  if (!(s.s_ref > 0.0 && s.s_ref < 1.0)) bad("s_ref", s.s_ref, "must satisfy 0 < s_ref < 1");
+  positive("k_p", s.k_p);
+  positive("k_i", s.k_i);
+  positive("f_min", s.f_min);
+  if (!(std::isfinite(s.f_max) && s.f_max > s.f_min)) bad("f_max", s.f_max, "must be finite and > f_min");
+  positive_or_inf("max_rate_up", s.max_rate_up);
+  positive_or_inf("max_rate_down", s.max_rate_down);
+  if (!(std::isfinite(s.invalid_raise_step) && s.invalid_raise_step >= 0.0))
+    bad("invalid_raise_step", s.invalid_raise_step, "must be finite and >= 0");
+  if (!(std::isfinite(s.s_pivot) && s.s_pivot > 1.0)) bad("s_pivot", s.s_pivot, "must be finite and > 1");
+  positive("tau_pivot", s.tau_pivot);
+  positive("k_f", s.k_f);
+  if (!(std::isfinite(s.pivot_floor_factor) && s.pivot_floor_factor >= 1.0))
+    bad("pivot_floor_factor", s.pivot_floor_factor, "must be finite and >= 1");
+  positive("pivot_end_c_tilde", s.pivot_end_c_tilde);
+  if (!(s.pivot_end_samples >= 1)) bad("pivot_end_samples", s.pivot_end_samples, "must be >= 1");
+  positive_or_inf("pivot_timeout", s.pivot_timeout);
+  if (message) *message = msg;
+  return msg.empty();
+}
+
+std::string to_string(const GraspControllerSettings& s) {
+  auto num = [](double v) { return std::isinf(v) ? std::string("float('inf')") : fmt(v); };
+  auto flag = [](bool b) { return std::string(b ? "True" : "False"); };
+  return "GraspControllerSettings(sensor_rate=" + num(s.sensor_rate) +
+         ", command_ratio=" + std::to_string(s.command_ratio) + ", k_cd=" + num(s.k_cd) +
+         ", p_cd=" + num(s.p_cd) + ", z_cd=" + num(s.z_cd) + ", dynamic_enabled=" + flag(s.dynamic_enabled) +
+         ", s_ref=" + num(s.s_ref) + ", k_p=" + num(s.k_p) + ", k_i=" + num(s.k_i) +
+         ", anti_windup=" + flag(s.anti_windup) + ", gain_schedule_force=" + num(s.gain_schedule_force) +
+         ", f_min=" + num(s.f_min) + ", f_max=" + num(s.f_max) +
+         ", max_rate_up=" + num(s.max_rate_up) + ", max_rate_down=" + num(s.max_rate_down) +
+         ", invalid_raise_step=" + num(s.invalid_raise_step) + ", s_pivot=" + num(s.s_pivot) +
+         ", tau_pivot=" + num(s.tau_pivot) + ", k_f=" + num(s.k_f) +
+         ", pivot_floor_factor=" + num(s.pivot_floor_factor) +
+         ", pivot_end_c_tilde=" + num(s.pivot_end_c_tilde) +
+         ", pivot_end_samples=" + std::to_string(s.pivot_end_samples) +
+         ", pivot_timeout=" + num(s.pivot_timeout) + ")";
+}
+
+const char* to_string(ControllerMode m) noexcept {
+  switch (m) {
+    case ControllerMode::SlippingAvoidance: return "slipping avoidance";
+    case ControllerMode::Pivoting: return "pivoting";
+  }
+  return "unknown";
+}
+
+const char* to_string(PivotEnd e) noexcept {
+  switch (e) {
+    case PivotEnd::None: return "none";
+    case PivotEnd::CorThreshold: return "mean |c~| above the threshold";
+    case PivotEnd::Timeout: return "timeout";
+    case PivotEnd::Requested: return "slipping avoidance requested";
+  }
+  return "unknown";
+}
+
+// --- C_d -------------------------------------------------------------------------------------
+
+LagFilter::LagFilter(double k, double z, double p, double sample_time) noexcept {
+  const double K = 2.0 / sample_time;  // s = K (1 - z^-1) / (1 + z^-1)
+  b0_ = k * (K + z) / (K + p);
+  b1_ = k * (z - K) / (K + p);
+  a1_ = (p - K) / (K + p);
+}
+
+// --- controller ------------------------------------------------------------------------------
+
+GraspController::GraspController(const ContactParams& params, const GraspControllerSettings& settings)
+    : s_(checked(settings)) {
+  validate_or_throw(params);
+  mu_ = params.mu;
+  dt_ = 1.0 / s_.sensor_rate;
+  t_cmd_ = s_.command_ratio * dt_;
+  pivot_decay_ = std::exp(-t_cmd_ / s_.tau_pivot);
+  for (auto& f : cd_) f = LagFilter(s_.k_cd, s_.z_cd, s_.p_cd, dt_);
+  reset(s_.f_min);
+}
+
+void GraspController::reset(double current_force) noexcept {
+  mode_ = ControllerMode::SlippingAvoidance;
+  request_ = Request::None;
+  init_static_ = true;
+  phase_ = 0;
+  command_ = std::isfinite(current_force) ? clamp(current_force, s_.f_min, s_.f_max) : s_.f_min;
+  integrator_ = 0.0;
+  pivot_state_ = command_;
+  pivot_samples_ = 0;
+  pivot_count_ = 0;
+  last_f_t_ = 0.0;
+  reset_dynamic();
+  last_ = GraspControllerOutput();
+  last_.force = command_;
+  last_.static_force = command_;
+  last_.floor = s_.f_min;
+}
+
+void GraspController::reset_dynamic() noexcept {
+  for (auto& f : cd_) f.reset();
+  peak_ = 0.0;
+}
+
+void GraspController::request_pivoting() noexcept { request_ = Request::Pivot; }
+void GraspController::request_slipping_avoidance() noexcept { request_ = Request::Avoid; }
+
+void GraspController::set_dynamic_enabled(bool enabled) noexcept {
+  if (enabled && !s_.dynamic_enabled) reset_dynamic();
+  s_.dynamic_enabled = enabled;
+}
+
+void GraspController::set_settings(const GraspControllerSettings& settings) {
+  checked(settings);
+  if (settings.sensor_rate != s_.sensor_rate || settings.command_ratio != s_.command_ratio ||
+      settings.k_cd != s_.k_cd || settings.p_cd != s_.p_cd || settings.z_cd != s_.z_cd)
+    throw std::invalid_argument(
+        "GraspController::set_settings: sensor_rate, command_ratio, k_cd, p_cd and z_cd are fixed "
+        "at construction");
+  const bool dynamic = settings.dynamic_enabled;
+  GraspControllerSettings next = settings;
+  next.dynamic_enabled = s_.dynamic_enabled;
+  s_ = next;
+  set_dynamic_enabled(dynamic);
+  pivot_decay_ = std::exp(-t_cmd_ / s_.tau_pivot);
+  command_ = clamp(command_, s_.f_min, s_.f_max);
+  last_.force = command_;
+}
+
+void GraspController::end_pivot(PivotEnd why, GraspControllerOutput& out) noexcept {
+  mode_ = ControllerMode::SlippingAvoidance;
+  init_static_ = true;  // PI integrator = last command - k_p e at the next command
+  reset_dynamic();      // C_d restarts from rest
+  pivot_count_ = 0;
+  out.pivot_finished = true;
+  out.pivot_end = why;
+}
+
+void GraspController::step(const GraspControllerInput& in, GraspControllerOutput& out) noexcept {
+  out.pivot_finished = false;
+  out.pivot_end = PivotEnd::None;
+  out.command_issued = false;
+
+  // Mode requests latched since the last call.
+  if (request_ == Request::Pivot && mode_ == ControllerMode::SlippingAvoidance) {
+    mode_ = ControllerMode::Pivoting;
+    init_static_ = true;  // the filter starts from the last command
+    pivot_samples_ = 0;
+    pivot_count_ = 0;
+    peak_ = 0.0;
+  } else if (request_ == Request::Avoid && mode_ == ControllerMode::Pivoting) {
+    end_pivot(PivotEnd::Requested, out);
+  }
+  request_ = Request::None;
+
+  // Per-finger checks, C_d at the sensor rate, combination (MODEL.md 9.8).
+  const bool dynamic = mode_ == ControllerMode::SlippingAvoidance && s_.dynamic_enabled;
+  bool any_present = false, valid = true;
+  Status worst = Status::Ok;
+  double slip = 0.0, c_sum = 0.0, f_t_max = 0.0;
+  int n_valid = 0;
+  for (int i = 0; i < kMaxFingers; ++i) {
+    const FingerInput& f = in.fingers[i];
+    if (!f.present) {
+      cd_[i].reset();
+      out.dynamic_sample[i] = 0.0;
+      continue;
+    }
+    any_present = true;
+    if (!finger_valid(f)) {
+      valid = false;
+      const Status s = is_valid(f.status) ? Status::InvalidSample : f.status;
+      if (severity(s) > severity(worst)) worst = s;
+      out.dynamic_sample[i] = cd_[i].output();  // state held, sample not filtered
+      continue;
+    }
+    slip = std::max(slip, f.slippage);
+    c_sum += std::fabs(f.c_tilde);
+    f_t_max = std::max(f_t_max, std::fabs(f.f_t));
+    ++n_valid;
+    if (dynamic) {
+      const double y = cd_[i].step(f.omega_hat);
+      peak_ = std::max(peak_, std::fabs(y));
+      out.dynamic_sample[i] = y;
+    } else {
+      out.dynamic_sample[i] = 0.0;
+    }
+  }
+  if (!any_present) {
+    valid = false;
+    worst = Status::NoContact;
+  }
+  if (valid) last_f_t_ = f_t_max;
+  out.status = valid ? Status::Ok : worst;
+  out.mean_c_tilde = n_valid > 0 ? c_sum / n_valid : 0.0;
+
+  // End of the pivoting manoeuvre, tested at every sensor sample.
+  if (mode_ == ControllerMode::Pivoting) {
+    ++pivot_samples_;
+    if (valid && out.mean_c_tilde > s_.pivot_end_c_tilde)
+      ++pivot_count_;
+    else
+      pivot_count_ = 0;
+    if (pivot_count_ >= s_.pivot_end_samples)
+      end_pivot(PivotEnd::CorThreshold, out);
+    else if (static_cast<double>(pivot_samples_) * dt_ >= s_.pivot_timeout)
+      end_pivot(PivotEnd::Timeout, out);
+  }
+  out.pivot_time = mode_ == ControllerMode::Pivoting ? static_cast<double>(pivot_samples_) * dt_ : 0.0;
+
+  if (phase_ == 0) {
+    issue_command(valid, slip);
+    out.command_issued = true;
+  }
+  phase_ = phase_ + 1 >= s_.command_ratio ? 0 : phase_ + 1;
+
+  out.force = last_.force;
+  out.static_force = last_.static_force;
+  out.dynamic_force = last_.dynamic_force;
+  out.floor = last_.floor;
+  out.slippage = last_.slippage;
+  out.error = last_.error;
+  out.integrator = last_.integrator;
+  out.saturated = last_.saturated;
+  out.rate_limited = last_.rate_limited;
+  out.held = last_.held;
+  out.dynamic_peak = peak_;
+  out.mode = mode_;
+}
+
+void GraspController::issue_command(bool valid, double slip) noexcept {
+  GraspControllerOutput& c = last_;
+  const double pivot_floor =
+      std::min(std::max(s_.f_min, s_.pivot_floor_factor * last_f_t_ / mu_), s_.f_max);
+  const double floor = mode_ == ControllerMode::Pivoting ? pivot_floor : s_.f_min;
+  c.floor = floor;
+  c.saturated = false;
+  c.rate_limited = false;
+
+  if (!valid) {  // safe command: hold (or raise), never below the floor; restart bumplessly
+    command_ = clamp(std::max(command_ + s_.invalid_raise_step, floor), s_.f_min, s_.f_max);
+    init_static_ = true;
+    peak_ = 0.0;
+    c.force = command_;
+    c.held = true;
+    return;
+  }
+  c.held = false;
+
+  double f_ns, f_nd = 0.0, e;
+  if (mode_ == ControllerMode::SlippingAvoidance) {
+    // PI on e = S - s_ref: e > 0 (closer to slip than wanted) raises the force (MODEL.md 9.4).
+    e = slip - s_.s_ref;
+    const double scale = s_.gain_schedule_force > 0.0 ? command_ / s_.gain_schedule_force : 1.0;
+    const double k_p = s_.k_p * scale, k_i = s_.k_i * scale;
+    if (init_static_) {  // bumpless (re)start from the last command
+      integrator_ = command_ - k_p * e;
+      init_static_ = false;
+    }
+    const double u = k_p * e + integrator_;
+    f_ns = clamp(u, s_.f_min, s_.f_max);
+    if (f_ns != u) {
+      c.saturated = true;
+      if (s_.anti_windup) integrator_ = f_ns - k_p * e;  // back-calculation, static part only
+    }
+    integrator_ += k_i * t_cmd_ * e;  // forward Euler
+    if (s_.dynamic_enabled) {
+      const double head_room = s_.f_max - f_ns;
+      f_nd = clamp(peak_, 0.0, head_room);
+      if (peak_ > head_room) c.saturated = true;
+    }
+  } else {
+    // tau_p df/dt = -f + k_f (S - s_pivot), exact discretisation at the command rate; output is
+    // the state before the update, so the first pivoting command equals the last command.
+    e = slip - s_.s_pivot;
+    if (init_static_) {
+      pivot_state_ = command_;
+      init_static_ = false;
+    }
+    pivot_state_ = clamp(pivot_state_, floor, s_.f_max);
+    f_ns = pivot_state_;
+    pivot_state_ = pivot_decay_ * pivot_state_ + (1.0 - pivot_decay_) * s_.k_f * e;
+    pivot_state_ = clamp(pivot_state_, floor, s_.f_max);
+  }
+  peak_ = 0.0;
+
+  const double target = f_ns + f_nd;
+  double f = clamp(target, command_ - s_.max_rate_down * t_cmd_, command_ + s_.max_rate_up * t_cmd_);
+  c.rate_limited = f != target;
+  f = clamp(std::max(f, floor), s_.f_min, s_.f_max);
+  command_ = f;
+
+  c.force = f;
+  c.static_force = f_ns;
+  c.dynamic_force = f_nd;
+  c.slippage = slip;
+  c.error = e;
+  c.integrator = integrator_;
+}
+
+// --- static grasp force ----------------------------------------------------------------------
+
+namespace {
+CorSettings static_cor_settings() {
+  CorSettings s;
+  s.f_n_min = 1.0e-12;  // evaluate the static map at any positive force
+  s.force_limit = 1.0e12;
+  s.torque_limit = 1.0e12;
+  return s;
+}
+}  // namespace
+
+StaticForceSolver::StaticForceSolver(const ContactModel& model) : est_(model, static_cor_settings()) {}
+StaticForceSolver::StaticForceSolver(const ContactParams& params) : est_(params, static_cor_settings()) {}
+
+double StaticForceSolver::slippage(double f_n, double f_t, double tau, double* c_tilde) noexcept {
+  constexpr double nan = std::numeric_limits<double>::quiet_NaN();
+  if (!(std::isfinite(f_n) && f_n > 0.0 && std::isfinite(f_t) && std::isfinite(tau))) return nan;
+  est_.reset();  // no history: tau below the zero threshold takes the default side
+  CorOutput o;
+  est_.step(CorInput{f_n, std::fabs(f_t), tau}, o);
+  if (!is_valid(o.status) || !(o.g > 0.0)) return nan;
+  if (c_tilde) *c_tilde = std::fabs(o.c_tilde);
+  // |tau - c f_t| = |tau| + |c| f_t (tau and c have opposite signs, MODEL.md 6). Equal to |y| of
+  // the estimator except for a torque below its zero threshold, whose sign it holds from history.
+  return (std::fabs(tau) + std::fabs(o.c) * std::fabs(f_t)) / o.g;
+}
+
+StaticForceResult StaticForceSolver::solve(double f_t, double tau, double s_ref) noexcept {
+  constexpr double nan = std::numeric_limits<double>::quiet_NaN();
+  constexpr int kMaxExpand = 120, kMaxRefine = 100;
+  StaticForceResult r;
+  if (!(std::isfinite(f_t) && std::isfinite(tau) && s_ref > 0.0 && s_ref <= 1.0)) {
+    r.force = r.c_tilde = r.slippage = nan;
+    return r;
+  }
+  const double ft = std::fabs(f_t);
+  if (ft == 0.0 && tau == 0.0) {  // no load: no force needed
+    r.converged = true;
+    return r;
+  }
+  const ContactParams& p = est_.model().params();
+  // Residual in logs: S_static decreases with f_n, roughly as a power law.
+  const double log_ref = std::log(s_ref);
+  auto residual = [&](double x) {
+    ++r.iterations;
+    const double s = slippage(std::exp(x), ft, tau);
+    return std::isfinite(s) && s > 0.0 ? std::log(s) - log_ref : nan;
+  };
+  // Guess: the larger of the pure-translation and pure-torsion forces at S = s_ref.
+  const double f_tr = ft / (p.mu * s_ref);
+  const double f_rot = std::pow(std::fabs(tau) / (p.mu * est_.model().xi() * p.delta * s_ref),
+                                1.0 / (1.0 + p.gamma));
+  double lo = std::log(std::max(f_tr, f_rot)), hi = lo;
+  double r_lo = residual(lo), r_hi = r_lo;
+  if (!std::isfinite(r_lo)) {
+    r.force = r.c_tilde = r.slippage = nan;
+    return r;
+  }
+  constexpr double kStep = 0.6931471805599453;  // log 2
+  for (int i = 0; r_hi > 0.0 && i < kMaxExpand; ++i) {
+    lo = hi;
+    r_lo = r_hi;
+    hi += kStep;
+    r_hi = residual(hi);
+  }
+  for (int i = 0; r_lo < 0.0 && i < kMaxExpand; ++i) {
+    hi = lo;
+    r_hi = r_lo;
+    lo -= kStep;
+    r_lo = residual(lo);
+  }
+  double x = r_lo == 0.0 ? lo : hi;
+  bool converged = r_lo == 0.0 || r_hi == 0.0;
+  if (!converged && r_lo > 0.0 && r_hi < 0.0) {
+    // Illinois (regula falsi with halving of the retained end) on [lo, hi].
+    int side = 0;
+    for (int i = 0; i < kMaxRefine; ++i) {
+      x = (lo * r_hi - hi * r_lo) / (r_hi - r_lo);
+      const double rx = residual(x);
+      if (!std::isfinite(rx)) break;
+      if (rx > 0.0) {
+        lo = x;
+        r_lo = rx;
+        if (side == 1) r_hi *= 0.5;
+        side = 1;
+      } else {
+        hi = x;
+        r_hi = rx;
+        if (side == -1) r_lo *= 0.5;
+        side = -1;
+      }
+      if (std::fabs(rx) <= 1e-14 || hi - lo <= 1e-12) {
+        converged = true;
+        break;
+      }
+    }
+  }
+  r.force = std::exp(x);
+  r.slippage = slippage(r.force, ft, tau, &r.c_tilde);
+  r.converged = converged;
+  return r;
+}
+
+double static_grasp_force(const ContactParams& params, double f_t, double tau, double s_ref) {
+  if (!(s_ref > 0.0 && s_ref <= 1.0))
+    throw std::invalid_argument("static_grasp_force: s_ref = " + fmt(s_ref) + ": must satisfy 0 < s_ref <= 1");
+  StaticForceSolver solver(params);
+  return solver.solve(f_t, tau, s_ref).force;
+}
+
+}  // namespace lugrip
