@@ -3,6 +3,7 @@
 
 #include "lugrip/contact.hpp"
 #include "lugrip/grasp_controller.hpp"
+#include "lugrip/grasp_plant.hpp"
 #include "lugrip/limit_surface.hpp"
 #include "lugrip/params.hpp"
 #include "lugrip/status.hpp"
