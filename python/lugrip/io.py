@@ -490,7 +490,8 @@ def _validate(cols: dict[str, np.ndarray], loc: _Locator, *, max_nan_run: int,
 
     bad = np.flatnonzero(~np.isfinite(t))
     if bad.size:
-        raise loc.error(f"time is {t[bad[0]]!r}; every sample needs a finite time", bad[0], "t")
+        raise loc.error(f"time is {float(t[bad[0]])!r}; every sample needs a finite time",
+                        bad[0], "t")
     if n > 1:
         step = np.diff(t)
         back = np.flatnonzero(step <= 0)
@@ -498,38 +499,42 @@ def _validate(cols: dict[str, np.ndarray], loc: _Locator, *, max_nan_run: int,
             i = int(back[0]) + 1
             prev = loc.where(i - 1, None)
             if step[i - 1] == 0:
-                raise loc.error(f"duplicated time t = {t[i]!r} s (same as {prev}); time must "
-                                "increase strictly", i, "t")
-            raise loc.error(f"time goes backwards: t = {t[i]!r} s after t = {t[i - 1]!r} s at "
-                            f"{prev}; time must increase strictly (sort the samples, or write "
-                            "one file per recording)", i, "t")
+                raise loc.error(f"duplicated time t = {float(t[i])!r} s (same as {prev}); "
+                                "time must increase strictly", i, "t")
+            raise loc.error(f"time goes backwards: t = {float(t[i])!r} s after "
+                            f"t = {float(t[i - 1])!r} s at {prev}; time must increase "
+                            "strictly (sort the samples, or write one file per recording)",
+                            i, "t")
 
     if "maneuver" in cols:
         m = cols["maneuver"]
         bad = np.flatnonzero(~np.isfinite(m) | (m != np.round(m)))
         if bad.size:
-            raise loc.error(f"maneuver id {m[bad[0]]!r} is not an integer", bad[0], "maneuver")
+            raise loc.error(f"maneuver id {float(m[bad[0]])!r} is not an integer", bad[0],
+                            "maneuver")
 
     if "omega" in cols:
         bad = np.flatnonzero(np.isinf(cols["omega"]))
         if bad.size:
-            raise loc.error(f"omega is {cols['omega'][bad[0]]!r} (use NaN for 'unknown')",
+            raise loc.error(f"omega is {float(cols['omega'][bad[0]])!r} (use NaN for 'unknown')",
                             bad[0], "omega")
 
     if "f_t" in cols:
         f_t = cols["f_t"]
         bad = np.flatnonzero(f_t < 0)
         if bad.size:
-            raise loc.error(f"f_t = {f_t[bad[0]]!r} N is negative; f_t is the magnitude of the "
-                            "in-plane force (give f_x and f_y for the vector)", bad[0], "f_t")
+            raise loc.error(f"f_t = {float(f_t[bad[0]])!r} N is negative; f_t is the magnitude "
+                            "of the in-plane force (give f_x and f_y for the vector)",
+                            bad[0], "f_t")
         if "f_x" in cols:
             mag = np.hypot(cols["f_x"], cols["f_y"])
             off = np.abs(mag - f_t) > 1e-6 + 1e-4 * np.abs(mag)
             bad = np.flatnonzero(off & np.isfinite(mag) & np.isfinite(f_t))
             if bad.size:
                 i = int(bad[0])
-                raise loc.error(f"f_t = {f_t[i]!r} N but hypot(f_x, f_y) = {mag[i]!r} N; give "
-                                "either f_t or f_x and f_y, or make them agree", i, "f_t")
+                raise loc.error(f"f_t = {float(f_t[i])!r} N but hypot(f_x, f_y) = "
+                                f"{float(mag[i])!r} N; give either f_t or f_x and f_y, or "
+                                "make them agree", i, "f_t")
 
     if check_units:
         _check_units(cols, loc, explicit)
@@ -1137,8 +1142,8 @@ def _read_ros(src: _RosSource, wrench_topic: str | None, omega_topic: str | None
         back = np.flatnonzero(step <= 0)
         if back.size:
             k = int(back[0]) + 1
-            raise LogError(file, f"time does not increase strictly ({o_t[k]!r} s after "
-                           f"{o_t[k - 1]!r} s)", where=f"message {k + 1} on topic "
+            raise LogError(file, f"time does not increase strictly ({float(o_t[k])!r} s after "
+                           f"{float(o_t[k - 1])!r} s)", where=f"message {k + 1} on topic "
                            f"'{omega_topic}'", row=k + 1, column="omega")
         field, pos = _OMEGA_FIELD[om.type]
         y = sign * np.asarray(om.values, dtype=np.float64)[:, pos]
