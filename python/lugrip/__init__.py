@@ -17,6 +17,7 @@ from ._contact import (
     sigma_1,
 )
 from ._params import PRESETS, ContactParams
+from .io import LogError, LogWarning, SlidingLog, read_log, write_log
 
 __all__ = [
     "__version__",
@@ -31,4 +32,9 @@ __all__ = [
     "sigma_1",
     "normalized_wrench",
     "shape_factor",
+    "SlidingLog",
+    "LogError",
+    "LogWarning",
+    "read_log",
+    "write_log",
 ]
