@@ -7,6 +7,7 @@
 #include <cmath>
 #include <cstdint>
 #include <cstdio>
+#include <cstdlib>
 #include <cstring>
 #include <limits>
 #include <map>
@@ -704,8 +705,13 @@ TEST(CorEstimatorProperty, MillionRandomSamples) {
   // non-degenerate sample does not depend on the history (no initial-guess logic).
   const std::vector<ContactParams> params = {table1_params(), with_cmax(10.0, 2.0), with_cmax(1.0, kInf),
                                              object_params("aluminium_can")};
-  const int per = 300000;
-  std::mt19937_64 rng(20240611);
+  // Defaults: 4 x 300000 samples, seed 20240611. Longer runs: LUGRIP_PROPERTY_SAMPLES (per
+  // parameter set) and LUGRIP_PROPERTY_SEED in the environment.
+  const char* env_n = std::getenv("LUGRIP_PROPERTY_SAMPLES");
+  const char* env_seed = std::getenv("LUGRIP_PROPERTY_SEED");
+  const int per = env_n ? std::max(1, std::atoi(env_n)) : 300000;
+  const std::uint64_t seed = env_seed ? std::strtoull(env_seed, nullptr, 10) : 20240611u;
+  std::mt19937_64 rng(seed);
   std::uniform_real_distribution<double> u(0.0, 1.0);
   long total = 0, valid = 0, saturated = 0, outside = 0;
   int max_iter = 0;
@@ -755,9 +761,10 @@ TEST(CorEstimatorProperty, MillionRandomSamples) {
       }
     }
   }
-  std::printf("  [property] %ld samples, %ld valid (%ld saturated, %ld outside), max iterations %d\n", total, valid,
+  std::printf("  [property] seed %llu: %ld samples, %ld valid (%ld saturated, %ld outside), max iterations %d\n",
+              static_cast<unsigned long long>(seed), total, valid,
               saturated, outside, max_iter);
-  EXPECT_GE(total, 1000000);
+  if (!env_n) EXPECT_GE(total, 1000000);
   EXPECT_GT(valid, total / 3);      // the generator exercises the estimator, not only the guards
   EXPECT_GT(outside, valid / 20);
   EXPECT_GT(saturated, valid / 50);
