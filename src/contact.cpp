@@ -236,6 +236,13 @@ Status CorEstimator::step(const CorInput& in, CorOutput& out) noexcept {
   const double rho = model_.rho(f_n);
   const double ft_t = in.f_t / (p.mu * f_n);
   const double tau_t = in.tau / (p.mu * ls.xi() * rho * f_n);
+  // A normal force so small (f_n_min set near 0) that f_t,max or tau_max underflows cannot be
+  // normalized: treat it like any other unusable sample instead of returning Inf/NaN.
+  if (!(std::isfinite(ft_t) && std::isfinite(tau_t))) {
+    out = last_;
+    out.iterations = 0;
+    return out.status = Status::InvalidSample;
+  }
   const double f = std::fabs(ft_t), t = std::fabs(tau_t);
   const double prev = last_.c_tilde;
 
@@ -288,6 +295,14 @@ Status CorEstimator::step(const CorInput& in, CorOutput& out) noexcept {
   r.g = p.mu * f_n * rho * (ls.xi() * q.T + a * q.F);
   r.sigma_1 = kPi * p.beta_a * r2 * r2 * (r.c_tilde * r.c_tilde + 0.5);
   r.y = in.tau - r.c * in.f_t;
+  // Overflow guard for settings/parameters at the edge of their valid ranges (e.g. force_limit
+  // near DBL_MAX makes c f_t overflow, beta_a near 1e300 makes sigma_1 overflow): outputs stay
+  // finite, the sample is reported as unusable and the previous estimate is held.
+  if (!(std::isfinite(r.c) && std::isfinite(r.g) && std::isfinite(r.sigma_1) && std::isfinite(r.y))) {
+    out = last_;
+    out.iterations = iters;
+    return out.status = Status::InvalidSample;
+  }
   r.iterations = iters;
   r.status = status;
   last_ = r;
