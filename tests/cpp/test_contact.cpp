@@ -769,3 +769,62 @@ TEST(CorEstimatorProperty, MillionRandomSamples) {
   EXPECT_GT(outside, valid / 20);
   EXPECT_GT(saturated, valid / 50);
 }
+
+TEST(CorEstimatorProperty, ExtremeButValidParametersAndSettings) {
+  // Every field at the edge of what validate() accepts, settings down to the smallest positive
+  // double: still finite outputs and a status for every sample (f_t,max or tau_max underflow
+  // for a denormal f_n is an InvalidSample, not Inf/NaN).
+  std::vector<ContactParams> params;
+  const ContactParams base = table1_params();
+  auto edit = [&](double ContactParams::*m, double v) {
+    ContactParams p = base;
+    p.*m = v;
+    params.push_back(p);
+  };
+  edit(&ContactParams::mu, 1e-300);
+  edit(&ContactParams::mu, 10.0);
+  edit(&ContactParams::beta_a, 0.0);
+  edit(&ContactParams::beta_a, 1e300);
+  edit(&ContactParams::delta, 1e-300);
+  edit(&ContactParams::delta, 0.999);
+  edit(&ContactParams::gamma, 1e-12);
+  edit(&ContactParams::gamma, 0.3333333);
+  edit(&ContactParams::k, 1e6);
+  edit(&ContactParams::k, kInf);
+  edit(&ContactParams::c_max, 1e-3);
+  edit(&ContactParams::c_max, 1000.0);
+  CorSettings tiny;
+  tiny.f_n_min = std::numeric_limits<double>::denorm_min();
+  tiny.zero_force = tiny.zero_torque = std::numeric_limits<double>::denorm_min();
+  tiny.force_limit = tiny.torque_limit = std::numeric_limits<double>::max();
+  CorSettings huge;
+  huge.f_n_min = std::numeric_limits<double>::denorm_min();
+  huge.zero_force = huge.zero_torque = 1e300;
+  std::mt19937_64 rng(99);
+  std::uniform_real_distribution<double> u(0.0, 1.0);
+  auto logu = [&](double lo, double hi) { return std::pow(10.0, lo + (hi - lo) * u(rng)); };
+  long valid = 0;
+  for (const ContactParams& p : params) {
+    ASSERT_TRUE(validate(p, nullptr));
+    const ContactModel& m = model_for(p);
+    for (const CorSettings& s : {tiny, huge}) {
+      CorEstimator est(m, s);
+      CorOutput o;
+      for (int i = 0; i < 20000; ++i) {
+        CorInput in{logu(-323, 300), (u(rng) < 0.5 ? -1 : 1) * logu(-323, 300),
+                    (u(rng) < 0.5 ? -1 : 1) * logu(-323, 300)};
+        if (i % 5 == 0) in.f_n = std::numeric_limits<double>::denorm_min();
+        if (i % 7 == 0) in.tau = 0.0;
+        const Status st = est.step(in, o);
+        ASSERT_TRUE(known_status(st));
+        ASSERT_TRUE(all_finite(o)) << to_string(p) << "\nf_n = " << in.f_n << ", f_t = " << in.f_t
+                                   << ", tau = " << in.tau;
+        ASSERT_LE(std::fabs(o.c_tilde), p.c_max);
+        ASSERT_LE(o.iterations, 62);
+        ASSERT_GE(o.g, 0.0);
+        valid += is_valid(st);
+      }
+    }
+  }
+  EXPECT_GT(valid, 10000);
+}
