@@ -212,4 +212,192 @@ NB_MODULE(_core, m) {
         d["inside"] = inside; d["saturated"] = sat; d["iterations"] = iters; d["status"] = status;
         return d;
       }, "f_n"_a, "f_t"_a, "tau"_a, "Runs step() over 1-D arrays in C++; returns a dict of arrays.");
+
+  // --- controller --------------------------------------------------------------------------
+  // GraspController, C_d filter and static grasp force (include/lugrip/grasp_controller.hpp).
+  nb::enum_<ControllerMode>(m, "ControllerMode")
+      .value("SlippingAvoidance", ControllerMode::SlippingAvoidance)
+      .value("Pivoting", ControllerMode::Pivoting);
+  nb::enum_<PivotEnd>(m, "PivotEnd")
+      .value("None_", PivotEnd::None)
+      .value("CorThreshold", PivotEnd::CorThreshold)
+      .value("Timeout", PivotEnd::Timeout)
+      .value("Requested", PivotEnd::Requested);
+
+  nb::class_<GraspControllerSettings>(m, "GraspControllerSettings")
+      .def(nb::init<>())
+      .def_rw("sensor_rate", &GraspControllerSettings::sensor_rate)
+      .def_rw("command_ratio", &GraspControllerSettings::command_ratio)
+      .def_rw("k_cd", &GraspControllerSettings::k_cd)
+      .def_rw("p_cd", &GraspControllerSettings::p_cd)
+      .def_rw("z_cd", &GraspControllerSettings::z_cd)
+      .def_rw("dynamic_enabled", &GraspControllerSettings::dynamic_enabled)
+      .def_rw("s_ref", &GraspControllerSettings::s_ref)
+      .def_rw("k_p", &GraspControllerSettings::k_p)
+      .def_rw("k_i", &GraspControllerSettings::k_i)
+      .def_rw("anti_windup", &GraspControllerSettings::anti_windup)
+      .def_rw("gain_schedule_force", &GraspControllerSettings::gain_schedule_force)
+      .def_rw("f_min", &GraspControllerSettings::f_min)
+      .def_rw("f_max", &GraspControllerSettings::f_max)
+      .def_rw("max_rate_up", &GraspControllerSettings::max_rate_up)
+      .def_rw("max_rate_down", &GraspControllerSettings::max_rate_down)
+      .def_rw("invalid_raise_step", &GraspControllerSettings::invalid_raise_step)
+      .def_rw("s_pivot", &GraspControllerSettings::s_pivot)
+      .def_rw("tau_pivot", &GraspControllerSettings::tau_pivot)
+      .def_rw("k_f", &GraspControllerSettings::k_f)
+      .def_rw("pivot_floor_factor", &GraspControllerSettings::pivot_floor_factor)
+      .def_rw("pivot_end_c_tilde", &GraspControllerSettings::pivot_end_c_tilde)
+      .def_rw("pivot_end_samples", &GraspControllerSettings::pivot_end_samples)
+      .def_rw("pivot_timeout", &GraspControllerSettings::pivot_timeout)
+      .def("__repr__", [](const GraspControllerSettings& s) { return to_string(s); });
+  m.def("validate_controller_settings", [](const GraspControllerSettings& s) {
+    std::string msg;
+    validate(s, &msg);
+    return msg;
+  }, "Empty string when valid, else one line per bad field.");
+
+  nb::class_<GraspControllerOutput>(m, "GraspControllerOutput")
+      .def(nb::init<>())
+      .def_ro("force", &GraspControllerOutput::force)
+      .def_ro("static_force", &GraspControllerOutput::static_force)
+      .def_ro("dynamic_force", &GraspControllerOutput::dynamic_force)
+      .def_ro("floor", &GraspControllerOutput::floor)
+      .def_ro("slippage", &GraspControllerOutput::slippage)
+      .def_ro("error", &GraspControllerOutput::error)
+      .def_ro("integrator", &GraspControllerOutput::integrator)
+      .def_prop_ro("dynamic_sample", [](const GraspControllerOutput& o) {
+        return nb::make_tuple(o.dynamic_sample[0], o.dynamic_sample[1]);
+      })
+      .def_ro("dynamic_peak", &GraspControllerOutput::dynamic_peak)
+      .def_ro("mean_c_tilde", &GraspControllerOutput::mean_c_tilde)
+      .def_ro("pivot_time", &GraspControllerOutput::pivot_time)
+      .def_ro("mode", &GraspControllerOutput::mode)
+      .def_ro("pivot_end", &GraspControllerOutput::pivot_end)
+      .def_ro("pivot_finished", &GraspControllerOutput::pivot_finished)
+      .def_ro("command_issued", &GraspControllerOutput::command_issued)
+      .def_ro("saturated", &GraspControllerOutput::saturated)
+      .def_ro("rate_limited", &GraspControllerOutput::rate_limited)
+      .def_ro("held", &GraspControllerOutput::held)
+      .def_ro("status", &GraspControllerOutput::status);
+
+  nb::class_<LagFilter>(m, "LagFilter")
+      .def(nb::init<double, double, double, double>(), "k"_a, "z"_a, "p"_a, "sample_time"_a)
+      .def_prop_ro("b0", &LagFilter::b0)
+      .def_prop_ro("b1", &LagFilter::b1)
+      .def_prop_ro("a1", &LagFilter::a1)
+      .def("reset", &LagFilter::reset)
+      .def("filter", [](LagFilter& f, const In1& u) { return map1(u, [&](double x) { return f.step(x); }); },
+           "u"_a, "Filters a 1-D array sample by sample (state carried over).");
+
+  using Fingers2 = nb::ndarray<const double, nb::shape<-1, 2>, nb::c_contig, nb::device::cpu>;
+  using Status2 = nb::ndarray<const int32_t, nb::shape<-1, 2>, nb::c_contig, nb::device::cpu>;
+  using Bool2 = nb::ndarray<const bool, nb::shape<-1, 2>, nb::c_contig, nb::device::cpu>;
+  using Int1 = nb::ndarray<const int32_t, nb::ndim<1>, nb::c_contig, nb::device::cpu>;
+  nb::class_<GraspController>(m, "GraspController")
+      .def(nb::init<const ContactParams&, const GraspControllerSettings&>(), "params"_a,
+           "settings"_a = GraspControllerSettings())
+      .def("reset", nb::overload_cast<double>(&GraspController::reset), "current_force"_a)
+      .def("request_pivoting", &GraspController::request_pivoting)
+      .def("request_slipping_avoidance", &GraspController::request_slipping_avoidance)
+      .def("set_dynamic_enabled", &GraspController::set_dynamic_enabled, "enabled"_a)
+      .def("set_settings", &GraspController::set_settings, "settings"_a)
+      .def_prop_ro("settings", &GraspController::settings)
+      .def_prop_ro("mode", &GraspController::mode)
+      .def_prop_ro("command", &GraspController::command)
+      .def_prop_ro("command_period", &GraspController::command_period)
+      .def_prop_ro("mu", &GraspController::mu)
+      .def_prop_ro("dynamic_filter", [](const GraspController& c) { return c.dynamic_filter(0); })
+      .def("step", [](GraspController& c, double w0, double s0, double c0, double f0, int st0, bool p0,
+                      double w1, double s1, double c1, double f1, int st1, bool p1) {
+        GraspControllerInput in;
+        in.fingers[0] = FingerInput{w0, s0, c0, f0, static_cast<Status>(st0), p0};
+        in.fingers[1] = FingerInput{w1, s1, c1, f1, static_cast<Status>(st1), p1};
+        GraspControllerOutput out;
+        c.step(in, out);
+        return out;
+      }, "Per-finger values of finger 0 then finger 1: omega_hat, S, c_tilde, f_t, status, present.")
+      .def("run", [](GraspController& c, const Fingers2& w, const Fingers2& S, const Fingers2& ct,
+                     const Fingers2& ft, const Status2& st, const Bool2& present, const Int1& requests) {
+        const size_t n = w.shape(0);
+        if (S.shape(0) != n || ct.shape(0) != n || ft.shape(0) != n || st.shape(0) != n ||
+            present.shape(0) != n || requests.shape(0) != n)
+          throw std::invalid_argument("arrays must have the same length");
+        auto force = new_array<double>(n), fns = new_array<double>(n), fnd = new_array<double>(n),
+             floor = new_array<double>(n), slip = new_array<double>(n), err = new_array<double>(n),
+             integ = new_array<double>(n), d0 = new_array<double>(n), d1 = new_array<double>(n),
+             peak = new_array<double>(n), mct = new_array<double>(n), pt = new_array<double>(n);
+        auto mode = new_array<int32_t>(n), pend = new_array<int32_t>(n), status = new_array<int32_t>(n);
+        auto issued = new_array<bool>(n), fin = new_array<bool>(n), sat = new_array<bool>(n),
+             rl = new_array<bool>(n), held = new_array<bool>(n);
+        const double *pw = w.data(), *ps = S.data(), *pc = ct.data(), *pf = ft.data();
+        const int32_t *pst = st.data(), *prq = requests.data();
+        const bool* pp = present.data();
+        {
+          nb::gil_scoped_release release;
+          GraspControllerInput in;
+          GraspControllerOutput o;
+          for (size_t i = 0; i < n; ++i) {
+            if (prq[i] == 1) c.request_pivoting();
+            else if (prq[i] == 2) c.request_slipping_avoidance();
+            for (int k = 0; k < 2; ++k) {
+              const size_t j = 2 * i + k;
+              in.fingers[k] = FingerInput{pw[j], ps[j], pc[j], pf[j], static_cast<Status>(pst[j]), pp[j]};
+            }
+            c.step(in, o);
+            force.data()[i] = o.force; fns.data()[i] = o.static_force; fnd.data()[i] = o.dynamic_force;
+            floor.data()[i] = o.floor; slip.data()[i] = o.slippage; err.data()[i] = o.error;
+            integ.data()[i] = o.integrator; d0.data()[i] = o.dynamic_sample[0];
+            d1.data()[i] = o.dynamic_sample[1]; peak.data()[i] = o.dynamic_peak;
+            mct.data()[i] = o.mean_c_tilde; pt.data()[i] = o.pivot_time;
+            mode.data()[i] = static_cast<int32_t>(o.mode); pend.data()[i] = static_cast<int32_t>(o.pivot_end);
+            status.data()[i] = static_cast<int32_t>(o.status); issued.data()[i] = o.command_issued;
+            fin.data()[i] = o.pivot_finished; sat.data()[i] = o.saturated; rl.data()[i] = o.rate_limited;
+            held.data()[i] = o.held;
+          }
+        }
+        nb::dict d;
+        d["force"] = force; d["static_force"] = fns; d["dynamic_force"] = fnd; d["floor"] = floor;
+        d["slippage"] = slip; d["error"] = err; d["integrator"] = integ; d["dynamic_sample_0"] = d0;
+        d["dynamic_sample_1"] = d1; d["dynamic_peak"] = peak; d["mean_c_tilde"] = mct;
+        d["pivot_time"] = pt; d["mode"] = mode; d["pivot_end"] = pend; d["status"] = status;
+        d["command_issued"] = issued; d["pivot_finished"] = fin; d["saturated"] = sat;
+        d["rate_limited"] = rl; d["held"] = held;
+        return d;
+      }, "omega_hat"_a, "S"_a, "c_tilde"_a, "f_t"_a, "status"_a, "present"_a, "requests"_a,
+         "Runs step() over (N, 2) arrays in C++ (requests: 0 none, 1 pivoting, 2 slipping "
+         "avoidance, applied before the sample); returns a dict of (N,) arrays.");
+
+  nb::class_<StaticForceSolver>(m, "StaticForceSolver")
+      .def(nb::init<const ContactModel&>(), "model"_a)
+      .def("slippage", [](StaticForceSolver& s, const In1& fn, const In1& ft, const In1& tau) {
+        same_size(fn, ft);
+        same_size(fn, tau);
+        const size_t n = fn.shape(0);
+        auto S = new_array<double>(n), c = new_array<double>(n);
+        for (size_t i = 0; i < n; ++i) {
+          double a = std::numeric_limits<double>::quiet_NaN();
+          S.data()[i] = s.slippage(fn.data()[i], ft.data()[i], tau.data()[i], &a);
+          c.data()[i] = a;
+        }
+        return nb::make_tuple(S, c);
+      }, "f_n"_a, "f_t"_a, "tau"_a, "S_static and |c~| at each (f_n, f_t, tau).")
+      .def("solve", [](StaticForceSolver& s, const In1& ft, const In1& tau, double s_ref) {
+        same_size(ft, tau);
+        const size_t n = ft.shape(0);
+        auto f = new_array<double>(n), c = new_array<double>(n), S = new_array<double>(n);
+        auto it = new_array<int32_t>(n);
+        auto conv = new_array<bool>(n);
+        {
+          nb::gil_scoped_release release;
+          for (size_t i = 0; i < n; ++i) {
+            const StaticForceResult r = s.solve(ft.data()[i], tau.data()[i], s_ref);
+            f.data()[i] = r.force; c.data()[i] = r.c_tilde; S.data()[i] = r.slippage;
+            it.data()[i] = r.iterations; conv.data()[i] = r.converged;
+          }
+        }
+        nb::dict d;
+        d["force"] = f; d["c_tilde"] = c; d["slippage"] = S; d["iterations"] = it; d["converged"] = conv;
+        return d;
+      }, "f_t"_a, "tau"_a, "s_ref"_a, "Static grasp force per load; dict of arrays.");
+  // --- end of controller block ---------------------------------------------------------------
 }

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
 #include <limits>
 #include <stdexcept>
 
@@ -15,9 +16,11 @@ namespace {
 constexpr double kMaxSlippage = 1.0e3;
 constexpr double kMaxInput = 1.0e6;
 
+// Shortest of %.15g / %.17g that reads back exactly.
 std::string fmt(double v) {
   char buf[40];
-  std::snprintf(buf, sizeof buf, "%.17g", v);
+  std::snprintf(buf, sizeof buf, "%.15g", v);
+  if (std::strtod(buf, nullptr) != v) std::snprintf(buf, sizeof buf, "%.17g", v);
   return buf;
 }
 

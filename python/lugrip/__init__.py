@@ -17,6 +17,14 @@ from ._contact import (
     sigma_1,
 )
 from ._params import PRESETS, ContactParams
+from ._controller import (
+    ControllerMode,
+    GraspController,
+    PivotEnd,
+    controller_settings,
+    static_grasp_force,
+    static_slippage,
+)
 from .io import LogError, LogWarning, SlidingLog, read_log, write_log
 
 __all__ = [
@@ -32,6 +40,12 @@ __all__ = [
     "sigma_1",
     "normalized_wrench",
     "shape_factor",
+    "GraspController",
+    "ControllerMode",
+    "PivotEnd",
+    "controller_settings",
+    "static_grasp_force",
+    "static_slippage",
     "SlidingLog",
     "LogError",
     "LogWarning",

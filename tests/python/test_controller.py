@@ -1,0 +1,293 @@
+"""Grasp-force controller and static grasp force through the Python API (MODEL.md 6, 9, 10.2)."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
+from scipy import signal
+
+import lugrip
+from lugrip import ControllerMode, GraspController, PivotEnd, Status
+
+CAN = lugrip.ContactParams.preset("aluminium_can")
+T_SENSOR = 1.0 / 500.0
+T_CMD = 10 * T_SENSOR
+
+
+# --- C_d discretisation -------------------------------------------------------------------------
+
+def test_cd_coefficients_match_scipy_bilinear_and_the_spec_table():
+    """Tustin coefficients equal scipy's bilinear transform and the MODEL.md 9.2 table."""
+    b0, b1, a1 = GraspController(CAN).dynamic_filter_coefficients
+    num, den = signal.bilinear([10.0, 2500.0], [1.0, 7.0], fs=500.0)
+    np.testing.assert_allclose([b0, b1], num / den[0], rtol=1e-13)
+    assert a1 == pytest.approx(den[1] / den[0], rel=1e-13)
+    np.testing.assert_allclose([b0, b1, a1], [12.413108, -7.447865, -0.986097], atol=5e-7)
+    assert (b0 + b1) / (1 + a1) == pytest.approx(357.142857, abs=1e-6)  # DC
+    assert (b0 - b1) / (1 - a1) == pytest.approx(10.0, abs=1e-12)  # Nyquist
+
+
+def test_cd_frequency_response_is_the_prewarped_continuous_one():
+    """|H(e^{jwT})| = |C(j (2/T) tan(wT/2))|, and within 1 % of C(jw) below a tenth of Nyquist."""
+    b0, b1, a1 = GraspController(CAN).dynamic_filter_coefficients
+    theta = np.geomspace(1e-4, 0.999 * np.pi, 200)
+    _, h_d = signal.freqz([b0, b1], [1.0, a1], worN=theta)
+    _, h_c = signal.freqs([10.0, 2500.0], [1.0, 7.0], worN=2 / T_SENSOR * np.tan(theta / 2))
+    np.testing.assert_allclose(h_d, h_c, rtol=1e-9)
+    w = np.geomspace(0.1, 0.1 * np.pi / T_SENSOR, 50)
+    _, h_d = signal.freqz([b0, b1], [1.0, a1], worN=w * T_SENSOR)
+    _, h_c = signal.freqs([10.0, 2500.0], [1.0, 7.0], worN=w)
+    np.testing.assert_allclose(np.abs(h_d), np.abs(h_c), rtol=0.01)
+
+
+def test_cd_step_response_through_the_controller():
+    """The controller's per-sample C_d output for a unit step of omega_hat follows the
+    continuous step response (exactly up to Tustin's half-sample shift) and settles at 357.14."""
+    ctrl = GraspController(CAN)
+    n = 2000
+    run = ctrl.run(np.ones(n), np.full(n, 0.8), 0.5, 0.5)
+    t = np.arange(n) * T_SENSOR
+    _, y_c0 = signal.step(([10.0, 2500.0], [1.0, 7.0]), T=t)  # continuous, scipy
+    def y_c(time):  # closed form k (z/p + (1 - z/p) e^{-p t})
+        return 10.0 * (250 / 7 + (1 - 250 / 7) * np.exp(-7.0 * time))
+    np.testing.assert_allclose(y_c(t), y_c0, rtol=1e-6)
+    y = run.dynamic_sample[:, 0]
+    assert np.max(np.abs(y - y_c(t + 0.5 * T_SENSOR))) < 5e-4 * 357.14
+    assert 0.005 * 357.14 < np.max(np.abs(y - y_c0)) < 0.01 * 357.14  # b0 = 12.41 vs k = 10
+    assert y[-1] == pytest.approx(y_c(t[-1]), rel=1e-3)
+
+
+def test_peak_of_the_last_command_period_reaches_the_command():
+    """A one-sample slip spike between commands is not lost: f_nd = max |C_d omega_hat|."""
+    ctrl = GraspController(CAN, max_rate_up=math.inf, max_rate_down=math.inf)
+    ctrl.reset(2.0)
+    w = np.zeros(11)
+    w[4] = -0.1
+    run = ctrl.run(w, np.full(11, 0.8), 0.5, 0.5)
+    assert run.command_issued[[0, 10]].all() and not run.command_issued[1:10].any()
+    assert run.dynamic_sample[4, 0] < 0
+    peak = np.max(np.abs(run.dynamic_sample[:11, 0]))
+    assert run.dynamic_force[10] == pytest.approx(peak, rel=1e-12)
+    assert run.force[10] == pytest.approx(2.0 + peak, rel=1e-12)
+
+
+# --- static part ------------------------------------------------------------------------------
+
+@pytest.mark.parametrize("S, sign", [(0.95, +1), (0.6, -1)])
+def test_pi_direction(S, sign):
+    """S above the reference raises the force, below lowers it, at k_i T e per command."""
+    ctrl = GraspController(CAN)
+    ctrl.reset(5.0)
+    run = ctrl.run(np.zeros(501), np.full(501, S), 0.5, 0.5)
+    forces = run.force[run.command_issued]
+    assert forces[0] == pytest.approx(5.0)  # bumpless start
+    np.testing.assert_allclose(np.diff(forces), 10.0 * T_CMD * (S - 0.8), rtol=1e-9)
+    assert sign * (forces[-1] - 5.0) > 0.5
+
+
+@pytest.mark.parametrize("anti_windup", [True, False])
+def test_anti_windup_leaves_the_ceiling_at_once(anti_windup):
+    """After 20 s at f_max the force leaves it at the first command after the error reverses
+    with back-calculation, only after hundreds of commands without."""
+    ctrl = GraspController(CAN, anti_windup=anti_windup, max_rate_up=math.inf, max_rate_down=math.inf)
+    ctrl.reset(5.0)
+    hold = ctrl.run(np.zeros(10000), np.ones(10000), 0.5, 0.5)
+    assert hold.force[-1] == 20.0
+    after = ctrl.run(np.zeros(5000), np.full(5000, 0.5), 0.5, 0.5)
+    first_below = int(np.argmax(after.force < 20.0))
+    if anti_windup:
+        assert first_below == 0
+    else:
+        assert first_below > 300 * 10
+
+
+def test_ceiling_and_floor_and_validation_messages():
+    with pytest.raises(ValueError, match="k_p"):
+        GraspController(CAN, k_p=-1.0)
+    with pytest.raises(ValueError, match="f_max"):
+        GraspController(CAN, f_min=2.0, f_max=1.0)
+    with pytest.raises(ValueError, match="unknown controller setting 'kp'"):
+        GraspController(CAN, kp=1.0)
+    with pytest.raises(ValueError, match="command_ratio"):
+        GraspController(CAN, command_ratio=2.5)
+    with pytest.raises(ValueError, match="s_pivot"):
+        GraspController(CAN, s_pivot=0.9)
+    ctrl = GraspController(CAN)
+    with pytest.raises(ValueError, match="fixed at construction"):
+        ctrl.update_settings(command_ratio=5)
+    ctrl.update_settings(k_p=2.0)
+    assert ctrl.settings["k_p"] == 2.0
+    assert lugrip.controller_settings()["k_p"] == 4.0
+
+
+# --- multi-rate, two fingers, bad input -----------------------------------------------------------
+
+def test_zero_order_hold_at_the_command_rate():
+    rng = np.random.default_rng(1)
+    ctrl = GraspController(CAN)
+    ctrl.reset(3.0)
+    n = 1000
+    run = ctrl.run(0.02 * rng.standard_normal(n), rng.uniform(0, 1, n), 0.5, 0.5)
+    np.testing.assert_array_equal(run.command_issued, np.arange(n) % 10 == 0)
+    changed = np.flatnonzero(np.diff(run.force) != 0) + 1
+    assert np.all(changed % 10 == 0)
+    assert len(changed) > 90
+
+
+def test_two_fingers_combine_max_s_and_max_dynamic_part():
+    ctrl = GraspController(CAN, max_rate_up=math.inf, max_rate_down=math.inf)
+    ctrl.reset(5.0)
+    n = 11
+    w = np.tile([0.0, -0.05], (n, 1))
+    S = np.tile([0.6, 0.9], (n, 1))
+    run = ctrl.run(w, S, [[0.2, 1.4]], 1.0)
+    assert run.slippage[0] == 0.9
+    assert run.mean_c_tilde[0] == pytest.approx(0.8)
+    assert run.dynamic_force[10] == pytest.approx(np.max(np.abs(run.dynamic_sample[1:11, 1])))
+    one = GraspController(CAN, max_rate_up=math.inf, max_rate_down=math.inf)
+    one.reset(5.0)
+    r1 = one.run(w[:, 1], S[:, 1], 1.4, 1.0)  # the dominant finger alone gives the same command
+    np.testing.assert_array_equal(r1.force, run.force)
+
+
+@pytest.mark.parametrize("status", [Status.INVALID_SAMPLE, Status.SENSOR_FAULT, Status.NO_CONTACT])
+def test_bad_status_holds_or_raises(status):
+    ctrl = GraspController(CAN, invalid_raise_step=0.05)
+    ctrl.reset(3.0)
+    n = 100
+    st_ = np.full((n, 2), int(Status.OK))
+    st_[:, 1] = int(status)
+    run = ctrl.run(np.zeros((n, 2)), np.zeros((n, 2)), 0.5, 0.5, status=st_)
+    assert np.all(run.status == int(status))
+    np.testing.assert_allclose(run.force[run.command_issued], 3.0 + 0.05 * np.arange(1, 11))
+    assert np.all(np.diff(run.force) >= 0)
+
+
+@settings(max_examples=40, deadline=None)
+@given(st.integers(0, 2**32 - 1))
+def test_command_always_finite_and_in_range(seed):
+    """Random and adversarial inputs (NaN, Inf, huge, negative, statuses, requests)."""
+    rng = np.random.default_rng(seed)
+    n = 5000
+    def junk(scale):
+        x = scale * rng.standard_normal((n, 2))
+        mask = rng.uniform(size=(n, 2))
+        x[mask < 0.03] = np.nan
+        x[(mask >= 0.03) & (mask < 0.05)] = np.inf
+        x[(mask >= 0.05) & (mask < 0.07)] = -1e300
+        return x
+    ctrl = GraspController(CAN, f_min=0.2, f_max=15.0, pivot_timeout=0.3)
+    run = ctrl.run(junk(0.5), np.abs(junk(1.0)), junk(2.0), junk(5.0),
+                   status=rng.integers(0, 7, (n, 2)), present=rng.uniform(size=(n, 2)) < 0.9,
+                   requests=rng.choice(3, n, p=[0.996, 0.002, 0.002]))
+    assert np.all(np.isfinite(run.force))
+    assert run.force.min() >= 0.2 and run.force.max() <= 15.0
+
+
+def test_step_and_run_agree():
+    """Binding parity: the per-sample step() and the C++ batch loop give identical outputs."""
+    rng = np.random.default_rng(5)
+    n = 300
+    w, S = 0.01 * rng.standard_normal((n, 2)), rng.uniform(0, 1.2, (n, 2))
+    c, ft = rng.uniform(0, 1.5, (n, 2)), rng.uniform(0, 2, (n, 2))
+    a, b = GraspController(CAN), GraspController(CAN)
+    req = np.zeros(n, dtype=int)
+    req[100], req[250] = 1, 2
+    run = a.run(w, S, c, ft, requests=req)
+    for i in range(n):
+        if req[i] == 1:
+            b.request_pivoting()
+        elif req[i] == 2:
+            b.request_slipping_avoidance()
+        o = b.step(w[i], S[i], c[i], ft[i])
+        assert o.force == run.force[i] and o.integrator == run.integrator[i]
+        assert o.mode == run.mode[i] and o.dynamic_sample == tuple(run.dynamic_sample[i])
+
+
+# --- pivoting -----------------------------------------------------------------------------------
+
+def test_pivoting_decay_floor_end_and_bumpless_return():
+    ctrl = GraspController(CAN, max_rate_up=math.inf, max_rate_down=math.inf)
+    ctrl.reset(8.0)
+    ctrl.run(np.full(20, 0.01), np.full(20, 0.8), 0.3, 0.5)
+    f0 = ctrl.command
+    n = 1500  # 3 s of sliding (S = 1) with |c~| < 1, f_t = 1.5 N: floor 1.1 * 1.5 / 0.75 = 2.2 N
+    run = ctrl.run(np.full(n, 5.0), np.ones(n), 0.3, 1.5, requests={0: "pivoting"})
+    assert np.all(run.mode == int(ControllerMode.PIVOTING))
+    assert np.all(run.dynamic_force == 0) and np.all(run.dynamic_sample == 0)
+    assert run.force[0] == f0  # no jump
+    k = np.arange(n // 10)
+    expected = np.maximum(-1.2 + (f0 + 1.2) * np.exp(-k * T_CMD / 2.0), 2.2)
+    np.testing.assert_allclose(run.force[run.command_issued], expected, rtol=1e-9)
+    # |c~| crosses 1: ends on the third consecutive sample, command unchanged at the switch.
+    last = ctrl.command
+    end = ctrl.run(np.zeros(40), np.full(40, 0.9), [0.9, 1.2, 1.1] + [1.3] * 37, 1.5)
+    i = int(np.argmax(end.pivot_finished))
+    assert i == 3 and end.pivot_end[i] == int(PivotEnd.COR_THRESHOLD)
+    assert np.all(end.mode[i:] == int(ControllerMode.SLIPPING_AVOIDANCE))
+    first_pi = np.flatnonzero(end.command_issued & (np.arange(40) >= i))[0]
+    assert end.force[first_pi] == pytest.approx(last, abs=1e-12)  # bumpless
+    assert end.integrator[first_pi] == pytest.approx(last - 4 * 0.1 + 10 * T_CMD * 0.1)
+
+
+# --- static grasp force -------------------------------------------------------------------------
+
+def test_static_grasp_force_reference_values():
+    """MODEL.md Appendix A and 10.2."""
+    f = lugrip.static_grasp_force(CAN, [0.12, 2.0, 2.0, 4.0], [0.0, 3e-3, 6e-3, 6e-3])
+    np.testing.assert_allclose(f, [0.190, 4.75, 6.66, 8.90], atol=0.005)
+    wide = CAN.replace(c_max=1000.0)
+    np.testing.assert_allclose(lugrip.static_grasp_force(wide, [0.12, 2.0], 0.0), [0.2, 10 / 3], rtol=1e-5)
+    f_e2, info = lugrip.static_grasp_force("small_resin_block", 1.20, 4.15e-3, full_output=True)
+    assert f_e2 == pytest.approx(5.0, abs=0.01)
+    assert info["c_tilde"] == pytest.approx(0.4, abs=0.002)
+    assert info["converged"] and info["slippage"] == pytest.approx(0.8, abs=1e-12)
+    assert lugrip.static_grasp_force(CAN, 0.0, 0.0) == 0.0
+    assert np.isnan(lugrip.static_grasp_force(CAN, np.nan, 0.0))
+    with pytest.raises(ValueError, match="s_ref"):
+        lugrip.static_grasp_force(CAN, 1.0, 0.0, s_ref=1.5)
+    assert lugrip.static_grasp_force(CAN, np.ones((3, 4)), 1e-3).shape == (3, 4)
+
+
+def test_static_grasp_force_against_closed_forms():
+    """Pure translation: f = f_t / (mu s_ref (F(c_max) + xi T(c_max)/c_max)); pure rotation:
+    tau = s_ref mu xi delta f^(1+gamma). Computed from the limit-surface curves directly."""
+    ls = lugrip.LimitSurface(CAN.k)
+    a = CAN.c_max
+    F, T = abs(ls.ft_star(a)), ls.tau_star(a)
+    ft = np.geomspace(1e-3, 30, 7)
+    np.testing.assert_allclose(lugrip.static_grasp_force(CAN, ft, 0.0),
+                               ft / (CAN.mu * 0.8 * (F + ls.xi * T / a)), rtol=1e-9)
+    tau = np.geomspace(1e-6, 0.05, 7)
+    expected = (tau / (0.8 * CAN.mu * ls.xi * CAN.delta)) ** (1 / (1 + CAN.gamma))
+    np.testing.assert_allclose(lugrip.static_grasp_force(CAN, 0.0, tau), expected, rtol=1e-9)
+
+
+@settings(max_examples=200, deadline=None)
+@given(st.floats(-3, 1.3), st.floats(-6, -1.5), st.floats(1.0, 2.0), st.floats(1.0, 2.0))
+def test_more_load_never_lowers_the_static_force(log_ft, log_tau, kf, kt):
+    ft, tau = 10.0 ** log_ft, 10.0 ** log_tau
+    f = lugrip.static_grasp_force("plastic_bottle", [ft, ft * kf, ft, ft * kf], [tau, tau, tau * kt, tau * kt])
+    assert f[1] >= f[0] * (1 - 1e-12) and f[2] >= f[0] * (1 - 1e-12) and f[3] >= f[0] * (1 - 1e-12)
+    S, _ = lugrip.static_slippage("plastic_bottle", [0.9 * f[0], f[0], 1.1 * f[0]], ft, tau)
+    assert S[0] > 0.8 > S[2] and S[1] == pytest.approx(0.8, rel=1e-9)
+
+
+@pytest.mark.parametrize("obj, ft, tau", [("aluminium_can", 2.0, 3e-3), ("small_resin_block", 1.2, 4.15e-3)])
+def test_closed_loop_settles_at_the_static_force(obj, ft, tau):
+    """Quasi-static plant S = S_static(commanded f_n): the settled force is static_grasp_force."""
+    ctrl = GraspController(obj)
+    ctrl.reset(2.0)
+    per_cmd = 10
+    forces = []
+    for _ in range(int(30.0 / T_CMD)):  # 30 s; S and c~ only change with the command
+        S, c = lugrip.static_slippage(obj, ctrl.command, ft, tau)
+        run = ctrl.run(np.zeros(per_cmd), np.full(per_cmd, min(float(S), 1.0)), float(c), ft)
+        forces.append(run.force[-1])
+    f_static = lugrip.static_grasp_force(obj, ft, tau)
+    tail = np.array(forces[-250:])  # last 5 s
+    assert np.all(np.abs(tail / f_static - 1) < 0.01)
