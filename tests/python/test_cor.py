@@ -8,7 +8,7 @@ import math
 
 import numpy as np
 import pytest
-from hypothesis import given
+from hypothesis import given, settings
 from hypothesis import strategies as st
 from hypothesis.extra import numpy as hnp
 from scipy.optimize import brentq
@@ -362,3 +362,41 @@ def test_random_physical_batches(arrays):
     well = ok & (np.abs(est.ft_tilde) >= 1e-4) & (np.abs(est.tau_tilde) >= 1e-4)
     expected = -np.sign(f_t[well]) * np.sign(tau[well])
     assert np.all(np.sign(est.c_tilde[well]) == expected)
+
+
+VALID_PARAMS = st.builds(
+    lugrip.ContactParams,
+    mu=st.floats(min_value=1e-300, max_value=10.0),
+    beta_a=st.floats(min_value=0.0, max_value=1e300),
+    sigma0=st.just(16.66),
+    sigma_z=st.just(2.0),
+    delta=st.floats(min_value=1e-300, max_value=0.999),
+    gamma=st.floats(min_value=1e-12, max_value=0.3333),
+    k=st.sampled_from([1.0, 2.0, 3.0, 4.0, 8.0, 1e6, math.inf]),
+    c_max=st.floats(min_value=1e-3, max_value=1000.0),
+)
+
+
+@settings(max_examples=40)  # each new parameter set builds its LS tables (~60 ms)
+@given(
+    p=VALID_PARAMS,
+    f_n_min=st.sampled_from([5e-324, 1e-300, 0.03, 1.0]),
+    limit=st.sampled_from([1e3, 1e300, 1.7e308]),
+    data=st.lists(st.tuples(ANY_FLOAT, ANY_FLOAT, ANY_FLOAT), min_size=1, max_size=20),
+)
+def test_any_valid_parameters_and_settings(p, f_n_min, limit, data):
+    """Whatever validate() accepts, bad or extreme samples give a status and finite outputs."""
+    f_n, f_t, tau = (np.array(x, dtype=float) for x in zip(*data))
+    est = lugrip.estimate_cor(p, f_n, f_t, tau, f_n_min=f_n_min, force_limit=limit, torque_limit=limit,
+                              zero_force=1e-4, zero_torque=1e-4)
+    _check_outputs(p, est)
+
+
+@pytest.mark.xfail(strict=True, raises=RuntimeError,
+                   reason="ContactModel throws std::logic_error ('sigma_LS is not increasing') for "
+                          "k <= 0.15, which validate() accepts (reported)")
+@pytest.mark.parametrize("k", [0.1, 0.15])
+def test_every_validated_k_builds_a_model(k):
+    p = lugrip.ContactParams.table1().replace(k=k)  # validation accepts any k > 0
+    est = lugrip.estimate_cor(p, 5.0, 1.0, -1e-3)
+    _check_outputs(p, est)
