@@ -29,6 +29,7 @@ from __future__ import annotations
 import csv
 import dataclasses
 import errno
+import functools
 import io
 import json
 import math
@@ -699,6 +700,9 @@ def _read_csv(path: Path, file: str) -> tuple[dict[str, np.ndarray], dict[str, s
         raise LogError(file, "empty file (expected a header row and data rows)")
     first = next(line for line in text.splitlines() if line.strip())
     delim = next((d for d in (",", ";", "\t") if d in first), ",")
+    fast = _read_csv_fast(text, delim, file)
+    if fast is not None:
+        return fast
     reader = csv.reader(io.StringIO(text, newline=""), delimiter=delim,
                         skipinitialspace=True)
     header: list[str] | None = None
@@ -735,6 +739,47 @@ def _read_csv(path: Path, file: str) -> tuple[dict[str, np.ndarray], dict[str, s
     return cols, units, loc, meta
 
 
+def _read_csv_fast(text: str, delim: str, file: str):
+    """pyarrow's CSV parser for clean files (no blank lines, every cell a number); None to
+    fall back to the line-by-line reader, which finds and names any problem."""
+    try:
+        import pyarrow as pa
+        import pyarrow.csv as pacsv
+    except ImportError:
+        return None
+    lines = text.splitlines()
+    if len(lines) < 2 or any(not line.strip() for line in lines):
+        return None
+    header = [c.strip() for c in next(csv.reader([lines[0]], delimiter=delim))]
+    index, units, ignored = _parse_header(header, file)
+    if not index:
+        return None
+    _check_required(index, header, file)
+    names = [f"c{i}" for i in range(len(header))]
+    try:
+        table = pacsv.read_csv(
+            io.BytesIO(text.encode("utf-8")),
+            read_options=pacsv.ReadOptions(skip_rows=1, column_names=names),
+            parse_options=pacsv.ParseOptions(delimiter=delim),
+            convert_options=pacsv.ConvertOptions(
+                column_types={names[pos]: pa.float64() for pos in index.values()},
+                include_columns=[names[pos] for pos in index.values()],
+                null_values=[""], strings_can_be_null=False))
+    except (pa.ArrowException, ValueError):
+        return None
+    if table.num_rows != len(lines) - 1:
+        return None
+    cols = {name: np.asarray(table.column(names[pos]).fill_null(math.nan).to_numpy(),
+                             dtype=np.float64) for name, pos in index.items()}
+    meta = {"format": "csv", "columns": header, "ignored_columns": ignored}
+    return cols, units, _Locator(file), meta
+
+
+def _exc_text(exc: BaseException) -> str:
+    text = str(exc).strip()
+    return f"{type(exc).__name__}: {text}" if text else type(exc).__name__
+
+
 def _is_number(text: str) -> bool:
     try:
         float(text)
@@ -762,7 +807,7 @@ def _read_parquet(path: Path, file: str):
     try:
         table = pq.read_table(path)
     except Exception as exc:  # noqa: BLE001 (pyarrow raises several types for bad files)
-        raise LogError(file, f"not a readable Parquet file ({exc})") from None
+        raise LogError(file, f"not a readable Parquet file ({_exc_text(exc)})") from None
     names = list(table.column_names)
     index, units, ignored = _parse_header(names, file)
     _check_required(index, names, file)
@@ -829,32 +874,43 @@ def _norm_type(name: str) -> str:
     return name.replace("/msg/", "/")
 
 
+_HEAD = {"<": struct.Struct("<iII"), ">": struct.Struct(">iII"), "ros1": struct.Struct("<IIII")}
+
+
+@functools.lru_cache(maxsize=64)
+def _body(end: str, code: str, count: int) -> struct.Struct:
+    return struct.Struct(f"{end}{count}{code}")
+
+
 def _decode(data: bytes, encoding: str, typ: str) -> tuple[int | None, tuple]:
     """One message -> (header stamp [ns] or None, values). ROS 1 or plain CDR (ROS 2)."""
     stamped, code, count, _ = _ROS_TYPES[typ]
-    size = struct.calcsize(code)
     if encoding == "cdr":
         end = _CDR_KINDS.get(bytes(data[:2]))
         if end is None:
             raise ValueError(f"unsupported CDR encapsulation 0x{bytes(data[:2]).hex()}")
-        base, pos = 4, 4
+        pos = 4
     elif encoding == "ros1":
-        end, base, pos = "<", None, 0
+        end, pos = "<", 0
     else:
         raise ValueError(f"unsupported message encoding {encoding!r}")
     stamp = None
     if stamped:
         if encoding == "ros1":
-            _seq, sec, nsec, slen = struct.unpack_from("<IIII", data, pos)
-            pos += 16 + slen
+            _seq, sec, nsec, slen = _HEAD["ros1"].unpack_from(data, 0)
+            pos = 16 + slen
         else:
-            sec, nsec, slen = struct.unpack_from(end + "iII", data, pos)
-            pos += 12 + slen
+            sec, nsec, slen = _HEAD[end].unpack_from(data, 4)
+            pos = 16 + slen
         stamp = sec * 1_000_000_000 + nsec
-    if base is not None:  # CDR aligns each primitive to its size, counted from the payload
-        pos += -(pos - base) % size
-    values = struct.unpack_from(f"{end}{count}{code}", data, pos)
-    return stamp, values
+    body = _body(end, code, count)
+    if encoding == "cdr":  # CDR aligns each primitive to its size, counted after the 4-byte header
+        size = body.size // count
+        pos += -(pos - 4) % size
+    if len(data) != pos + body.size and not (encoding == "cdr" and len(data) > pos + body.size
+                                             and len(data) - (pos + body.size) < 4):
+        raise ValueError(f"{len(data)} bytes, expected {pos + body.size} for {typ}")
+    return stamp, body.unpack_from(data, pos)
 
 
 def _encode_cdr(typ: str, values: tuple, stamp_ns: int | None = None, frame_id: str = "") -> bytes:
@@ -949,60 +1005,54 @@ class _RosSource:
 
 
 class _McapSource(_RosSource):
+    """One sequential pass over the file (no summary needed, so a recording cut short by a
+    crash is read up to its last complete chunk, with a warning). Message bytes are kept only
+    for the types we can decode."""
+
     def __init__(self, path: Path, file: str):
         super().__init__(file)
-        mcap_reader = _need("mcap.reader", "reading MCAP")
+        stream_reader = _need("mcap.stream_reader", "reading MCAP")
+        records = _need("mcap.records", "reading MCAP")
         if path.stat().st_size == 0:
             raise LogError(file, "empty file (expected an MCAP recording)")
-        self._fh = open(path, "rb")  # noqa: SIM115 (closed by read() or on error)
-        try:
-            self._reader = mcap_reader.make_reader(self._fh)
-            summary = self._reader.get_summary()
-        except Exception as exc:  # noqa: BLE001 (any reader failure: a bad file)
-            self._fh.close()
-            raise LogError(file, f"not a readable MCAP file ({exc})") from None
-        self._scanned: dict[str, list] | None = None
-        if summary is not None:
-            counts = summary.statistics.channel_message_counts if summary.statistics else {}
-            for cid, ch in summary.channels.items():
-                schema = summary.schemas.get(ch.schema_id)
-                typ = _norm_type(schema.name) if schema else "(no schema)"
-                self.topics[ch.topic] = (typ, ch.message_encoding, counts.get(cid))
+        schemas: dict[int, str] = {}
+        channels: dict[int, tuple[str, str, str]] = {}  # id -> topic, type, encoding
+        counts: dict[str, int] = {}
+        self._messages: dict[str, list[tuple[int, bytes]]] = {}
+        with open(path, "rb") as fh:
             try:
-                for record in self._reader.iter_metadata():
-                    if record.name == _MCAP_META:
-                        self.metadata = dict(record.metadata)
-            except Exception:  # noqa: BLE001 (metadata is optional)
-                self.metadata = {}
-        else:  # unfinished recording: no summary, scan every message once
-            self._scanned = {}
-            try:
-                for schema, ch, msg in self._reader.iter_messages(log_time_order=False):
-                    typ = _norm_type(schema.name) if schema else "(no schema)"
-                    self.topics[ch.topic] = (typ, ch.message_encoding, None)
-                    self._scanned.setdefault(ch.topic, []).append((msg.log_time, msg.data))
+                for rec in stream_reader.StreamReader(fh).records:
+                    if isinstance(rec, records.Message):
+                        topic, typ, _enc = channels[rec.channel_id]
+                        counts[topic] += 1
+                        if typ in _ROS_TYPES:
+                            self._messages[topic].append((rec.log_time, rec.data))
+                    elif isinstance(rec, records.Schema):
+                        schemas[rec.id] = _norm_type(rec.name)
+                    elif isinstance(rec, records.Channel):
+                        typ = schemas.get(rec.schema_id, "(no schema)")
+                        channels[rec.id] = (rec.topic, typ, rec.message_encoding)
+                        counts.setdefault(rec.topic, 0)
+                        self._messages.setdefault(rec.topic, [])
+                    elif isinstance(rec, records.Metadata) and rec.name == _MCAP_META:
+                        self.metadata = dict(rec.metadata)
             except Exception as exc:  # noqa: BLE001 (any reader failure: a bad file)
-                self._fh.close()
-                raise LogError(file, f"not a readable MCAP file ({exc})") from None
+                if not channels:
+                    raise LogError(file, f"not a readable MCAP file ({_exc_text(exc)})") from None
+                warnings.warn(f"{file}: truncated or damaged MCAP ({_exc_text(exc)}); read the "
+                              f"{sum(counts.values())} messages before the damage",
+                              LogWarning, stacklevel=4)
+        for topic, typ, enc in channels.values():
+            self.topics[topic] = (typ, enc, counts[topic])
 
     def read(self, names):
-        out = {name: _Topic(name, self.topics[name][0]) for name in names}
-        try:
-            if self._scanned is not None:
-                for name in names:
-                    enc = self.topics[name][1]
-                    for log_ns, data in sorted(self._scanned[name], key=lambda m: m[0]):
-                        self._decode_into(out[name], enc, data, log_ns)
-            else:
-                for _schema, ch, msg in self._reader.iter_messages(topics=names):
-                    self._decode_into(out[ch.topic], ch.message_encoding, msg.data,
-                                      msg.log_time)
-        except LogError:
-            raise
-        except Exception as exc:  # noqa: BLE001 (any reader failure: a bad file)
-            raise LogError(self.file, f"not a readable MCAP file ({exc})") from None
-        finally:
-            self._fh.close()
+        out = {}
+        for name in names:
+            topic = out[name] = _Topic(name, self.topics[name][0])
+            enc = self.topics[name][1]
+            # file order is chunk order; sort by log time (stable) as a recorder would play it
+            for log_ns, data in sorted(self._messages[name], key=lambda m: m[0]):
+                self._decode_into(topic, enc, data, log_ns)
         return out
 
 
@@ -1018,7 +1068,8 @@ class _BagSource(_RosSource):
             self._reader = rb.Reader(path)
             self._reader.open()
         except Exception as exc:  # noqa: BLE001 (any reader failure: a bad file)
-            raise LogError(file, f"not a readable ROS {1 if ros1 else 2} bag ({exc})") from None
+            raise LogError(file, f"not a readable ROS {1 if ros1 else 2} bag "
+                           f"({_exc_text(exc)})") from None
         for conn in self._reader.connections:
             typ = _norm_type(conn.msgtype)
             count = getattr(conn, "msgcount", None)
@@ -1036,7 +1087,7 @@ class _BagSource(_RosSource):
         except LogError:
             raise
         except Exception as exc:  # noqa: BLE001 (any reader failure: a bad file)
-            raise LogError(self.file, f"cannot read the bag ({exc})") from None
+            raise LogError(self.file, f"cannot read the bag ({_exc_text(exc)})") from None
         finally:
             self._reader.close()
         return out
@@ -1335,6 +1386,13 @@ def _write_mcap(log: SlidingLog, fh, wrench_topic: str | None, omega_topic: str 
     wid = channel(wrench_topic, "geometry_msgs/WrenchStamped")
     oid = channel(omega_topic, "geometry_msgs/TwistStamped") if log.omega is not None else None
     mid = channel(_DEFAULT_MANEUVER_TOPIC, "std_msgs/Int32")
+    # metadata first: a file cut short by a crash still says how to read it
+    w.add_metadata(_MCAP_META, {
+        "format_version": "1", "wrench_topic": wrench_topic,
+        "omega_topic": omega_topic if log.omega is not None else "",
+        "maneuver_topic": _DEFAULT_MANEUVER_TOPIC,
+        "force_vector": "true" if log.has_force_vector else "false", "t0_ns": str(t0),
+        "frame_id": frame_id, "units": json.dumps(UNITS)})
     if log.has_force_vector:
         fx, fy = log.f_x.tolist(), log.f_y.tolist()
     else:
@@ -1354,12 +1412,6 @@ def _write_mcap(log: SlidingLog, fh, wrench_topic: str | None, omega_topic: str 
         if i == 0 or man[i] != man[i - 1]:
             w.add_message(channel_id=mid, log_time=s, publish_time=s,
                           data=_encode_cdr("std_msgs/Int32", (man[i],)), sequence=i)
-    w.add_metadata(_MCAP_META, {
-        "format_version": "1", "wrench_topic": wrench_topic,
-        "omega_topic": omega_topic if log.omega is not None else "",
-        "maneuver_topic": _DEFAULT_MANEUVER_TOPIC,
-        "force_vector": "true" if log.has_force_vector else "false", "t0_ns": str(t0),
-        "frame_id": frame_id, "units": json.dumps(UNITS)})
     w.finish()
 
 

@@ -144,6 +144,39 @@ def test_csv_head_and_header_units(tmp_path):
     assert log.meta["converted_from"] == {"t": "ms", "f_t": "mN", "tau": "N mm"}
 
 
+def test_csv_fast_and_line_by_line_readers_agree(tmp_path, monkeypatch):
+    """The pyarrow CSV path and the line-by-line path read identical arrays."""
+    import lugrip.io as lio
+
+    log = make_log(n=200, seed=9)
+    path = write_log(log, tmp_path / "both.csv")
+    fast = read_log(path)
+    monkeypatch.setattr(lio, "_read_csv_fast", lambda *a: None)
+    slow = read_log(path)
+    assert_same(fast, slow)
+    assert_same(log, slow)
+
+
+def test_truncated_mcap_reads_what_is_complete(tmp_path, monkeypatch):
+    """An MCAP cut short (crash while recording) reads its complete chunks, with a warning."""
+    import mcap.writer
+
+    class SmallChunks(mcap.writer.Writer):
+        def __init__(self, output, **kw):
+            super().__init__(output, **{**kw, "chunk_size": 4096})
+
+    monkeypatch.setattr(mcap.writer, "Writer", SmallChunks)
+    log = make_log(n=3000, seed=4, omega=False, maneuvers=0)
+    whole = write_log(log, tmp_path / "whole.mcap").read_bytes()
+    cut = tmp_path / "cut.mcap"
+    cut.write_bytes(whole[: len(whole) // 2])
+    with pytest.warns(LogWarning, match="truncated or damaged MCAP"):
+        part = read_log(cut)
+    assert 0.3 * len(log) < len(part) < 0.7 * len(log)
+    np.testing.assert_array_equal(part.f_n, log.f_n[: len(part)])
+    np.testing.assert_allclose(part.t, log.t[: len(part)], rtol=0, atol=1e-9)
+
+
 def test_semicolon_csv_and_blank_lines(tmp_path):
     """';'-separated files and blank lines are read; rows keep their line numbers."""
     p = tmp_path / "semi.csv"
