@@ -37,7 +37,7 @@ struct GraspControllerSettings {
   //! by (last command / gain_schedule_force), which keeps the loop gain k_p |dS/df_n| (S ~ 1/f_n)
   //! the same at every force. Without it the 50 Hz loop on a quasi-static S(f_n) is unstable
   //! when (k_p - k_i T) |dS/df_n| > 1, i.e. below ~3 N for a translational load (S = 0.8 f*/f_n),
-  //! and limit-cycles there (tests: ClosedLoop.*). >= 0, finite.
+  //! and limit-cycles there (tests: ControllerClosedLoop.*). >= 0, finite.
   double gain_schedule_force = 0.0;
 
   // --- force range and rate limits (MODEL.md 9.5) --------------------------------------------

@@ -135,7 +135,7 @@ TEST(ControllerSettings, RunTimeChangesKeepFixedFields) {
 
 // --- C_d discretisation (MODEL.md 9.2) ------------------------------------------------------------
 
-TEST(DynamicPart, TustinCoefficientsMatchTheSpecTable) {
+TEST(ControllerDynamicPart, TustinCoefficientsMatchTheSpecTable) {
   const LagFilter f500(10, 250, 7, 1.0 / 500);
   EXPECT_NEAR(f500.b0(), 12.413108, 5e-7);
   EXPECT_NEAR(f500.b1(), -7.447865, 5e-7);
@@ -154,7 +154,7 @@ TEST(DynamicPart, TustinCoefficientsMatchTheSpecTable) {
   EXPECT_EQ(c.dynamic_filter(1).a1(), f500.a1());
 }
 
-TEST(DynamicPart, FrequencyResponseIsTheWarpedContinuousOne) {
+TEST(ControllerDynamicPart, FrequencyResponseIsTheWarpedContinuousOne) {
   const double T = 1.0 / 500;
   const LagFilter f(10, 250, 7, T);
   for (double theta = 1e-4; theta < kPi; theta *= 1.3) {
@@ -169,7 +169,7 @@ TEST(DynamicPart, FrequencyResponseIsTheWarpedContinuousOne) {
     EXPECT_NEAR(std::abs(cd_discrete(f, w * T)) / std::abs(cd_continuous(w)), 1.0, 0.01) << w;
 }
 
-TEST(DynamicPart, StepResponseThroughTheControllerMatchesTheContinuousOne) {
+TEST(ControllerDynamicPart, StepResponseThroughTheControllerMatchesTheContinuousOne) {
   // Unit step of omega_hat; continuous response y(t) = k (z/p + (1 - z/p) e^{-p t}).
   GraspController c(can());
   const auto in = one(0.8, 1.0);
@@ -190,7 +190,7 @@ TEST(DynamicPart, StepResponseThroughTheControllerMatchesTheContinuousOne) {
   EXPECT_NEAR(run(c, in, 5000).dynamic_sample[0], 2500.0 / 7.0, 1e-6);  // DC gain after 13 s
 }
 
-TEST(DynamicPart, AbsoluteValueAfterFilteringAndPeakHold) {
+TEST(ControllerDynamicPart, AbsoluteValueAfterFilteringAndPeakHold) {
   GraspControllerSettings s;
   s.max_rate_up = s.max_rate_down = kInf;
   GraspController c(can(), s);
@@ -220,7 +220,7 @@ TEST(DynamicPart, AbsoluteValueAfterFilteringAndPeakHold) {
   EXPECT_EQ(out.dynamic_peak, 0.0);  // restarted after the command
 }
 
-TEST(DynamicPart, ClippedToTheHeadRoomWithoutTouchingTheIntegrator) {
+TEST(ControllerDynamicPart, ClippedToTheHeadRoomWithoutTouchingTheIntegrator) {
   GraspControllerSettings s;
   s.max_rate_up = s.max_rate_down = kInf;
   GraspController c(can(), s);
@@ -233,7 +233,7 @@ TEST(DynamicPart, ClippedToTheHeadRoomWithoutTouchingTheIntegrator) {
   EXPECT_NEAR(out.integrator, 15.0, 1e-12);
 }
 
-TEST(DynamicPart, DisabledAndReenabledFromRest) {
+TEST(ControllerDynamicPart, DisabledAndReenabledFromRest) {
   GraspController c(can());
   auto out = run(c, one(0.8, 1.0), 200);  // filter state far from rest
   EXPECT_GT(out.dynamic_sample[0], 100.0);
@@ -248,7 +248,7 @@ TEST(DynamicPart, DisabledAndReenabledFromRest) {
 
 // --- static part: PI (MODEL.md 9.4-9.5) ----------------------------------------------------------
 
-TEST(StaticPart, SAboveTheReferenceRaisesTheForceAndBelowLowersIt) {
+TEST(ControllerStaticPart, SAboveTheReferenceRaisesTheForceAndBelowLowersIt) {
   const double T = 0.02;
   for (double S : {0.9, 0.7}) {
     GraspController c(can());
@@ -269,7 +269,7 @@ TEST(StaticPart, SAboveTheReferenceRaisesTheForceAndBelowLowersIt) {
   }
 }
 
-TEST(StaticPart, ProportionalStepHasTheRightSign) {
+TEST(ControllerStaticPart, ProportionalStepHasTheRightSign) {
   GraspControllerSettings s;
   s.max_rate_up = s.max_rate_down = kInf;
   GraspController c(can(), s);
@@ -280,7 +280,7 @@ TEST(StaticPart, ProportionalStepHasTheRightSign) {
   EXPECT_NEAR(out.error, 0.2, 1e-12);
 }
 
-TEST(StaticPart, NoLoadDecaysToTheFloorInAQuarterSecond) {
+TEST(ControllerStaticPart, NoLoadDecaysToTheFloorInAQuarterSecond) {
   // MODEL.md 9.5: from 2 N with S = 0 the integrator drains at k_i S_ref = 8 N/s.
   GraspController c(can());
   c.reset(2.0);
@@ -313,7 +313,7 @@ int commands_to_leave_ceiling(bool anti_windup, double hold) {
 }
 }  // namespace
 
-TEST(StaticPart, AntiWindupLeavesTheCeilingAtOnce) {
+TEST(ControllerStaticPart, AntiWindupLeavesTheCeilingAtOnce) {
   EXPECT_EQ(commands_to_leave_ceiling(true, 30.0), 1);
   // Without back-calculation the integrator winds up by k_i 0.2 per second of saturation.
   const int without = commands_to_leave_ceiling(false, 30.0);
@@ -323,7 +323,7 @@ TEST(StaticPart, AntiWindupLeavesTheCeilingAtOnce) {
   EXPECT_NEAR(without, (5.0 - 0.8 + 60.0 - 21.2) / (10.0 * 0.02 * 0.3), 3.0);
 }
 
-TEST(StaticPart, AntiWindupAtTheFloorToo) {
+TEST(ControllerStaticPart, AntiWindupAtTheFloorToo) {
   GraspControllerSettings s;
   s.max_rate_up = s.max_rate_down = kInf;
   GraspController c(can(), s);
@@ -334,7 +334,7 @@ TEST(StaticPart, AntiWindupAtTheFloorToo) {
   EXPECT_GT(out.force, 0.1);
 }
 
-TEST(StaticPart, RateLimitsBoundEachCommandChange) {
+TEST(ControllerStaticPart, RateLimitsBoundEachCommandChange) {
   GraspControllerSettings s;
   s.max_rate_up = 10.0;  // 0.2 N per command
   s.max_rate_down = 5.0;
@@ -354,7 +354,7 @@ TEST(StaticPart, RateLimitsBoundEachCommandChange) {
 
 // --- multi-rate -----------------------------------------------------------------------------------
 
-TEST(MultiRate, CommandChangesOnlyEveryTenthCall) {
+TEST(ControllerMultiRate, CommandChangesOnlyEveryTenthCall) {
   GraspController c(can());
   c.reset(3.0);
   std::mt19937 rng(7);
@@ -385,7 +385,7 @@ TEST(MultiRate, CommandChangesOnlyEveryTenthCall) {
 
 // --- two fingers (MODEL.md 9.8) -------------------------------------------------------------------
 
-TEST(TwoFingers, MaxOfSMaxOfDynamicPartMeanOfCoR) {
+TEST(ControllerTwoFingers, MaxOfSMaxOfDynamicPartMeanOfCoR) {
   GraspControllerSettings s;
   s.max_rate_up = s.max_rate_down = kInf;
   GraspController c(can(), s);
@@ -414,7 +414,7 @@ TEST(TwoFingers, MaxOfSMaxOfDynamicPartMeanOfCoR) {
   EXPECT_DOUBLE_EQ(out1.force, out.force);
 }
 
-TEST(TwoFingers, AbsentFingerIsIgnoredEvenWithGarbage) {
+TEST(ControllerTwoFingers, AbsentFingerIsIgnoredEvenWithGarbage) {
   GraspController c(can());
   GraspControllerInput in = one(0.7);
   in.fingers[1] = FingerInput{kNaN, kNaN, kNaN, kNaN, Status::SensorFault, false};
@@ -430,7 +430,7 @@ TEST(TwoFingers, AbsentFingerIsIgnoredEvenWithGarbage) {
 
 // --- invalid inputs ---------------------------------------------------------------------------
 
-TEST(BadInput, InvalidStatusesAndValuesHoldTheCommand) {
+TEST(ControllerBadInput, InvalidStatusesAndValuesHoldTheCommand) {
   const FingerInput bad[] = {
       {0, 0.0, 0.5, 0.5, Status::InvalidSample, true}, {0, 0.0, 0.5, 0.5, Status::SensorFault, true},
       {0, 0.0, 0.5, 0.5, Status::NoContact, true},     {kNaN, 0.0, 0.5, 0.5, Status::Ok, true},
@@ -467,7 +467,7 @@ TEST(BadInput, InvalidStatusesAndValuesHoldTheCommand) {
   EXPECT_EQ(out.status, Status::SensorFault);
 }
 
-TEST(BadInput, ConfigurableRaiseStepUpToTheCeiling) {
+TEST(ControllerBadInput, ConfigurableRaiseStepUpToTheCeiling) {
   GraspControllerSettings s;
   s.invalid_raise_step = 0.5;
   GraspController c(can(), s);
@@ -481,7 +481,7 @@ TEST(BadInput, ConfigurableRaiseStepUpToTheCeiling) {
   EXPECT_EQ(out.force, 20.0);
 }
 
-TEST(BadInput, RandomAdversarialInputsKeepTheCommandFiniteAndInRange) {
+TEST(ControllerBadInput, RandomAdversarialInputsKeepTheCommandFiniteAndInRange) {
   // Property: 1e6 seeded samples (NaN, Inf, huge, negative, random statuses, presence, mode
   // requests and resets) -> command finite and in [f_min, f_max]; never lowered by a held command.
   GraspControllerSettings s;
@@ -531,7 +531,7 @@ TEST(BadInput, RandomAdversarialInputsKeepTheCommandFiniteAndInRange) {
 
 // --- pivoting (MODEL.md 9.6) ----------------------------------------------------------------------
 
-TEST(Pivoting, NoDynamicPartExponentialDecayNoJump) {
+TEST(ControllerPivoting, NoDynamicPartExponentialDecayNoJump) {
   GraspControllerSettings s;
   s.max_rate_up = s.max_rate_down = kInf;
   GraspController c(can(), s);
@@ -558,7 +558,7 @@ TEST(Pivoting, NoDynamicPartExponentialDecayNoJump) {
   EXPECT_NEAR(out.force, -1.2 + (before + 1.2) * std::exp(-1.0), 1e-9);  // after 2 s = tau_p
 }
 
-TEST(Pivoting, FloorFromTheTangentialForceHoldsTheFilterState) {
+TEST(ControllerPivoting, FloorFromTheTangentialForceHoldsTheFilterState) {
   GraspController c(can());
   c.reset(3.0);
   GraspControllerOutput out;
@@ -582,7 +582,7 @@ TEST(Pivoting, FloorFromTheTangentialForceHoldsTheFilterState) {
   EXPECT_GT(out.force, 2.0);
 }
 
-TEST(Pivoting, EndsOnThreeConsecutiveSamplesAboveOneThenBumplessReturn) {
+TEST(ControllerPivoting, EndsOnThreeConsecutiveSamplesAboveOneThenBumplessReturn) {
   GraspControllerSettings s;
   s.max_rate_up = s.max_rate_down = kInf;
   GraspController c(can(), s);
@@ -620,7 +620,7 @@ TEST(Pivoting, EndsOnThreeConsecutiveSamplesAboveOneThenBumplessReturn) {
   EXPECT_GT(out.force, last);
 }
 
-TEST(Pivoting, TwoFingersEndOnTheMeanOfTheCoR) {
+TEST(ControllerPivoting, TwoFingersEndOnTheMeanOfTheCoR) {
   GraspController c(can());
   GraspControllerInput in;
   in.fingers[0] = FingerInput{0.0, 1.0, 1.5, 0.2, Status::Ok, true};
@@ -635,7 +635,7 @@ TEST(Pivoting, TwoFingersEndOnTheMeanOfTheCoR) {
   EXPECT_TRUE(out.pivot_finished);
 }
 
-TEST(Pivoting, TimeoutAndRequestEndIt) {
+TEST(ControllerPivoting, TimeoutAndRequestEndIt) {
   GraspControllerSettings s;
   s.pivot_timeout = 1.0;
   GraspController c(can(), s);
@@ -659,7 +659,7 @@ TEST(Pivoting, TimeoutAndRequestEndIt) {
   EXPECT_FALSE(out.pivot_finished);
 }
 
-TEST(Pivoting, InvalidInputHoldsInsteadOfDecaying) {
+TEST(ControllerPivoting, InvalidInputHoldsInsteadOfDecaying) {
   GraspController c(can());
   c.reset(5.0);
   c.request_pivoting();
@@ -674,7 +674,7 @@ TEST(Pivoting, InvalidInputHoldsInsteadOfDecaying) {
 
 // --- static grasp force (MODEL.md 6, 10.2, Appendix A) --------------------------------------------
 
-TEST(StaticGraspForce, ReferenceValues) {
+TEST(ControllerStaticGraspForce, ReferenceValues) {
   StaticForceSolver can_solver(can());
   EXPECT_NEAR(can_solver.solve(0.12, 0.0).force, 0.190, 0.0005);  // empty can, c_max = 1.5
   EXPECT_NEAR(can_solver.solve(0.12, 0.0).force, 0.12 / 0.75 / 0.8 / 1.0518, 2e-4);
@@ -706,7 +706,7 @@ TEST(StaticGraspForce, ReferenceValues) {
   EXPECT_EQ(can_solver.solve(-2.0, -3e-3).force, can_solver.solve(2.0, 3e-3).force);
 }
 
-TEST(StaticGraspForce, MoreLoadNeverLowersTheForceAndSlippageDecreases) {
+TEST(ControllerStaticGraspForce, MoreLoadNeverLowersTheForceAndSlippageDecreases) {
   StaticForceSolver solver(object_params("plastic_bottle"));
   std::mt19937 rng(11);
   std::uniform_real_distribution<double> lf(-3.0, 1.5), lt(-6.0, -1.5), grow(1.0, 1.5);
@@ -750,7 +750,7 @@ std::pair<double, double> quasi_static_loop(const ContactParams& p, double ft, d
 }
 }  // namespace
 
-TEST(ClosedLoop, SettlesAtTheStaticGraspForce) {
+TEST(ControllerClosedLoop, SettlesAtTheStaticGraspForce) {
   struct Load {
     const char* object;
     double ft, tau;
@@ -765,7 +765,7 @@ TEST(ClosedLoop, SettlesAtTheStaticGraspForce) {
   }
 }
 
-TEST(ClosedLoop, LowForcesNeedGainScheduling) {
+TEST(ControllerClosedLoop, LowForcesNeedGainScheduling) {
   // Empty can (0.12 N per finger -> 0.190 N): k_p |dS/df| = 4 * 0.8 / 0.19 = 17 > 1, the 50 Hz
   // loop with the paper's gains limit-cycles; with gain scheduling it settles.
   const double f_static = StaticForceSolver(can()).solve(0.12, 0.0).force;
