@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <cmath>
 #include <complex>
+#include <cstdlib>
 #include <limits>
 #include <random>
 #include <string>
@@ -490,7 +491,12 @@ TEST(ControllerBadInput, RandomAdversarialInputsKeepTheCommandFiniteAndInRange) 
   s.invalid_raise_step = 0.01;
   s.pivot_timeout = 0.5;
   GraspController c(can(), s);
-  std::mt19937_64 rng(20240607);
+  // Defaults: 1e6 samples, seed 20240607; LUGRIP_PROPERTY_SAMPLES / LUGRIP_PROPERTY_SEED override.
+  const char* env_n = std::getenv("LUGRIP_PROPERTY_SAMPLES");
+  const char* env_seed = std::getenv("LUGRIP_PROPERTY_SEED");
+  const long samples = env_n ? std::max(1L, std::atol(env_n)) : 1000000L;
+  std::mt19937_64 rng(env_seed ? std::strtoull(env_seed, nullptr, 10) : 20240607u);
+  SCOPED_TRACE("seed " + std::string(env_seed ? env_seed : "20240607"));
   std::uniform_real_distribution<double> u(0.0, 1.0);
   const double specials[] = {kNaN, kInf, -kInf, 1e300, -1e300, 1e7, -1e7, 0.0, -0.0, 1e-300};
   auto value = [&](double scale) {
@@ -501,7 +507,7 @@ TEST(ControllerBadInput, RandomAdversarialInputsKeepTheCommandFiniteAndInRange) 
   };
   GraspControllerOutput out;
   double previous = c.command();
-  for (int n = 0; n < 1000000; ++n) {
+  for (long n = 0; n < samples; ++n) {
     GraspControllerInput in;
     for (auto& f : in.fingers) {
       f.omega_hat = value(0.5);
