@@ -1346,8 +1346,9 @@ def _write_parquet(log: SlidingLog, fh) -> None:
     cols = log.columns()
     arrays = [pa.array(a, type=pa.int64() if name == "maneuver" else pa.float64())
               for name, a in cols.items()]
-    meta = _json_meta({k: v for k, v in log.meta.items()
-                       if k not in ("format", "columns", "ignored_columns")})
+    # keep provenance (topics, t0_ns, ...), drop what describes one particular read
+    skip = ("format", "columns", "ignored_columns", "converted_from", "flip_normal", "units")
+    meta = _json_meta({k: v for k, v in log.meta.items() if k not in skip})
     meta["format_version"] = 1
     schema = pa.schema([pa.field(name, arr.type) for name, arr in zip(cols, arrays)],
                        metadata={b"lugrip": json.dumps(meta).encode()})

@@ -234,6 +234,18 @@ def test_malformed_csv_names_file_row_and_column(tmp_path, case):
         assert word in msg, (word, msg)
 
 
+def test_flip_normal_on_a_table(tmp_path):
+    """flip_normal on a table rotates by pi about x: f_n, f_y, tau, omega change sign."""
+    p = tmp_path / "raw.csv"
+    p.write_text(rows(*[g.replace(",2.", ",-2.") for g in GOOD]))
+    log = read_log(p, flip_normal=True)
+    np.testing.assert_array_equal(log.f_n, [2.0, 2.1, 2.2, 2.3])
+    np.testing.assert_array_equal(log.f_x, [0.1] * 4)
+    np.testing.assert_array_equal(log.f_y, [-0.2] * 4)
+    np.testing.assert_array_equal(log.tau, [-0.001] * 4)
+    np.testing.assert_array_equal(log.omega, [-0.0, -0.1, -0.2, -0.3])
+
+
 def test_ragged_row_and_missing_header(tmp_path):
     """A row with the wrong cell count, and a file without header, are named by row."""
     err = csv_error(tmp_path, rows(GOOD[0], "0.002,2,0.1"))
