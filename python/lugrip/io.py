@@ -572,7 +572,7 @@ def _validate(cols: dict[str, np.ndarray], loc: _Locator, *, max_nan_run: int,
         if med < 0:
             i = _near(f_n, med)
             raise loc.error(f"f_n is negative in most samples (median {med:.4g} N): the "
-                            "sensor's z axis points out of the contact; pass flip_normal=True "
+                            "sensor's z axis points toward the object; pass flip_normal=True "
                             "(or negate f_n, f_y, tau and omega)", i, "f_n")
         low = np.flatnonzero(finite & (f_n <= 0))
         if low.size:
@@ -1256,8 +1256,9 @@ def read_log(path: str | os.PathLike, *, format: str | None = None,
             ``TwistStamped``/``Twist`` (angular.z), ``Vector3[Stamped]`` (z) or
             ``Float64``/``Float32``; linearly resampled onto the wrench times (NaN outside its
             time span and across gaps longer than 10 of its median periods).
-        flip_normal: the sensor's z axis points away from the object: rotate the frame by pi
-            about x (f_n, f_y, tau and omega change sign) so that f_n > 0 in contact.
+        flip_normal: the sensor's z axis points toward the object (out of the pad), so its
+            force z is negative while pressed: rotate the frame by pi about x (f_n, f_y, tau
+            and omega change sign) so that f_n > 0 in contact.
         units: units of the source columns, converted to SI, e.g. ``{'tau': 'N mm',
             't': 'ms'}``; key ``'force'`` sets every force column. A column given a unit here
             (or in a table header as ``tau [N mm]``) skips the magnitude check.
