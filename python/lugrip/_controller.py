@@ -17,17 +17,17 @@ from ._contact import Status, _as_params, _flat, _model, _shaped
 from ._params import ContactParams
 
 __all__ = [
-    "ControllerMode",
-    "PivotEnd",
-    "ControllerOutput",
-    "ControllerRun",
-    "GraspController",
-    "controller_settings",
-    "static_grasp_force",
-    "static_slippage",
     "REQUEST_NONE",
     "REQUEST_PIVOTING",
     "REQUEST_SLIPPING_AVOIDANCE",
+    "ControllerMode",
+    "ControllerOutput",
+    "ControllerRun",
+    "GraspController",
+    "PivotEnd",
+    "controller_settings",
+    "static_grasp_force",
+    "static_slippage",
 ]
 
 #: Codes of the ``requests`` array of :meth:`GraspController.run`.
@@ -74,7 +74,8 @@ def _core_settings(values: dict[str, Any]) -> _core.GraspControllerSettings:
     s = _core.GraspControllerSettings()
     for name, value in values.items():
         if name not in _SETTINGS_FIELDS:
-            raise ValueError(f"unknown controller setting {name!r}; known: {', '.join(_SETTINGS_FIELDS)}")
+            known = ", ".join(_SETTINGS_FIELDS)
+            raise ValueError(f"unknown controller setting {name!r}; known: {known}")
         try:
             if name in _BOOL_FIELDS:
                 value = bool(value)
@@ -132,7 +133,7 @@ class ControllerOutput:
     status: Status
 
     @classmethod
-    def _from_core(cls, o) -> "ControllerOutput":
+    def _from_core(cls, o) -> ControllerOutput:
         return cls(
             force=o.force, static_force=o.static_force, dynamic_force=o.dynamic_force,
             floor=o.floor, slippage=o.slippage, error=o.error, integrator=o.integrator,
@@ -286,22 +287,24 @@ class GraspController:
             raise ValueError(str(err)) from None
 
     # --- stepping --------------------------------------------------------------------------
-    def step(self, omega_hat, S, c_tilde=0.0, f_t=0.0, status=Status.OK, present=None) -> ControllerOutput:
-        """One sensor sample. Scalars describe finger 0 alone (finger 1 absent); length-2
-        sequences describe both fingers.
+    def step(self, omega_hat, S, c_tilde=0.0, f_t=0.0, status=Status.OK,
+             present=None) -> ControllerOutput:
+        """One sensor sample. Scalars describe finger 0 alone (finger 1 absent unless `present`
+        says otherwise, then it gets the same values); length-2 sequences describe both fingers.
 
         Args:
             omega_hat: estimated sliding velocity [rad/s]; S: slippage indicator [-];
             c_tilde: normalized CoR [-]; f_t: tangential force [N]; status: observer Status;
             present: per-finger bools (default: the fingers given).
         """
-        vals = [np.atleast_1d(np.asarray(v, dtype=np.float64)) for v in (omega_hat, S, c_tilde, f_t)]
+        vals = [np.atleast_1d(np.asarray(v, dtype=np.float64))
+                for v in (omega_hat, S, c_tilde, f_t)]
         st = np.atleast_1d(np.asarray(status, dtype=np.int64))
         n_fingers = max(len(v) for v in vals + [st])
         if n_fingers > 2 or any(len(v) not in (1, n_fingers) for v in vals + [st]):
             raise ValueError("per-finger inputs must be scalars or sequences of length 2")
-        vals = [np.broadcast_to(v, (2,)) if n_fingers == 2 else np.array([v[0], 0.0]) for v in vals]
-        st = np.broadcast_to(st, (2,)) if n_fingers == 2 else np.array([st[0], 0])
+        vals = [np.broadcast_to(v, (2,)) for v in vals]
+        st = np.broadcast_to(st, (2,))
         if present is None:
             pres = (True, n_fingers == 2)
         else:

@@ -4,14 +4,13 @@ from __future__ import annotations
 
 import math
 
+import lugrip
 import numpy as np
 import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
-from scipy import signal
-
-import lugrip
 from lugrip import ControllerMode, GraspController, PivotEnd, Status
+from scipy import signal
 
 CAN = lugrip.ContactParams.preset("aluminium_can")
 T_SENSOR = 1.0 / 500.0
@@ -93,7 +92,8 @@ def test_pi_direction(S, sign):
 def test_anti_windup_leaves_the_ceiling_at_once(anti_windup):
     """After 20 s at f_max the force leaves it at the first command after the error reverses
     with back-calculation, only after hundreds of commands without."""
-    ctrl = GraspController(CAN, anti_windup=anti_windup, max_rate_up=math.inf, max_rate_down=math.inf)
+    ctrl = GraspController(CAN, anti_windup=anti_windup, max_rate_up=math.inf,
+                           max_rate_down=math.inf)
     ctrl.reset(5.0)
     hold = ctrl.run(np.zeros(10000), np.ones(10000), 0.5, 0.5)
     assert hold.force[-1] == 20.0
@@ -241,7 +241,8 @@ def test_static_grasp_force_reference_values():
     f = lugrip.static_grasp_force(CAN, [0.12, 2.0, 2.0, 4.0], [0.0, 3e-3, 6e-3, 6e-3])
     np.testing.assert_allclose(f, [0.190, 4.75, 6.66, 8.90], atol=0.005)
     wide = CAN.replace(c_max=1000.0)
-    np.testing.assert_allclose(lugrip.static_grasp_force(wide, [0.12, 2.0], 0.0), [0.2, 10 / 3], rtol=1e-5)
+    np.testing.assert_allclose(lugrip.static_grasp_force(wide, [0.12, 2.0], 0.0), [0.2, 10 / 3],
+                               rtol=1e-5)
     f_e2, info = lugrip.static_grasp_force("small_resin_block", 1.20, 4.15e-3, full_output=True)
     assert f_e2 == pytest.approx(5.0, abs=0.01)
     assert info["c_tilde"] == pytest.approx(0.4, abs=0.002)
@@ -271,13 +272,15 @@ def test_static_grasp_force_against_closed_forms():
 @given(st.floats(-3, 1.3), st.floats(-6, -1.5), st.floats(1.0, 2.0), st.floats(1.0, 2.0))
 def test_more_load_never_lowers_the_static_force(log_ft, log_tau, kf, kt):
     ft, tau = 10.0 ** log_ft, 10.0 ** log_tau
-    f = lugrip.static_grasp_force("plastic_bottle", [ft, ft * kf, ft, ft * kf], [tau, tau, tau * kt, tau * kt])
+    f = lugrip.static_grasp_force("plastic_bottle", [ft, ft * kf, ft, ft * kf],
+                                  [tau, tau, tau * kt, tau * kt])
     assert f[1] >= f[0] * (1 - 1e-12) and f[2] >= f[0] * (1 - 1e-12) and f[3] >= f[0] * (1 - 1e-12)
     S, _ = lugrip.static_slippage("plastic_bottle", [0.9 * f[0], f[0], 1.1 * f[0]], ft, tau)
     assert S[0] > 0.8 > S[2] and S[1] == pytest.approx(0.8, rel=1e-9)
 
 
-@pytest.mark.parametrize("obj, ft, tau", [("aluminium_can", 2.0, 3e-3), ("small_resin_block", 1.2, 4.15e-3)])
+@pytest.mark.parametrize("obj, ft, tau",
+                         [("aluminium_can", 2.0, 3e-3), ("small_resin_block", 1.2, 4.15e-3)])
 def test_closed_loop_settles_at_the_static_force(obj, ft, tau):
     """Quasi-static plant S = S_static(commanded f_n): the settled force is static_grasp_force."""
     ctrl = GraspController(obj)
