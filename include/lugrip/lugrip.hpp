@@ -5,6 +5,8 @@
 #include "lugrip/grasp_controller.hpp"
 #include "lugrip/grasp_plant.hpp"
 #include "lugrip/limit_surface.hpp"
+#include "lugrip/observer.hpp"
 #include "lugrip/params.hpp"
+#include "lugrip/slider_model.hpp"
 #include "lugrip/status.hpp"
 #include "lugrip/version.hpp"

@@ -1,0 +1,172 @@
+// lugrip — sliding-velocity observer (paper eqs. 19-23) and slippage indicator (eq. 37).
+#pragma once
+
+#include <cmath>
+#include <string>
+
+#include "lugrip/contact.hpp"
+#include "lugrip/params.hpp"
+#include "lugrip/slider_model.hpp"
+#include "lugrip/status.hpp"
+
+namespace lugrip {
+
+//! How the observer gain l is chosen at each sample.
+enum class GainMode : int {
+  Fixed = 0,      //!< l = ObserverSettings::gain
+  //! l = bandwidth / sigma_1 clipped to [gain_min, gain_max]: the sliding convergence rate
+  //! l sigma_1 is then the same at every force, CoR and beta_A (MODEL.md 7.4 "scale the gain
+  //! with sigma_1"); sigma_1 spans five decades, a fixed l is seconds late when it is small.
+  Bandwidth = 1,
+};
+
+//! Short name ("fixed", "bandwidth"); never allocates.
+const char* to_string(GainMode m) noexcept;
+
+//! Observer settings; every default lives here. The defaults were chosen on synthetic sliding
+//! data (plant = SliderModel, sensor = ContactModel::wrench_at + white noise); the figures are in
+//! the report of issue 3 and the tests in tests/cpp/test_observer.cpp pin the behaviour.
+//!
+//! | field | meaning | unit | range | default |
+//! |---|---|---|---|---|
+//! | dt | nominal sample period, used when ObserverInput::dt == 0 | s | > 0 | 0.002 |
+//! | integrator | discretisation (Integrator) | - | | Rosenbrock |
+//! | gain_mode | Fixed or Bandwidth | - | | Bandwidth |
+//! | gain | l in Fixed mode | 1/(kg m^2) | > 0 | 200 |
+//! | bandwidth | B = l sigma_1 in Bandwidth mode (sliding convergence rate) | 1/s | > 0 | 100 |
+//! | gain_min, gain_max | clip of l in Bandwidth mode | 1/(kg m^2) | 0 < min <= max | 1, 1e7 |
+//! | g_floor | lower bound on g | N m | > 0 | 1e-7 |
+//! | torque_cutoff | first-order low-pass of the torque used for the CoR only (0: off); y uses the raw torque | Hz | >= 0 | 2 |
+//! | filter_force | also low-pass f_t (same filter) for the CoR, so a proportional load ramp keeps its CoR | - | | true |
+//! | cor_sign_sigmas | CoR sign hysteresis: the side changes only when the filtered torque exceeds this many standard deviations of the filtered torque noise (torque_noise through the low-pass at dt) with the other sign | - | >= 0 | 5 |
+//! | max_invalid | consecutive invalid samples before SensorFault | - | >= 1 | 10 |
+//! | max_dt_gap | longer gaps re-initialise instead of being integrated across | s | >= dt | 0.05 |
+//! | torque_noise | torque noise std of the sensor (omega_resolution, sign hysteresis) | N m | >= 0 | 1e-5 |
+//! | resolution_max | speed_observable when omega_resolution <= this | rad/s | > 0 | 0.02 |
+//! | omega_limit | divergence guard: larger |omega_hat| re-initialises | rad/s | > 0 | 1000 |
+//! | substeps | (minimum) equal substeps per sample, every scheme | - | >= 1 | 1 |
+//! | max_substeps | cap of adaptive substeps (Rk4Adaptive, Rosenbrock) per sample | - | >= substeps | 500 |
+//! | cor | CoR estimator settings (contact threshold, sensor range, zero thresholds) | | | CorSettings() |
+struct ObserverSettings {
+  double dt = 0.002;
+  Integrator integrator = Integrator::Rosenbrock;
+  GainMode gain_mode = GainMode::Bandwidth;
+  double gain = 200.0;
+  double bandwidth = 100.0;
+  double gain_min = 1.0;
+  double gain_max = 1.0e7;
+  double g_floor = 1.0e-7;
+  double torque_cutoff = 2.0;
+  bool filter_force = true;
+  double cor_sign_sigmas = 5.0;
+  int max_invalid = 10;
+  double max_dt_gap = 0.05;
+  double torque_noise = 1.0e-5;
+  double resolution_max = 0.02;
+  double omega_limit = 1.0e3;
+  int substeps = 1;
+  int max_substeps = 500;
+  CorSettings cor;
+};
+
+//! Checks every field (and the nested CorSettings); one line per bad field in *message,
+//! naming field and value. Returns true when valid.
+bool validate(const ObserverSettings& s, std::string* message);
+
+//! One fingertip sample: the wrench the OBJECT exerts on the FINGERTIP, i.e. what a fingertip
+//! force/torque sensor reads (MODEL.md 7.2), in a frame with z along the contact normal.
+//! With this wrench y = tau - c f_t has the sign of the slip velocity and omega_hat is the
+//! object's angular velocity relative to the fingertip about the sensor's z axis. Feeding the
+//! opposite wrench (fingertip on object) returns -omega_hat with the same S.
+struct ObserverInput {
+  double f_n = 0.0;  //!< normal force [N], >= CorSettings::f_n_min in contact
+  double f_t = 0.0;  //!< tangential force [N]: in-plane magnitude (>= 0) or a signed component
+  double tau = 0.0;  //!< torsional moment about the contact normal [N m], signed
+  double dt = 0.0;   //!< time since the previous sample [s]; 0 means the nominal settings.dt
+
+  //! Builds the input from the in-plane force vector (f_t = hypot(f_x, f_y)).
+  static ObserverInput from_force_vector(double f_n, double f_x, double f_y, double tau,
+                                         double dt = 0.0) noexcept {
+    return ObserverInput{f_n, std::hypot(f_x, f_y), tau, dt};
+  }
+};
+
+//! Result for one sample. Always finite. On InvalidSample / SensorFault the previous output is
+//! held (with the new status); on NoContact omega_hat = z_hat = S = y = 0 (state reset).
+struct ObserverOutput {
+  double omega_hat = 0.0;   //!< estimated slip velocity about the CoR [rad/s] (object vs fingertip)
+  double z_hat = 0.0;       //!< estimated bristle state [rad], |sigma0 z_hat| <= g
+  double S = 0.0;           //!< slippage indicator sigma0 |z_hat| / g in [0, 1] (eq. 37)
+  double c_tilde = 0.0;     //!< normalized CoR [-] (sensor frame), |c~| <= c_max
+  double c = 0.0;           //!< CoR position [m]
+  double g = 0.0;           //!< dry torque capacity about the CoR [N m] (eq. 18, floored)
+  double sigma_1 = 0.0;     //!< viscous coefficient about the CoR [N m s/rad] (eq. 17)
+  double y = 0.0;           //!< measured friction torque about the CoR, tau - c f_t [N m] (eq. 20), raw torque
+  double tau_cor = 0.0;     //!< filtered torque (with sign hysteresis) used for the CoR [N m]
+  double ft_cor = 0.0;      //!< tangential force used for the CoR (filtered when filter_force) [N]
+  double gain = 0.0;        //!< observer gain l used on this sample [1/(kg m^2)]
+  //! Speed resolution torque_noise / sigma_1 [rad/s]: the slip speed enters the wrench only
+  //! through viscous friction (MODEL.md 6, 7.3), so speed changes below this are invisible.
+  double omega_resolution = 0.0;
+  bool speed_observable = false;  //!< omega_resolution <= settings.resolution_max
+  bool inside = true;       //!< CoR wrench strictly inside the limit surface (eq. 15)
+  bool saturated = false;   //!< |c~| clipped at c_max
+  bool projected = false;   //!< z_hat was clipped to +-g/sigma0 after the update
+  bool diverged = false;    //!< the update left the valid range (|omega_hat| > omega_limit or non-finite): re-initialised
+  bool substeps_capped = false;  //!< Rk4Adaptive needed more than max_substeps
+  int substeps = 0;         //!< integrator (sub)steps on this sample (0 when not integrated)
+  int cor_iterations = 0;   //!< root-finding iterations of the CoR estimate
+  Status status = Status::NoContact;
+};
+
+//! Nonlinear sliding-velocity observer of the paper (eqs. 21-23, MODEL.md 7), per fingertip:
+//!
+//!   zhat' = omegahat - (sigma0/g) zhat |omegahat|,
+//!   omegahat' = l [y - sigma0 zhat - sigma_1 omegahat - sigma_z zhat'],
+//!
+//! with y = tau - c f_t. Per sample: (1) CoR estimate (CorEstimator) from f_n, f_t and the
+//! low-pass filtered torque (raw torque for y: on translational loads the torque is below the
+//! noise and an unfiltered CoR changes side every few samples, which flips the sign of y);
+//! (2) g, sigma_1 and y at the current sample; (3) one update with the chosen integrator over
+//! the time since the last integrated sample; (4) projection |zhat| <= g/sigma0, so S <= 1.
+//!
+//! What is observable: the slip indicator S (how much of the dry capacity is used) always is.
+//! The slip SPEED enters the measured wrench only through the viscous term sigma_1 omega: in
+//! steady sliding omega_hat converges to (|y| - g)/sigma_1 at rate l sigma_1, and a torque error
+//! e maps to a speed error e / sigma_1. With weak viscous friction (paper Table 2, sigma_1 ~ 1e-3)
+//! the speed is poorly observable; omega_resolution and speed_observable report this per sample.
+//!
+//! Initialisation (first valid sample, after reset(), NoContact, SensorFault or a dt gap):
+//! omega_hat = 0, z_hat = clip(y/sigma0, +-g/sigma0), status Reinitialized.
+class Observer {
+ public:
+  //! Validates params and settings (std::invalid_argument, one line per bad field).
+  explicit Observer(const ContactParams& params, const ObserverSettings& settings = ObserverSettings());
+  //! Reuses an existing contact model (copies its tables; no quadrature).
+  explicit Observer(const ContactModel& model, const ObserverSettings& settings = ObserverSettings());
+
+  //! Processes one sample; never throws, never allocates; out is always finite.
+  Status step(const ObserverInput& in, ObserverOutput& out) noexcept;
+  //! Forgets the state; the next valid sample re-initialises.
+  void reset() noexcept;
+
+  double omega_hat() const noexcept { return omega_; }
+  double z_hat() const noexcept { return z_; }
+  const ContactModel& model() const noexcept { return cor_.model(); }
+  const ObserverSettings& settings() const noexcept { return s_; }
+
+ private:
+  CorEstimator cor_;
+  ObserverSettings s_;
+  double z_ = 0.0, omega_ = 0.0;
+  double tau_f_ = 0.0;    // low-pass filtered torque for the CoR
+  double ft_f_ = 0.0;     // low-pass filtered tangential force for the CoR (filter_force)
+  double cor_sign_ = 1.0; // side of the CoR torque (hysteresis)
+  double pending_ = 0.0;  // time of skipped (invalid) samples, added to the next step
+  double sign_band_ = 0.0;  // [N m] CoR sign hysteresis (cor_sign_sigmas x filtered noise std)
+  int invalid_run_ = 0;
+  bool need_init_ = true;
+  ObserverOutput last_;
+};
+
+}  // namespace lugrip

@@ -1,0 +1,243 @@
+#include "lugrip/observer.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <limits>
+#include <stdexcept>
+#include <string>
+
+namespace lugrip {
+
+namespace {
+constexpr double kTwoPi = 6.28318530717958647692;
+
+std::string fmt(double v) {
+  char buf[40];
+  std::snprintf(buf, sizeof buf, "%.17g", v);
+  return buf;
+}
+
+const ObserverSettings& checked(const ObserverSettings& s) {
+  std::string msg;
+  if (!validate(s, &msg)) throw std::invalid_argument("invalid ObserverSettings:\n" + msg);
+  return s;
+}
+
+inline double clip(double v, double bound) noexcept { return v > bound ? bound : (v < -bound ? -bound : v); }
+}  // namespace
+
+const char* to_string(GainMode m) noexcept {
+  switch (m) {
+    case GainMode::Fixed: return "fixed";
+    case GainMode::Bandwidth: return "bandwidth";
+  }
+  return "unknown";
+}
+
+bool validate(const ObserverSettings& s, std::string* message) {
+  std::string msg;
+  auto bad = [&](const char* name, const std::string& value, const char* rule) {
+    msg += std::string(name) + " = " + value + ": " + rule + "\n";
+  };
+  auto positive = [&](const char* name, double v, const char* unit) {
+    if (!(std::isfinite(v) && v > 0.0)) bad(name, fmt(v), unit);
+  };
+  auto non_negative = [&](const char* name, double v, const char* unit) {
+    if (!(std::isfinite(v) && v >= 0.0)) bad(name, fmt(v), unit);
+  };
+  positive("dt", s.dt, "must be finite and > 0 [s]");
+  if (!(s.integrator == Integrator::Implicit || s.integrator == Integrator::Rk4 ||
+        s.integrator == Integrator::Rk4Adaptive || s.integrator == Integrator::Rosenbrock))
+    bad("integrator", std::to_string(static_cast<int>(s.integrator)), "unknown scheme (implicit, rk4, rk4_adaptive, rosenbrock)");
+  if (!(s.gain_mode == GainMode::Fixed || s.gain_mode == GainMode::Bandwidth))
+    bad("gain_mode", std::to_string(static_cast<int>(s.gain_mode)), "unknown mode (fixed, bandwidth)");
+  positive("gain", s.gain, "must be finite and > 0 [1/(kg m^2)]");
+  positive("bandwidth", s.bandwidth, "must be finite and > 0 [1/s]");
+  positive("gain_min", s.gain_min, "must be finite and > 0 [1/(kg m^2)]");
+  positive("gain_max", s.gain_max, "must be finite and > 0 [1/(kg m^2)]");
+  if (std::isfinite(s.gain_min) && std::isfinite(s.gain_max) && s.gain_min > s.gain_max)
+    bad("gain_max", fmt(s.gain_max), "must be >= gain_min");
+  positive("g_floor", s.g_floor, "must be finite and > 0 [N m]");
+  non_negative("torque_cutoff", s.torque_cutoff, "must be finite and >= 0 [Hz] (0: no filter)");
+  non_negative("cor_sign_sigmas", s.cor_sign_sigmas, "must be finite and >= 0 [-]");
+  if (!(s.max_invalid >= 1)) bad("max_invalid", std::to_string(s.max_invalid), "must be >= 1");
+  if (!(std::isfinite(s.max_dt_gap) && s.max_dt_gap > 0.0 && !(s.max_dt_gap < s.dt)))
+    bad("max_dt_gap", fmt(s.max_dt_gap), "must be finite and >= dt [s]");
+  non_negative("torque_noise", s.torque_noise, "must be finite and >= 0 [N m]");
+  positive("resolution_max", s.resolution_max, "must be finite and > 0 [rad/s]");
+  positive("omega_limit", s.omega_limit, "must be finite and > 0 [rad/s]");
+  if (!(s.substeps >= 1)) bad("substeps", std::to_string(s.substeps), "must be >= 1");
+  if (!(s.max_substeps >= 1)) bad("max_substeps", std::to_string(s.max_substeps), "must be >= 1");
+  if (s.substeps >= 1 && s.max_substeps >= 1 && s.substeps > s.max_substeps)
+    bad("max_substeps", std::to_string(s.max_substeps), "must be >= substeps");
+  std::string cor_msg;
+  if (!validate(s.cor, &cor_msg)) {
+    size_t start = 0;
+    while (start < cor_msg.size()) {
+      const size_t end = cor_msg.find('\n', start);
+      msg += "cor." + cor_msg.substr(start, end == std::string::npos ? std::string::npos : end - start) + "\n";
+      if (end == std::string::npos) break;
+      start = end + 1;
+    }
+  }
+  if (message) *message = msg;
+  return msg.empty();
+}
+
+namespace {
+// Hysteresis band: cor_sign_sigmas standard deviations of white torque noise after the
+// first-order low-pass at the nominal rate (variance ratio alpha / (2 - alpha)).
+double sign_band(const ObserverSettings& s) {
+  const double alpha = s.torque_cutoff > 0.0 ? -std::expm1(-kTwoPi * s.torque_cutoff * s.dt) : 1.0;
+  return s.cor_sign_sigmas * s.torque_noise * std::sqrt(alpha / (2.0 - alpha));
+}
+}  // namespace
+
+Observer::Observer(const ContactParams& params, const ObserverSettings& settings)
+    : cor_(params, checked(settings).cor), s_(settings), sign_band_(sign_band(settings)) {
+  reset();
+}
+
+Observer::Observer(const ContactModel& model, const ObserverSettings& settings)
+    : cor_(model, checked(settings).cor), s_(settings), sign_band_(sign_band(settings)) {
+  reset();
+}
+
+void Observer::reset() noexcept {
+  cor_.reset();
+  z_ = 0.0;
+  omega_ = 0.0;
+  tau_f_ = 0.0;
+  ft_f_ = 0.0;
+  cor_sign_ = 1.0;
+  pending_ = 0.0;
+  invalid_run_ = 0;
+  need_init_ = true;
+  last_ = ObserverOutput();
+}
+
+Status Observer::step(const ObserverInput& in, ObserverOutput& out) noexcept {
+  const CorSettings& cs = s_.cor;
+  const double dt = in.dt == 0.0 ? s_.dt : in.dt;
+  const bool dt_ok = std::isfinite(dt) && dt > 0.0;
+  const bool valid = dt_ok && std::isfinite(in.f_n) && std::isfinite(in.f_t) && std::isfinite(in.tau) &&
+                     std::fabs(in.f_n) <= cs.force_limit && std::fabs(in.f_t) <= cs.force_limit &&
+                     std::fabs(in.tau) <= cs.torque_limit;
+  if (!valid) {
+    // State untouched; the skipped time is integrated with the next valid sample (or, beyond
+    // max_dt_gap, causes a re-initialisation).
+    pending_ = std::min(pending_ + (dt_ok ? dt : s_.dt), 1.0e9);
+    if (invalid_run_ < s_.max_invalid) ++invalid_run_;
+    out = last_;
+    out.substeps = 0;
+    out.cor_iterations = 0;
+    out.diverged = false;
+    out.substeps_capped = false;
+    if (invalid_run_ >= s_.max_invalid) {
+      need_init_ = true;
+      return out.status = Status::SensorFault;
+    }
+    return out.status = Status::InvalidSample;
+  }
+  invalid_run_ = 0;
+  const double h = pending_ + dt;
+  pending_ = 0.0;
+
+  if (!(in.f_n >= cs.f_n_min)) {  // contact lost: forget the state, show it
+    need_init_ = true;
+    ObserverOutput r = last_;
+    r.omega_hat = 0.0;
+    r.z_hat = 0.0;
+    r.S = 0.0;
+    r.y = 0.0;
+    r.projected = r.diverged = r.substeps_capped = false;
+    r.substeps = 0;
+    r.cor_iterations = 0;
+    r.status = Status::NoContact;
+    last_ = r;
+    out = r;
+    return r.status;
+  }
+  if (h > s_.max_dt_gap) need_init_ = true;
+
+  // (1) CoR from the low-pass filtered torque with sign hysteresis; raw torque for y.
+  const bool init = need_init_;
+  if (init) {
+    cor_.reset();
+    tau_f_ = in.tau;
+    ft_f_ = in.f_t;
+    cor_sign_ = in.tau < 0.0 ? -1.0 : 1.0;
+  } else {
+    const double alpha = s_.torque_cutoff > 0.0 ? -std::expm1(-kTwoPi * s_.torque_cutoff * h) : 1.0;
+    tau_f_ += alpha * (in.tau - tau_f_);
+    ft_f_ += alpha * (in.f_t - ft_f_);
+    if (std::fabs(tau_f_) > sign_band_) cor_sign_ = tau_f_ < 0.0 ? -1.0 : 1.0;
+  }
+  const double tau_cor = std::copysign(std::fabs(tau_f_), cor_sign_);
+  CorOutput co;
+  const double ft_cor = s_.filter_force ? ft_f_ : in.f_t;
+  const Status cor_status = cor_.step(CorInput{in.f_n, ft_cor, tau_cor}, co);
+
+  // (2) g, sigma_1, y at this sample.
+  const ContactParams& p = cor_.model().params();
+  RotorCoefficients rc;
+  rc.sigma0 = p.sigma0;
+  rc.sigma_z = p.sigma_z;
+  rc.sigma_1 = co.sigma_1;
+  rc.g = std::max(co.g, s_.g_floor);
+  rc.drive = in.tau - co.c * in.f_t;
+  if (s_.gain_mode == GainMode::Fixed) {
+    rc.gain = s_.gain;
+  } else {
+    const double l = co.sigma_1 > 0.0 ? s_.bandwidth / co.sigma_1 : s_.gain_max;
+    rc.gain = std::min(std::max(l, s_.gain_min), s_.gain_max);
+  }
+  const double bound = rc.g / rc.sigma0;
+
+  // (3)-(4) update and projection, or (re)initialisation.
+  ObserverOutput r;
+  Status status = cor_status;
+  if (init) {
+    z_ = clip(rc.drive / rc.sigma0, bound);
+    omega_ = 0.0;
+    need_init_ = false;
+    status = Status::Reinitialized;
+  } else {
+    double z = z_, w = omega_;
+    r.projected = rotor_advance(z, w, h, rc, s_.integrator, s_.substeps, s_.max_substeps, &r.substeps, &r.substeps_capped);
+    if (std::isfinite(z) && std::isfinite(w) && std::fabs(w) <= s_.omega_limit) {
+      z_ = z;
+      omega_ = w;
+    } else {
+      r.diverged = true;
+      r.projected = false;
+      z_ = clip(rc.drive / rc.sigma0, bound);
+      omega_ = 0.0;
+      status = Status::Reinitialized;
+    }
+  }
+  r.omega_hat = omega_;
+  r.z_hat = z_;
+  r.S = std::min(p.sigma0 * std::fabs(z_) / rc.g, 1.0);
+  r.c_tilde = co.c_tilde;
+  r.c = co.c;
+  r.g = rc.g;
+  r.sigma_1 = co.sigma_1;
+  r.y = rc.drive;
+  r.tau_cor = tau_cor;
+  r.ft_cor = ft_cor;
+  r.gain = rc.gain;
+  r.omega_resolution = co.sigma_1 > 0.0 ? std::min(s_.torque_noise / co.sigma_1, std::numeric_limits<double>::max())
+                                        : (s_.torque_noise > 0.0 ? std::numeric_limits<double>::max() : 0.0);
+  r.speed_observable = r.omega_resolution <= s_.resolution_max;
+  r.inside = co.inside;
+  r.saturated = co.saturated;
+  r.cor_iterations = co.iterations;
+  r.status = status;
+  last_ = r;
+  out = r;
+  return status;
+}
+
+}  // namespace lugrip
