@@ -337,10 +337,10 @@ class GraspPlant {
   // dynamic state
   PlantState st_;
   double f_act_ = 0.0, f_held_ = 0.0, f_cmd_ = 0.0;
-  // slip u of the object point that was at the grasp point, its velocity V (= pad slip velocity),
-  // angle and angular velocity; CoG position r and velocity v derived from them
-  double ux_ = 0.0, uy_ = 0.0, Vx_ = 0.0, Vy_ = 0.0, th_ = 0.0, om_ = 0.0;
-  double rx_ = 0.0, ry_ = 0.0, vx_ = 0.0, vy_ = 0.0;
+  // CoG position r and velocity v relative to the grasp point, angle, angular velocity; slip u of
+  // the object point that was at the grasp point; twist of the last step (V at the pad centre)
+  double rx_ = 0.0, ry_ = 0.0, vx_ = 0.0, vy_ = 0.0, th_ = 0.0, om_ = 0.0;
+  double ux_ = 0.0, uy_ = 0.0, Vx_ = 0.0, Vy_ = 0.0;
   double support_y_ = 0.0;  // world CoG height of the support
   bool supported_ = false;
   double ext_fx_ = 0.0, ext_fy_ = 0.0, ext_tau_ = 0.0;  // set_external
@@ -353,7 +353,6 @@ class GraspPlant {
   void substep_patch(double h, double t0) noexcept;
   void substep_lumped(double h, double t0) noexcept;
   void take_sample() noexcept;
-  void update_cog() noexcept;
   void true_wrench(int finger, double out[4]) const noexcept;
   void update_drop() noexcept;
 };

@@ -1,0 +1,618 @@
+// Planar grasp simulator: object dynamics, actuator, sensors, disturbances, drop detection.
+#include "lugrip/grasp_plant.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <sstream>
+#include <stdexcept>
+#include <string>
+
+#include "lugrip/slider_model.hpp"
+
+namespace lugrip {
+
+namespace {
+constexpr double kPi = 3.14159265358979323846;
+
+bool finite(double x) { return std::isfinite(x); }
+
+// n when x / y is (numerically) the positive integer n, else 0.
+long integer_ratio(double x, double y) {
+  if (!(finite(x) && finite(y) && x > 0.0 && y > 0.0)) return 0;
+  const double r = x / y;
+  const double n = std::round(r);
+  if (n < 1.0 || n > 1e9 || std::fabs(r - n) > 1e-9 * n) return 0;
+  return static_cast<long>(n);
+}
+
+std::string num(double x) {
+  std::ostringstream s;
+  s.precision(17);
+  s << x;
+  return s.str();
+}
+
+const PlantConfig& checked(const PlantConfig& c) {
+  std::string msg;
+  if (!validate(c, &msg)) throw std::invalid_argument("invalid PlantConfig:\n" + msg);
+  return c;
+}
+
+inline double clampd(double x, double lo, double hi) { return x < lo ? lo : (x > hi ? hi : x); }
+}  // namespace
+
+const char* to_string(PlantModel m) noexcept {
+  switch (m) {
+    case PlantModel::Patch: return "patch";
+    case PlantModel::Lumped: return "lumped";
+  }
+  return "unknown";
+}
+
+const char* to_string(PulseShape s) noexcept {
+  switch (s) {
+    case PulseShape::Rectangular: return "rectangular";
+    case PulseShape::HalfSine: return "half_sine";
+    case PulseShape::Ramp: return "ramp";
+    case PulseShape::Triangle: return "triangle";
+  }
+  return "unknown";
+}
+
+bool validate(const PlantConfig& c, std::string* message) {
+  std::string msg, sub;
+  if (!validate(c.contact, &sub)) {
+    std::istringstream lines(sub);
+    for (std::string line; std::getline(lines, line);)
+      if (!line.empty()) msg += "contact." + line + "\n";
+  }
+  auto need = [&](bool ok, const std::string& field, double value, const char* rule) {
+    if (!ok) msg += field + " = " + num(value) + ": " + rule + "\n";
+  };
+  need(c.model == PlantModel::Patch || c.model == PlantModel::Lumped, "model", static_cast<int>(c.model), "unknown model");
+  const ObjectConfig& o = c.object;
+  need(finite(o.mass) && o.mass > 0.0, "object.mass", o.mass, "must be finite and > 0 [kg]");
+  need(finite(o.inertia) && o.inertia > 0.0, "object.inertia", o.inertia, "must be finite and > 0 [kg m^2]");
+  need(finite(o.cog_x), "object.cog_x", o.cog_x, "must be finite [m]");
+  need(finite(o.cog_y), "object.cog_y", o.cog_y, "must be finite [m]");
+  need(finite(o.theta0), "object.theta0", o.theta0, "must be finite [rad]");
+  const ActuatorConfig& a = c.actuator;
+  need(finite(a.f_max) && a.f_max > 0.0, "actuator.f_max", a.f_max, "must be finite and > 0 [N]");
+  need(finite(a.f_init) && a.f_init >= 0.0 && a.f_init <= a.f_max, "actuator.f_init", a.f_init, "must be in [0, f_max] [N]");
+  need(finite(a.time_constant) && a.time_constant >= 0.0, "actuator.time_constant", a.time_constant, "must be finite and >= 0 [s]");
+  need(a.rate_limit > 0.0, "actuator.rate_limit", a.rate_limit, "must be > 0 (inf allowed) [N/s]");
+  need(finite(c.rate) && c.rate > 0.0, "rate", c.rate, "must be finite and > 0 [Hz]");
+  need(integer_ratio(c.rate, a.command_rate) > 0, "actuator.command_rate", a.command_rate,
+       "must divide the plant rate (rate / command_rate a positive integer) [Hz]");
+  const SensorConfig& s = c.sensor;
+  need(integer_ratio(c.rate, s.rate) > 0, "sensor.rate", s.rate,
+       "must divide the plant rate (rate / sensor.rate a positive integer) [Hz]");
+  need(finite(s.force_noise) && s.force_noise >= 0.0, "sensor.force_noise", s.force_noise, "must be finite and >= 0 [N]");
+  need(finite(s.torque_noise) && s.torque_noise >= 0.0, "sensor.torque_noise", s.torque_noise, "must be finite and >= 0 [N m]");
+  need(finite(s.force_resolution) && s.force_resolution >= 0.0, "sensor.force_resolution", s.force_resolution, "must be finite and >= 0 [N]");
+  need(finite(s.torque_resolution) && s.torque_resolution >= 0.0, "sensor.torque_resolution", s.torque_resolution, "must be finite and >= 0 [N m]");
+  need(finite(s.filter_time_constant) && s.filter_time_constant >= 0.0, "sensor.filter_time_constant", s.filter_time_constant, "must be finite and >= 0 [s]");
+  for (int i = 0; i < 2; ++i)
+    for (int j = 0; j < 4; ++j)
+      need(finite(s.bias[i][j]), "sensor.bias[" + std::to_string(i) + "][" + std::to_string(j) + "]", s.bias[i][j], "must be finite");
+  const PatchSettings& p = c.patch;
+  need(p.rings >= 1 && p.rings <= 200, "patch.rings", p.rings, "must be in [1, 200]");
+  need(finite(p.bristle_stiffness) && p.bristle_stiffness > 0.0, "patch.bristle_stiffness", p.bristle_stiffness, "must be finite and > 0 [1/m]");
+  need(finite(p.bristle_damping) && p.bristle_damping >= 0.0, "patch.bristle_damping", p.bristle_damping, "must be finite and >= 0 [s]");
+  need(finite(p.static_ratio) && p.static_ratio >= 1.0, "patch.static_ratio", p.static_ratio, "must be finite and >= 1");
+  need(finite(p.stribeck_velocity) && p.stribeck_velocity > 0.0, "patch.stribeck_velocity", p.stribeck_velocity, "must be finite and > 0 [m/s]");
+  const DropConfig& d = c.drop;
+  need(d.slip_limit > 0.0, "drop.slip_limit", d.slip_limit, "must be > 0 (inf allowed) [m]");
+  need(d.rotation_limit > 0.0, "drop.rotation_limit", d.rotation_limit, "must be > 0 (inf allowed) [rad]");
+  need(finite(d.contact_force_min) && d.contact_force_min >= 0.0, "drop.contact_force_min", d.contact_force_min, "must be finite and >= 0 [N]");
+  need(finite(c.gravity) && c.gravity >= 0.0, "gravity", c.gravity, "must be finite and >= 0 [m/s^2]");
+  need(c.substeps >= 1 && c.substeps <= 1000, "substeps", c.substeps, "must be in [1, 1000]");
+  for (size_t i = 0; i < c.moves.size(); ++i) {
+    const GripperMove& m = c.moves[i];
+    const std::string f = "moves[" + std::to_string(i) + "].";
+    need(finite(m.t_start), f + "t_start", m.t_start, "must be finite [s]");
+    need(finite(m.duration) && m.duration > 0.0, f + "duration", m.duration, "must be finite and > 0 [s]");
+    need(finite(m.dx), f + "dx", m.dx, "must be finite [m]");
+    need(finite(m.dy), f + "dy", m.dy, "must be finite [m]");
+  }
+  for (size_t i = 0; i < c.disturbances.size(); ++i) {
+    const Disturbance& q = c.disturbances[i];
+    const std::string f = "disturbances[" + std::to_string(i) + "].";
+    need(finite(q.t_start), f + "t_start", q.t_start, "must be finite [s]");
+    need(finite(q.duration) && q.duration > 0.0, f + "duration", q.duration, "must be finite and > 0 [s]");
+    const int sh = static_cast<int>(q.shape);
+    need(sh >= 0 && sh <= 3, f + "shape", sh, "unknown pulse shape");
+    need(finite(q.force_x) && finite(q.force_y) && finite(q.torque), f + "force/torque",
+         q.force_x + q.force_y + q.torque, "must be finite");
+    need(finite(q.point_x) && finite(q.point_y), f + "point", q.point_x + q.point_y, "must be finite [m]");
+  }
+  if (message) *message = msg;
+  return msg.empty();
+}
+
+// ---------------------------------------------------------------------------------------------
+
+GraspPlant::GraspPlant(const PlantConfig& config)
+    : cfg_(checked(config)),
+      model_(cfg_.contact),
+      patch_(cfg_.contact, cfg_.patch),
+      cor_(model_) {
+  h_ = 1.0 / cfg_.rate;
+  steps_per_sample_ = static_cast<int>(integer_ratio(cfg_.rate, cfg_.sensor.rate));
+  steps_per_command_ = static_cast<int>(integer_ratio(cfg_.rate, cfg_.actuator.command_rate));
+  reset();
+}
+
+void GraspPlant::gripper_at(double t, double& x, double& y, double& vx, double& vy) const noexcept {
+  x = y = vx = vy = 0.0;
+  for (const GripperMove& m : cfg_.moves) {
+    const double s = (t - m.t_start) / m.duration;
+    double pos, vel;
+    if (s <= 0.0) {
+      pos = vel = 0.0;
+    } else if (s >= 1.0) {
+      pos = 1.0;
+      vel = 0.0;
+    } else {  // minimum jerk: 10 s^3 - 15 s^4 + 6 s^5
+      const double s2 = s * s;
+      pos = s2 * s * (10.0 - 15.0 * s + 6.0 * s2);
+      vel = 30.0 * s2 * (1.0 - 2.0 * s + s2) / m.duration;
+    }
+    x += m.dx * pos;
+    y += m.dy * pos;
+    vx += m.dx * vel;
+    vy += m.dy * vel;
+  }
+}
+
+void GraspPlant::disturbance_at(double t, double theta, double& fx, double& fy, double& tau) const noexcept {
+  fx = fy = tau = 0.0;
+  const double c = std::cos(theta), s = std::sin(theta);
+  for (const Disturbance& d : cfg_.disturbances) {
+    const double u = (t - d.t_start) / d.duration;
+    if (!(u >= 0.0 && u < 1.0)) continue;
+    double a = 0.0;
+    switch (d.shape) {
+      case PulseShape::Rectangular: a = 1.0; break;
+      case PulseShape::HalfSine: a = std::sin(kPi * u); break;
+      case PulseShape::Ramp: a = u; break;
+      case PulseShape::Triangle: a = 1.0 - std::fabs(2.0 * u - 1.0); break;
+    }
+    const double px = c * d.point_x - s * d.point_y, py = s * d.point_x + c * d.point_y;
+    const double qx = a * d.force_x, qy = a * d.force_y;
+    fx += qx;
+    fy += qy;
+    tau += a * d.torque + px * qy - py * qx;
+  }
+}
+
+void GraspPlant::reset() noexcept {
+  const ObjectConfig& o = cfg_.object;
+  th_ = o.theta0;
+  rx_ = std::cos(th_) * o.cog_x - std::sin(th_) * o.cog_y;
+  ry_ = std::sin(th_) * o.cog_x + std::cos(th_) * o.cog_y;
+  ux_ = uy_ = Vx_ = Vy_ = 0.0;
+  vx_ = vy_ = om_ = 0.0;
+  f_act_ = f_held_ = f_cmd_ = cfg_.actuator.f_init;
+  double gx, gy, gvx, gvy;
+  gripper_at(0.0, gx, gy, gvx, gvy);
+  support_y_ = gy + ry_;
+  supported_ = cfg_.support;
+  ext_fx_ = ext_fy_ = ext_tau_ = 0.0;
+  pad_ = PadWrench();
+  lumped_z_ = lumped_c_ = lumped_slip_ = 0.0;
+  patch_.reset();
+  cor_.reset();
+  for (int i = 0; i < 2; ++i) rng_[i].seed_with(cfg_.seed * 0x9E3779B97F4A7C15ULL + static_cast<uint64_t>(i + 1));
+  st_ = PlantState();
+  st_.f_cmd = f_cmd_;
+  st_.f_held = f_held_;
+  st_.f_n = f_act_;
+  st_.gripper_x = gx;
+  st_.gripper_y = gy;
+  st_.gripper_vx = gvx;
+  st_.gripper_vy = gvy;
+  st_.x = rx_;
+  st_.y = ry_;
+  st_.theta = th_;
+  st_.supported = supported_;
+  for (int i = 0; i < 2; ++i) {
+    double w[4];
+    true_wrench(i, w);
+    for (int j = 0; j < 4; ++j) filt_[i][j] = w[j];
+  }
+  update_drop();
+  take_sample();
+}
+
+void GraspPlant::set_command(double f_cmd) noexcept {
+  if (std::isnan(f_cmd)) return;
+  f_cmd_ = clampd(f_cmd, 0.0, cfg_.actuator.f_max);
+  st_.f_cmd = f_cmd_;
+}
+
+void GraspPlant::set_external(double fx, double fy, double torque) noexcept {
+  ext_fx_ = finite(fx) ? fx : 0.0;
+  ext_fy_ = finite(fy) ? fy : 0.0;
+  ext_tau_ = finite(torque) ? torque : 0.0;
+}
+
+bool GraspPlant::step() noexcept {
+  const int64_t n = st_.steps;
+  const double t0 = static_cast<double>(n) * h_;
+  // Actuator: ZOH of the command at the command ticks, saturation, first-order lag, rate limit.
+  if (n % steps_per_command_ == 0) f_held_ = f_cmd_;
+  const ActuatorConfig& a = cfg_.actuator;
+  const double target = clampd(f_held_, 0.0, a.f_max);
+  double f = a.time_constant > 0.0 ? target + (f_act_ - target) * std::exp(-h_ / a.time_constant) : target;
+  const double dmax = a.rate_limit * h_;
+  f = clampd(f, f_act_ - dmax, f_act_ + dmax);
+  f_act_ = clampd(f, 0.0, a.f_max);
+
+  const int ns = cfg_.substeps;
+  const double hs = h_ / ns;
+  for (int k = 0; k < ns; ++k) {
+    const double ts = t0 + k * hs;
+    if (cfg_.model == PlantModel::Patch) substep_patch(hs, ts);
+    else substep_lumped(hs, ts);
+  }
+
+  st_.steps = n + 1;
+  st_.t = static_cast<double>(n + 1) * h_;
+  // Sensor anti-alias low-pass (continuous-time first order, exact for a held input).
+  const double tf = cfg_.sensor.filter_time_constant;
+  const double alpha = tf > 0.0 ? -std::expm1(-h_ / tf) : 1.0;
+  for (int i = 0; i < 2; ++i) {
+    double w[4];
+    true_wrench(i, w);
+    for (int j = 0; j < 4; ++j) filt_[i][j] += alpha * (w[j] - filt_[i][j]);
+  }
+  // State report.
+  double gx, gy, gvx, gvy;
+  gripper_at(st_.t, gx, gy, gvx, gvy);
+  st_.f_cmd = f_cmd_;
+  st_.f_held = f_held_;
+  st_.f_n = f_act_;
+  st_.gripper_x = gx;
+  st_.gripper_y = gy;
+  st_.gripper_vx = gvx;
+  st_.gripper_vy = gvy;
+  st_.x = rx_;
+  st_.y = ry_;
+  st_.vx = vx_;
+  st_.vy = vy_;
+  st_.theta = th_;
+  st_.omega = om_;
+  st_.contact_fx = 2.0 * pad_.fx;
+  st_.contact_fy = 2.0 * pad_.fy;
+  // pad wrench is about the pad centre = grasp point
+  st_.contact_tau = 2.0 * pad_.tau;
+  st_.supported = supported_;
+  update_drop();
+  if ((n + 1) % steps_per_sample_ == 0) {
+    take_sample();
+    return true;
+  }
+  return false;
+}
+
+int64_t GraspPlant::advance_sample() noexcept {
+  while (!step()) {
+  }
+  return sample_[0].index;
+}
+
+namespace {
+// Rigid motion of a point p of the object over h under the constant twist (V at the pad centre,
+// omega): p' = R(h omega) p + h (S V + C z x V), S = sin(d)/d, C = (1 - cos d)/d, d = h omega
+// (exact; the exponential map of the twist).
+inline void twist_map(double& px, double& py, double Vx, double Vy, double omega, double h) noexcept {
+  const double d = h * omega;
+  const double cd = std::cos(d), sd = std::sin(d);
+  double S, C;
+  if (std::fabs(d) < 1e-4) {
+    S = 1.0 - d * d / 6.0;
+    C = 0.5 * d;
+  } else {
+    S = sd / d;
+    C = (1.0 - cd) / d;
+  }
+  const double nx = cd * px - sd * py + h * (S * Vx - C * Vy);
+  const double ny = sd * px + cd * py + h * (S * Vy + C * Vx);
+  px = nx;
+  py = ny;
+}
+}  // namespace
+
+// One implicit step of the 3-DOF object on the two pads (MODEL.md 10.1 (b)).
+// State: CoG velocity v and omega (momentum), slip u of the object point that was at the pad
+// centre, angle theta; the CoG is at r = u + R(theta) cog. Unknowns q' = (V', omega'), the twist of
+// the object relative to the gripper (V' = velocity of the object point at the pad centre, i.e. the
+// slip velocity the pads see), with v' = V' + omega' z x r~, r~ the CoG at the end of the step
+// predicted with the previous twist. About the pad centre the system is (M_O(r~)/h + D) q' = rhs
+// with the rigid-body mass matrix M_O and the SPD damping D of the linearised pads: SPD for any
+// state. Momentum is integrated exactly (v' = v + h F / m) and the configuration by the exact
+// rigid motion of the twist, so the slip u is exactly what the pads integrated.
+void GraspPlant::substep_patch(double h, double t0) noexcept {
+  const double t1 = t0 + h;
+  const ObjectConfig& o = cfg_.object;
+  const double m = o.mass, I = o.inertia, g = cfg_.gravity;
+  double gx0, gy0, gvx0, gvy0, gx1, gy1, gvx1, gvy1;
+  gripper_at(t0, gx0, gy0, gvx0, gvy0);
+  gripper_at(t1, gx1, gy1, gvx1, gvy1);
+  const double agx = (gvx1 - gvx0) / h, agy = (gvy1 - gvy0) / h;  // exact velocity increment
+  double efx, efy, etau;
+  disturbance_at(t1, th_, efx, efy, etau);
+  efx += ext_fx_;
+  efy += ext_fy_;
+  etau += ext_tau_;
+  st_.ext_fx = efx;
+  st_.ext_fy = efy;
+  st_.ext_tau = etau;
+
+  PatchContact::Linear L;
+  patch_.prepare(f_act_, Vx_, Vy_, om_, h, L);
+  // Both pads (symmetric): twice one pad. Affine in q' = (V', omega'):
+  //   F = A_F - B0 V' - omega' z x B1,   tau_O = A_tau - B1 x V' - omega' B2   (about the pad centre)
+  const double B0 = 2.0 * L.b0, B1x = 2.0 * L.b1x, B1y = 2.0 * L.b1y, B2 = 2.0 * L.b2;
+  const double AFx = 2.0 * L.a_fx, AFy = 2.0 * L.a_fy, AT = 2.0 * L.a_tau;
+
+  double nVx, nVy, nom;
+  bool free_motion = true;
+  if (supported_) {
+    // At rest in the world: V' = -v_gripper, omega' = 0. Lift off when the contacts pull up more
+    // than gravity and the disturbance push down.
+    nVx = -gvx1;
+    nVy = -gvy1;
+    nom = 0.0;
+    const double Fy = AFy - B0 * nVy;
+    if (Fy - m * g + efy > 0.0) {
+      supported_ = false;
+    } else {
+      free_motion = false;
+    }
+  }
+  if (free_motion) {
+    double qx = rx_, qy = ry_;  // r~
+    twist_map(qx, qy, Vx_, Vy_, om_, h);
+    // force:  a V' + b omega' = p,   p = m v/h + A_F + m (g - a_g) + F_ext
+    // moment about the pad centre: b.V' + c omega' = s
+    const double a = m / h + B0;
+    const double b1 = -m / h * qy - B1y, b2 = m / h * qx + B1x;
+    const double c = (I + m * (qx * qx + qy * qy)) / h + B2;
+    const double lx = m * vx_ / h - m * agx + efx, ly = m * vy_ / h - m * (g + agy) + efy;
+    const double p1 = lx + AFx, p2 = ly + AFy;
+    const double s3 = I * om_ / h + AT + etau + (qx * ly - qy * lx);
+    const double S = c - (b1 * b1 + b2 * b2) / a;  // > 0 (SPD)
+    nom = (s3 - (b1 * p1 + b2 * p2) / a) / S;
+    nVx = (p1 - b1 * nom) / a;
+    nVy = (p2 - b2 * nom) / a;
+    if (!(finite(nom) && finite(nVx) && finite(nVy))) {  // only on overflow of absurd inputs
+      nom = 0.0;
+      nVx = -gvx1;
+      nVy = -gvy1;
+    }
+    vx_ = nVx - nom * qy;
+    vy_ = nVy + nom * qx;
+  } else {
+    vx_ = nVx;
+    vy_ = nVy;
+  }
+  patch_.finish(nVx, nVy, nom, pad_);
+  Vx_ = nVx;
+  Vy_ = nVy;
+  om_ = nom;
+  twist_map(ux_, uy_, nVx, nVy, nom, h);
+  th_ += h * nom;
+  const double cth = std::cos(th_), sth = std::sin(th_);
+  rx_ = ux_ + cth * o.cog_x - sth * o.cog_y;
+  ry_ = uy_ + sth * o.cog_x + cth * o.cog_y;
+  // Landing on the support (inelastic).
+  if (cfg_.support && !supported_ && gy1 + ry_ < support_y_ && gvy1 + vy_ < 0.0) {
+    supported_ = true;
+    uy_ += support_y_ - (gy1 + ry_);
+    ry_ = support_y_ - gy1;
+    vx_ = Vx_ = -gvx1;
+    vy_ = Vy_ = -gvy1;
+    om_ = 0.0;
+  }
+}
+
+// One step of the lumped slider (eqs. 1-2) about the CoR of the current quasi-static load.
+void GraspPlant::substep_lumped(double h, double t0) noexcept {
+  const double t1 = t0 + h;
+  const ObjectConfig& o = cfg_.object;
+  const double m = o.mass, g = cfg_.gravity;
+  double gx0, gy0, gvx0, gvy0, gx1, gy1, gvx1, gvy1;
+  gripper_at(t0, gx0, gy0, gvx0, gvy0);
+  gripper_at(t1, gx1, gy1, gvx1, gvy1);
+  const double agx = (gvx1 - gvx0) / h, agy = (gvy1 - gvy0) / h;
+  double efx, efy, etau;
+  disturbance_at(t1, th_, efx, efy, etau);
+  efx += ext_fx_;
+  efy += ext_fy_;
+  etau += ext_tau_;
+  st_.ext_fx = efx;
+  st_.ext_fy = efy;
+  st_.ext_tau = etau;
+
+  // No translation: the object point at the grasp point stays there, r = R(theta) cog.
+  const double c = std::cos(th_), s = std::sin(th_);
+  const double rx = c * o.cog_x - s * o.cog_y, ry = s * o.cog_x + c * o.cog_y;
+  const double I_O = o.inertia + m * (rx * rx + ry * ry);
+  // Load on the object other than friction (gravity, gripper acceleration, pushes).
+  const double Lx = -m * agx + efx, Ly = -m * (g + agy) + efy;
+  const double tauL = etau + rx * Ly - ry * Lx;  // about the grasp point
+
+  if (supported_) {
+    const bool lifting = gvy1 > 0.0 || gy1 > support_y_ - ry;
+    if (!lifting) {
+      om_ = 0.0;
+      lumped_z_ = 0.0;
+      pad_ = PadWrench();
+      Vx_ = -gvx1;
+      Vy_ = -gvy1;
+      rx_ = rx;
+      ry_ = ry;
+      vx_ = -gvx1;
+      vy_ = -gvy1;
+      return;
+    }
+    supported_ = false;
+  }
+
+  // Per finger: friction force balances half the load (no translation); its torque is the state.
+  const double Ffx = -0.5 * Lx, Ffy = -0.5 * Ly;
+  const double f_t = std::sqrt(Ffx * Ffx + Ffy * Ffy);
+  const double f_n = f_act_;
+  double tau_o;  // friction torque on the object about the grasp point, per finger
+  double c_cor = 0.0;
+  if (f_n > 1e-9) {
+    // CoR of the quasi-static friction wrench (f_t, -tau_L/2) in the slider frame (y along f_t).
+    CorOutput co;
+    cor_.step(CorInput{f_n, f_t, -0.5 * tauL}, co);
+    const double ct = co.c_tilde;
+    const double rho = model_.rho(f_n);
+    c_cor = ct * rho;
+    RotorCoefficients rc;
+    rc.sigma0 = cfg_.contact.sigma0;
+    rc.sigma_z = cfg_.contact.sigma_z;
+    rc.sigma_1 = model_.sigma_1(f_n, ct);
+    rc.g = std::max(model_.g(f_n, ct), 1e-12);
+    rc.gain = 2.0 / I_O;
+    rc.drive = 0.5 * tauL + c_cor * f_t;
+    double z = lumped_z_, w = om_;
+    rotor_advance(z, w, h, rc, Integrator::Implicit, 1, 1, nullptr, nullptr);
+    lumped_z_ = z;
+    om_ = w;
+    const double zdot = lugre_zdot(z, w, rc.sigma0, rc.g);
+    const double y = rc.sigma0 * z + rc.sigma_z * zdot + rc.sigma_1 * w;  // about the CoR
+    tau_o = -y + c_cor * f_t;
+  } else {  // no contact: free rotation about the grasp point
+    lumped_z_ = 0.0;
+    om_ += h * tauL / I_O;
+    tau_o = 0.0;
+  }
+  lumped_c_ = c_cor;
+  th_ += h * om_;
+  // Implied velocity of the object point at the pad centre for a rotation about the CoR:
+  // V = omega z x (0 - p_C), p_C = c x_hat, x_hat = y_hat x z (y_hat along the friction force).
+  double yhx = 0.0, yhy = 0.0;
+  if (f_t > 0.0) {
+    yhx = Ffx / f_t;
+    yhy = Ffy / f_t;
+  }
+  // x_hat = (yhy, -yhx); z x p_C = c (yhx, yhy)  ->  V = -omega c y_hat
+  Vx_ = -om_ * c_cor * yhx;
+  Vy_ = -om_ * c_cor * yhy;
+  lumped_slip_ += h * std::fabs(om_ * c_cor);
+  const double c1 = std::cos(th_), s1 = std::sin(th_);
+  rx_ = c1 * o.cog_x - s1 * o.cog_y;
+  ry_ = s1 * o.cog_x + c1 * o.cog_y;
+  vx_ = -om_ * ry_;  // CoG velocity relative to the gripper (rotation about the grasp point)
+  vy_ = om_ * rx_;
+  if (f_n > 1e-9) {
+    pad_.fx = Ffx;
+    pad_.fy = Ffy;
+    pad_.tau = tau_o;
+  } else {
+    pad_ = PadWrench();
+  }
+}
+
+// Wrench object -> fingertip i in its sensor frame: (f_n, f_x, f_y, tau).
+void GraspPlant::true_wrench(int finger, double out[4]) const noexcept {
+  out[0] = f_act_;
+  if (finger == 0) {
+    out[1] = -pad_.fx;
+    out[2] = -pad_.fy;
+    out[3] = -pad_.tau;
+  } else {
+    out[1] = pad_.fx;
+    out[2] = -pad_.fy;
+    out[3] = pad_.tau;
+  }
+}
+
+void GraspPlant::take_sample() noexcept {
+  const int64_t index = st_.steps / steps_per_sample_;
+  const SensorConfig& sc = cfg_.sensor;
+  const ObjectConfig& o = cfg_.object;
+  // displacement of the object point that was at the grasp point: u = r - R(theta) cog
+  const double ux = ux_, uy = uy_;  // zero for the lumped plant
+  const double rho = f_act_ > 0.0 ? model_.rho(f_act_) : 0.0;
+  // |CoR - pad centre| / rho of the relative motion
+  const double vnorm = std::hypot(Vx_, Vy_);
+  double a;
+  if (rho <= 0.0 || (vnorm == 0.0 && om_ == 0.0)) a = 0.0;
+  else if (vnorm >= 1e3 * rho * std::fabs(om_)) a = 1e3;
+  else a = vnorm / (rho * std::fabs(om_));
+  if (cfg_.model == PlantModel::Lumped) a = rho > 0.0 ? std::min(std::fabs(lumped_c_) / rho, 1e3) : 0.0;
+  for (int i = 0; i < 2; ++i) {
+    FingerSample& f = sample_[i];
+    const double sgn = i == 0 ? 1.0 : -1.0;  // x_i and z_i flip for finger 1
+    double w[4];
+    true_wrench(i, w);
+    f.index = index;
+    f.t = st_.t;
+    f.true_f_n = w[0];
+    f.true_f_x = w[1];
+    f.true_f_y = w[2];
+    f.true_tau = w[3];
+    double meas[4];
+    for (int j = 0; j < 4; ++j) {
+      const double sd = j == 3 ? sc.torque_noise : sc.force_noise;
+      const double q = j == 3 ? sc.torque_resolution : sc.force_resolution;
+      double v = filt_[i][j] + sc.bias[i][j] + sd * rng_[i].normal();
+      if (q > 0.0) v = q * std::round(v / q);
+      meas[j] = v;
+    }
+    f.f_n = meas[0];
+    f.f_x = meas[1];
+    f.f_y = meas[2];
+    f.tau = meas[3];
+    f.slip_x = sgn * ux;
+    f.slip_y = uy;
+    f.slip_angle = sgn * (th_ - o.theta0);
+    f.slip_vx = sgn * Vx_;
+    f.slip_vy = Vy_;
+    f.omega = sgn * om_;
+    const double wi = sgn * om_;
+    f.c_tilde = wi > 0.0 ? -a : a;
+    f.rho = rho;
+  }
+}
+
+void GraspPlant::update_drop() noexcept {
+  const ObjectConfig& o = cfg_.object;
+  st_.slip_x = ux_;
+  st_.slip_y = uy_;
+  const double slip = cfg_.model == PlantModel::Patch ? std::hypot(ux_, uy_) : lumped_slip_;
+  st_.slip_angle = th_ - o.theta0;
+  st_.max_slip = std::max(st_.max_slip, slip);
+  st_.max_rotation = std::max(st_.max_rotation, std::fabs(st_.slip_angle));
+  int reason = 0;
+  if (slip > cfg_.drop.slip_limit) reason |= 1;
+  if (std::fabs(st_.slip_angle) > cfg_.drop.rotation_limit) reason |= 2;
+  if (f_act_ < cfg_.drop.contact_force_min && !supported_) reason |= 4;
+  if (reason) {
+    if (!st_.dropped) st_.drop_time = st_.t;
+    st_.dropped = true;
+    st_.drop_reason |= reason;
+  }
+}
+
+double GraspPlant::energy() const noexcept {
+  const ObjectConfig& o = cfg_.object;
+  double gx, gy, gvx, gvy;
+  gripper_at(st_.t, gx, gy, gvx, gvy);
+  const double wx = gvx + vx_, wy = gvy + vy_;
+  const double kin = 0.5 * o.mass * (wx * wx + wy * wy) + 0.5 * o.inertia * om_ * om_;
+  const double pot = o.mass * cfg_.gravity * (gy + ry_);
+  const double el = cfg_.model == PlantModel::Patch ? 2.0 * patch_.bristle_energy()
+                                                     : cfg_.contact.sigma0 * lumped_z_ * lumped_z_;
+  return kin + pot + el;
+}
+
+}  // namespace lugrip
