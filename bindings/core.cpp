@@ -400,4 +400,251 @@ NB_MODULE(_core, m) {
         return d;
       }, "f_t"_a, "tau"_a, "s_ref"_a, "Static grasp force per load; dict of arrays.");
   // --- end of controller block ---------------------------------------------------------------
+  // --- plant ---------------------------------------------------------------------------------
+  // Grasp simulator (include/lugrip/grasp_plant.hpp): config structs, PatchContact, GraspPlant
+  // with a batch run() that loops in C++ (GIL released) and returns a dict of arrays.
+  {
+    nb::enum_<PlantModel>(m, "PlantModel", "Contact model of the grasp plant.")
+        .value("Patch", PlantModel::Patch)
+        .value("Lumped", PlantModel::Lumped);
+    nb::enum_<PulseShape>(m, "PulseShape", "Time profile of a disturbance pulse.")
+        .value("Rectangular", PulseShape::Rectangular)
+        .value("HalfSine", PulseShape::HalfSine)
+        .value("Ramp", PulseShape::Ramp)
+        .value("Triangle", PulseShape::Triangle);
+
+    nb::class_<ObjectConfig>(m, "ObjectConfig")
+        .def(nb::init<>())
+        .def_rw("mass", &ObjectConfig::mass)
+        .def_rw("inertia", &ObjectConfig::inertia)
+        .def_rw("cog_x", &ObjectConfig::cog_x)
+        .def_rw("cog_y", &ObjectConfig::cog_y)
+        .def_rw("theta0", &ObjectConfig::theta0);
+    nb::class_<GripperMove>(m, "GripperMove")
+        .def(nb::init<>())
+        .def_rw("t_start", &GripperMove::t_start)
+        .def_rw("duration", &GripperMove::duration)
+        .def_rw("dx", &GripperMove::dx)
+        .def_rw("dy", &GripperMove::dy);
+    nb::class_<Disturbance>(m, "Disturbance")
+        .def(nb::init<>())
+        .def_rw("t_start", &Disturbance::t_start)
+        .def_rw("duration", &Disturbance::duration)
+        .def_rw("shape", &Disturbance::shape)
+        .def_rw("force_x", &Disturbance::force_x)
+        .def_rw("force_y", &Disturbance::force_y)
+        .def_rw("torque", &Disturbance::torque)
+        .def_rw("point_x", &Disturbance::point_x)
+        .def_rw("point_y", &Disturbance::point_y);
+    nb::class_<ActuatorConfig>(m, "ActuatorConfig")
+        .def(nb::init<>())
+        .def_rw("f_init", &ActuatorConfig::f_init)
+        .def_rw("f_max", &ActuatorConfig::f_max)
+        .def_rw("time_constant", &ActuatorConfig::time_constant)
+        .def_rw("rate_limit", &ActuatorConfig::rate_limit)
+        .def_rw("command_rate", &ActuatorConfig::command_rate);
+    nb::class_<SensorConfig>(m, "SensorConfig")
+        .def(nb::init<>())
+        .def_rw("rate", &SensorConfig::rate)
+        .def_rw("force_noise", &SensorConfig::force_noise)
+        .def_rw("torque_noise", &SensorConfig::torque_noise)
+        .def_rw("force_resolution", &SensorConfig::force_resolution)
+        .def_rw("torque_resolution", &SensorConfig::torque_resolution)
+        .def_rw("filter_time_constant", &SensorConfig::filter_time_constant)
+        .def("get_bias", [](const SensorConfig& s, int finger, int channel) {
+          if (finger < 0 || finger > 1 || channel < 0 || channel > 3) throw std::out_of_range("finger 0..1, channel 0..3");
+          return s.bias[finger][channel];
+        }, "finger"_a, "channel"_a)
+        .def("set_bias", [](SensorConfig& s, int finger, int channel, double v) {
+          if (finger < 0 || finger > 1 || channel < 0 || channel > 3) throw std::out_of_range("finger 0..1, channel 0..3");
+          s.bias[finger][channel] = v;
+        }, "finger"_a, "channel"_a, "value"_a, "Bias of (f_n, f_x, f_y, tau)[channel] of a finger.");
+    nb::class_<PatchSettings>(m, "PatchSettings")
+        .def(nb::init<>())
+        .def_rw("rings", &PatchSettings::rings)
+        .def_rw("bristle_stiffness", &PatchSettings::bristle_stiffness)
+        .def_rw("bristle_damping", &PatchSettings::bristle_damping)
+        .def_rw("static_ratio", &PatchSettings::static_ratio)
+        .def_rw("stribeck_velocity", &PatchSettings::stribeck_velocity);
+    nb::class_<DropConfig>(m, "DropConfig")
+        .def(nb::init<>())
+        .def_rw("slip_limit", &DropConfig::slip_limit)
+        .def_rw("rotation_limit", &DropConfig::rotation_limit)
+        .def_rw("contact_force_min", &DropConfig::contact_force_min);
+    nb::class_<PlantConfig>(m, "PlantConfig")
+        .def(nb::init<>())
+        .def_rw("contact", &PlantConfig::contact)
+        .def_rw("model", &PlantConfig::model)
+        .def_rw("object", &PlantConfig::object)
+        .def_rw("actuator", &PlantConfig::actuator)
+        .def_rw("sensor", &PlantConfig::sensor)
+        .def_rw("patch", &PlantConfig::patch)
+        .def_rw("drop", &PlantConfig::drop)
+        .def_rw("gravity", &PlantConfig::gravity)
+        .def_rw("rate", &PlantConfig::rate)
+        .def_rw("substeps", &PlantConfig::substeps)
+        .def_rw("support", &PlantConfig::support)
+        .def_rw("seed", &PlantConfig::seed)
+        .def("clear_moves", [](PlantConfig& c) { c.moves.clear(); })
+        .def("add_move", [](PlantConfig& c, const GripperMove& v) { c.moves.push_back(v); })
+        .def("clear_disturbances", [](PlantConfig& c) { c.disturbances.clear(); })
+        .def("add_disturbance", [](PlantConfig& c, const Disturbance& v) { c.disturbances.push_back(v); })
+        .def_prop_ro("n_moves", [](const PlantConfig& c) { return c.moves.size(); })
+        .def_prop_ro("n_disturbances", [](const PlantConfig& c) { return c.disturbances.size(); });
+    m.def("validate_plant_config", [](const PlantConfig& c) {
+      std::string msg;
+      validate(c, &msg);
+      return msg;
+    }, "Empty string when valid, else one line per bad field.");
+
+    nb::class_<FingerSample>(m, "FingerSample")
+        .def(nb::init<>())
+        .def_ro("index", &FingerSample::index)
+        .def_ro("t", &FingerSample::t)
+        .def_ro("f_n", &FingerSample::f_n)
+        .def_ro("f_x", &FingerSample::f_x)
+        .def_ro("f_y", &FingerSample::f_y)
+        .def_ro("tau", &FingerSample::tau)
+        .def_ro("true_f_n", &FingerSample::true_f_n)
+        .def_ro("true_f_x", &FingerSample::true_f_x)
+        .def_ro("true_f_y", &FingerSample::true_f_y)
+        .def_ro("true_tau", &FingerSample::true_tau)
+        .def_ro("slip_x", &FingerSample::slip_x)
+        .def_ro("slip_y", &FingerSample::slip_y)
+        .def_ro("slip_angle", &FingerSample::slip_angle)
+        .def_ro("slip_vx", &FingerSample::slip_vx)
+        .def_ro("slip_vy", &FingerSample::slip_vy)
+        .def_ro("omega", &FingerSample::omega)
+        .def_ro("c_tilde", &FingerSample::c_tilde)
+        .def_ro("rho", &FingerSample::rho);
+    nb::class_<PlantState>(m, "PlantState")
+        .def(nb::init<>())
+        .def_ro("t", &PlantState::t)
+        .def_ro("f_cmd", &PlantState::f_cmd)
+        .def_ro("f_held", &PlantState::f_held)
+        .def_ro("f_n", &PlantState::f_n)
+        .def_ro("gripper_x", &PlantState::gripper_x)
+        .def_ro("gripper_y", &PlantState::gripper_y)
+        .def_ro("gripper_vx", &PlantState::gripper_vx)
+        .def_ro("gripper_vy", &PlantState::gripper_vy)
+        .def_ro("x", &PlantState::x)
+        .def_ro("y", &PlantState::y)
+        .def_ro("vx", &PlantState::vx)
+        .def_ro("vy", &PlantState::vy)
+        .def_ro("theta", &PlantState::theta)
+        .def_ro("omega", &PlantState::omega)
+        .def_ro("slip_x", &PlantState::slip_x)
+        .def_ro("slip_y", &PlantState::slip_y)
+        .def_ro("slip_angle", &PlantState::slip_angle)
+        .def_ro("max_slip", &PlantState::max_slip)
+        .def_ro("max_rotation", &PlantState::max_rotation)
+        .def_ro("contact_fx", &PlantState::contact_fx)
+        .def_ro("contact_fy", &PlantState::contact_fy)
+        .def_ro("contact_tau", &PlantState::contact_tau)
+        .def_ro("ext_fx", &PlantState::ext_fx)
+        .def_ro("ext_fy", &PlantState::ext_fy)
+        .def_ro("ext_tau", &PlantState::ext_tau)
+        .def_ro("supported", &PlantState::supported)
+        .def_ro("dropped", &PlantState::dropped)
+        .def_ro("drop_time", &PlantState::drop_time)
+        .def_ro("drop_reason", &PlantState::drop_reason)
+        .def_ro("steps", &PlantState::steps);
+
+    nb::class_<PatchContact>(m, "PatchContact")
+        .def(nb::init<const ContactParams&, const PatchSettings&>(), "params"_a, "settings"_a = PatchSettings())
+        .def_prop_ro("cells", &PatchContact::cells)
+        .def_prop_ro("rho", &PatchContact::rho)
+        .def_prop_ro("moment2", &PatchContact::moment2)
+        .def_prop_ro("bristle_energy", &PatchContact::bristle_energy)
+        .def("reset", &PatchContact::reset)
+        .def("advance", [](PatchContact& pc, double f_n, double vx, double vy, double omega, double h, int steps) {
+          PadWrench w;
+          for (int i = 0; i < steps; ++i) pc.advance(f_n, vx, vy, omega, h, w);
+          return nb::make_tuple(w.fx, w.fy, w.tau);
+        }, "f_n"_a, "vx"_a, "vy"_a, "omega"_a, "h"_a, "steps"_a = 1,
+           "Prescribed kinematics for `steps` steps of h; wrench of the pad on the object (fx, fy, tau).");
+
+    nb::class_<GraspPlant>(m, "GraspPlant")
+        .def(nb::init<const PlantConfig&>(), "config"_a)
+        .def("reset", &GraspPlant::reset)
+        .def("set_command", &GraspPlant::set_command, "f_cmd"_a)
+        .def("set_external", &GraspPlant::set_external, "fx"_a, "fy"_a, "torque"_a)
+        .def("step", &GraspPlant::step)
+        .def("advance_sample", &GraspPlant::advance_sample)
+        .def("sensor_sample", [](const GraspPlant& p, int finger) {
+          if (finger < 0 || finger > 1) throw std::out_of_range("finger must be 0 or 1");
+          return p.sensor_sample(finger);
+        }, "finger"_a)
+        .def_prop_ro("state", [](const GraspPlant& p) { return p.state(); })
+        .def_prop_ro("config", [](const GraspPlant& p) { return p.config(); })
+        .def_prop_ro("time", &GraspPlant::time)
+        .def_prop_ro("dt", &GraspPlant::dt)
+        .def_prop_ro("steps_per_sample", &GraspPlant::steps_per_sample)
+        .def_prop_ro("steps_per_command", &GraspPlant::steps_per_command)
+        .def_prop_ro("cells", &GraspPlant::cells)
+        .def_prop_ro("energy", &GraspPlant::energy)
+        .def("gripper_at", [](const GraspPlant& p, double t) {
+          double x, y, vx, vy;
+          p.gripper_at(t, x, y, vx, vy);
+          return nb::make_tuple(x, y, vx, vy);
+        }, "t"_a)
+        .def("disturbance_at", [](const GraspPlant& p, double t, double theta) {
+          double fx, fy, tz;
+          p.disturbance_at(t, theta, fx, fy, tz);
+          return nb::make_tuple(fx, fy, tz);
+        }, "t"_a, "theta"_a)
+        .def("run", [](GraspPlant& p, const In1& command) {
+          // Row k: set_command(command[k]) at the current sample, advance to the next sample,
+          // record it. NaN commands leave the command unchanged.
+          const size_t n = command.shape(0);
+          const char* fin[] = {"f_n", "f_x", "f_y", "tau", "true_f_n", "true_f_x", "true_f_y", "true_tau",
+                               "slip_x", "slip_y", "slip_angle", "slip_vx", "slip_vy", "omega", "c_tilde", "rho"};
+          constexpr int nf = 16;
+          const char* pl[] = {"t", "f_cmd", "f_held", "f_act", "gripper_x", "gripper_y", "gripper_vy", "x", "y",
+                              "vx", "vy", "theta", "object_omega", "max_slip", "max_rotation", "contact_fx",
+                              "contact_fy", "contact_tau", "ext_fx", "ext_fy", "ext_tau", "energy"};
+          constexpr int np = 22;
+          std::vector<Out1<double>> fa, pa;
+          for (int j = 0; j < 2 * nf; ++j) fa.push_back(new_array<double>(n));
+          for (int j = 0; j < np; ++j) pa.push_back(new_array<double>(n));
+          auto sup = new_array<bool>(n), drop = new_array<bool>(n);
+          std::vector<double*> fp(2 * nf), pp(np);
+          for (int j = 0; j < 2 * nf; ++j) fp[j] = fa[j].data();
+          for (int j = 0; j < np; ++j) pp[j] = pa[j].data();
+          const double* cmd = command.data();
+          {
+            nb::gil_scoped_release release;
+            for (size_t k = 0; k < n; ++k) {
+              if (cmd[k] == cmd[k]) p.set_command(cmd[k]);
+              p.advance_sample();
+              for (int i = 0; i < 2; ++i) {
+                const FingerSample& s = p.sensor_sample(i);
+                const double v[nf] = {s.f_n, s.f_x, s.f_y, s.tau, s.true_f_n, s.true_f_x, s.true_f_y, s.true_tau,
+                                      s.slip_x, s.slip_y, s.slip_angle, s.slip_vx, s.slip_vy, s.omega, s.c_tilde, s.rho};
+                for (int j = 0; j < nf; ++j) fp[2 * j + i][k] = v[j];
+              }
+              const PlantState& st = p.state();
+              const double v[np] = {st.t, st.f_cmd, st.f_held, st.f_n, st.gripper_x, st.gripper_y, st.gripper_vy,
+                                    st.x, st.y, st.vx, st.vy, st.theta, st.omega, st.max_slip, st.max_rotation,
+                                    st.contact_fx, st.contact_fy, st.contact_tau, st.ext_fx, st.ext_fy, st.ext_tau,
+                                    p.energy()};
+              for (int j = 0; j < np; ++j) pp[j][k] = v[j];
+              sup.data()[k] = st.supported;
+              drop.data()[k] = st.dropped;
+            }
+          }
+          nb::dict d;
+          for (int j = 0; j < nf; ++j) {
+            d[(std::string(fin[j]) + "_0").c_str()] = fa[2 * j];
+            d[(std::string(fin[j]) + "_1").c_str()] = fa[2 * j + 1];
+          }
+          for (int j = 0; j < np; ++j) d[pl[j]] = pa[j];
+          d["supported"] = sup;
+          d["dropped"] = drop;
+          return d;
+        }, "command"_a,
+           "One row per sensor sample: set_command(command[k]) (NaN: keep), advance to the next "
+           "sample, record. Finger quantities as <name>_0 / <name>_1. Returns a dict of arrays.");
+  }
+  // --- end of plant block --------------------------------------------------------------------
 }
