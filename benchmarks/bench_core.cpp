@@ -1,0 +1,469 @@
+// lugrip — per-call timings of the real-time core (issue 2, item 9; STYLE.md section 9).
+//
+//   bench_core [--quick] [--json] [--seed N]
+//
+// What is timed (all inputs precomputed from a seeded std::mt19937, outside the timed loops):
+//   ls_eval      LimitSurface::eval(a), and ft_star(c~) + tau_star(c~) (two calls, as a user of
+//                the signed curves makes them), c~ log-uniform in [1e-3, 1e3] or uniform on [0, 3];
+//   cor_step     CorEstimator::step on realistic samples (f_n log-uniform in [0.2, 16] N; loads
+//                inside the LS, on the LS plus a viscous excess, and radially outside it, from
+//                rotational to translational), for paper Table 1 and the big resin block of
+//                Table 2, split by the estimator's own inside/outside verdict;
+//   construct    LimitSurface(k) for k = 2, 3, 4, 8, inf, and ContactModel(Table 1).
+//
+// Method: a per-call figure is the time of a batch of kBatch = 16 consecutive calls (two
+// std::chrono::steady_clock reads around the batch) minus the median cost of an empty timed
+// batch, divided by 16. Median, p99 and mean are over all batches; "worst" is the slowest
+// batch (its per-call mean), so a single preemption of the process shows up as a worst case,
+// which is the honest figure on a shared machine. For cor_step a second pass times every call
+// on its own (same clock, overhead subtracted) to give the single-call p99 / worst a 1 kHz
+// loop sees. Constructions are timed one by one.
+//
+// Output: a human-readable table, or JSON on stdout with --json (for run_benchmarks.py).
+// Benchmarks are not tests: nothing here asserts a timing.
+#include <algorithm>
+#include <atomic>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <cstring>
+#include <limits>
+#include <new>
+#include <random>
+#include <string>
+#include <vector>
+
+#include "lugrip/contact.hpp"
+#include "lugrip/limit_surface.hpp"
+#include "lugrip/params.hpp"
+
+#ifndef LUGRIP_BENCH_CXX_FLAGS
+#define LUGRIP_BENCH_CXX_FLAGS "unknown"
+#endif
+#ifndef LUGRIP_BENCH_BUILD_TYPE
+#define LUGRIP_BENCH_BUILD_TYPE "unknown"
+#endif
+
+// ---- allocation counter: the timed loops must not allocate ---------------------------------
+namespace {
+std::atomic<long> g_allocations{0};
+}
+void* operator new(std::size_t n) {
+  g_allocations.fetch_add(1, std::memory_order_relaxed);
+  if (void* p = std::malloc(n ? n : 1)) return p;
+  throw std::bad_alloc();
+}
+void* operator new[](std::size_t n) { return operator new(n); }
+void operator delete(void* p) noexcept { std::free(p); }
+void operator delete[](void* p) noexcept { std::free(p); }
+void operator delete(void* p, std::size_t) noexcept { std::free(p); }
+void operator delete[](void* p, std::size_t) noexcept { std::free(p); }
+
+namespace {
+
+using Clock = std::chrono::steady_clock;
+constexpr int kBatch = 16;
+volatile double g_sink = 0.0;  // keeps results observable
+
+double ns_between(Clock::time_point a, Clock::time_point b) {
+  return std::chrono::duration<double, std::nano>(b - a).count();
+}
+
+struct Stats {
+  double median = 0, p99 = 0, worst = 0, mean = 0, best = 0;
+  long calls = 0;
+  long allocations = 0;
+};
+
+double percentile(std::vector<double>& v, double q) {  // v is sorted
+  if (v.empty()) return 0.0;
+  const double pos = q * (v.size() - 1);
+  const size_t i = static_cast<size_t>(pos);
+  const double f = pos - i;
+  return i + 1 < v.size() ? v[i] * (1 - f) + v[i + 1] * f : v[i];
+}
+
+Stats summarize(std::vector<double> per_call, long calls) {
+  Stats s;
+  std::sort(per_call.begin(), per_call.end());
+  s.median = percentile(per_call, 0.5);
+  s.p99 = percentile(per_call, 0.99);
+  s.worst = per_call.back();
+  s.best = per_call.front();
+  double sum = 0;
+  for (double x : per_call) sum += x;
+  s.mean = sum / per_call.size();
+  s.calls = calls;
+  return s;
+}
+
+// Median cost of an empty timed region (two clock reads), subtracted from every batch.
+double timer_overhead_ns() {
+  std::vector<double> v(20000);
+  for (auto& x : v) {
+    const auto t0 = Clock::now();
+    const auto t1 = Clock::now();
+    x = ns_between(t0, t1);
+  }
+  std::sort(v.begin(), v.end());
+  return v[v.size() / 2];
+}
+
+double g_overhead = 0.0;
+
+// Calls fn(i) for i over `n_inputs` precomputed inputs, `rounds` times, in batches of kBatch.
+template <class Fn>
+Stats time_batched(Fn&& fn, int n_inputs, int rounds) {
+  const int batches = n_inputs / kBatch;
+  std::vector<double> per_call;
+  per_call.reserve(static_cast<size_t>(batches) * rounds);
+  for (int i = 0; i < n_inputs; ++i) fn(i);  // warm-up: caches, branch predictors
+  const long alloc0 = g_allocations.load();
+  for (int r = 0; r < rounds; ++r) {
+    for (int b = 0; b < batches; ++b) {
+      const int i0 = b * kBatch;
+      const auto t0 = Clock::now();
+      for (int i = i0; i < i0 + kBatch; ++i) fn(i);
+      const auto t1 = Clock::now();
+      per_call.push_back(std::max(0.0, ns_between(t0, t1) - g_overhead) / kBatch);
+    }
+  }
+  const long alloc1 = g_allocations.load();
+  Stats s = summarize(std::move(per_call), static_cast<long>(batches) * kBatch * rounds);
+  // the vector push_back above reserved its storage first, so any count is the callee's
+  s.allocations = alloc1 - alloc0;
+  return s;
+}
+
+template <class Fn>
+Stats time_single(Fn&& fn, int n_inputs, int rounds) {
+  std::vector<double> per_call;
+  per_call.reserve(static_cast<size_t>(n_inputs) * rounds);
+  for (int i = 0; i < n_inputs; ++i) fn(i);
+  for (int r = 0; r < rounds; ++r) {
+    for (int i = 0; i < n_inputs; ++i) {
+      const auto t0 = Clock::now();
+      fn(i);
+      const auto t1 = Clock::now();
+      per_call.push_back(std::max(0.0, ns_between(t0, t1) - g_overhead));
+    }
+  }
+  return summarize(std::move(per_call), static_cast<long>(n_inputs) * rounds);
+}
+
+// ---- inputs ----------------------------------------------------------------------------------
+
+double log_uniform(std::mt19937& rng, double lo, double hi) {
+  std::uniform_real_distribution<double> u(std::log(lo), std::log(hi));
+  return std::exp(u(rng));
+}
+
+// One realistic sensor sample (the recipe is repeated in scipy_baseline.py):
+//   f_n log-uniform in [0.2, 16] N; LS parameter a log-uniform in [1e-2, 1e2] (rotational for
+//   a << 1, translational for a >> 1); then with probability 1/2 inside: lambda (F, T),
+//   lambda ~ U[0.05, 0.98]; 1/4 sliding: (F + 2 xi a nu, T + nu), nu log-uniform in [1e-3, 1];
+//   1/4 radially outside: lambda (F, T), lambda ~ U[1.02, 2]; random signs of f_t and tau.
+lugrip::CorInput make_sample(std::mt19937& rng, const lugrip::ContactModel& m) {
+  const lugrip::LimitSurface& ls = m.limit_surface();
+  std::uniform_real_distribution<double> u01(0.0, 1.0);
+  const double f_n = log_uniform(rng, 0.2, 16.0);
+  const double a = log_uniform(rng, 1e-2, 1e2);
+  const lugrip::LsPoint q = ls.eval(a);
+  const double kind = u01(rng);
+  double f, t;
+  if (kind < 0.5) {
+    const double lam = 0.05 + 0.93 * u01(rng);
+    f = lam * q.F;
+    t = lam * q.T;
+  } else if (kind < 0.75) {
+    const double nu = log_uniform(rng, 1e-3, 1.0);
+    f = q.F + 2.0 * ls.xi() * a * nu;
+    t = q.T + nu;
+  } else {
+    const double lam = 1.02 + 0.98 * u01(rng);
+    f = lam * q.F;
+    t = lam * q.T;
+  }
+  const double sf = u01(rng) < 0.5 ? -1.0 : 1.0, st = u01(rng) < 0.5 ? -1.0 : 1.0;
+  return lugrip::CorInput{f_n, sf * f * m.ft_max(f_n), st * t * m.tau_max(f_n)};
+}
+
+// ---- reporting -------------------------------------------------------------------------------
+
+struct Row {
+  std::string group, name, detail;
+  Stats batched;
+  bool has_single = false;
+  Stats single;
+  double iterations = -1.0;  // mean root-finding iterations per call (cor_step)
+  double inside_fraction = -1.0;
+  bool ms = false;           // construction rows are in milliseconds
+};
+
+std::string json_escape(const std::string& s) {
+  std::string r;
+  for (char c : s) {
+    if (c == '"' || c == '\\') r += '\\';
+    r += c;
+  }
+  return r;
+}
+
+std::string num(double x) {
+  char buf[64];
+  std::snprintf(buf, sizeof buf, "%.6g", x);
+  return buf;
+}
+
+std::string stats_json(const Stats& s, const char* unit) {
+  const std::string u = unit;
+  return "{\"median_" + u + "\": " + num(s.median) + ", \"p99_" + u + "\": " + num(s.p99) +
+         ", \"worst_" + u + "\": " + num(s.worst) + ", \"mean_" + u + "\": " + num(s.mean) +
+         ", \"best_" + u + "\": " + num(s.best) + ", \"calls\": " + std::to_string(s.calls) +
+         ", \"allocations\": " + std::to_string(s.allocations) + "}";
+}
+
+std::string compiler_string() {
+#if defined(__clang__)
+  return std::string("clang ") + __clang_version__;
+#elif defined(__GNUC__)
+  return std::string("gcc ") + __VERSION__;
+#elif defined(_MSC_VER)
+  return "msvc " + std::to_string(_MSC_VER);
+#else
+  return "unknown";
+#endif
+}
+
+std::string macro_flags() {
+  std::string f;
+#if defined(__OPTIMIZE__)
+  f += "__OPTIMIZE__ ";
+#endif
+#if defined(__OPTIMIZE_SIZE__)
+  f += "__OPTIMIZE_SIZE__ ";
+#endif
+#if defined(__NO_INLINE__)
+  f += "__NO_INLINE__ ";
+#endif
+#if defined(NDEBUG)
+  f += "NDEBUG ";
+#endif
+#if defined(__FAST_MATH__)
+  f += "__FAST_MATH__ ";
+#endif
+#if defined(__SSE2__)
+  f += "__SSE2__ ";
+#endif
+#if defined(__AVX__)
+  f += "__AVX__ ";
+#endif
+#if defined(__AVX2__)
+  f += "__AVX2__ ";
+#endif
+#if defined(__FMA__)
+  f += "__FMA__ ";
+#endif
+#if defined(__SANITIZE_ADDRESS__)
+  f += "__SANITIZE_ADDRESS__ ";
+#endif
+  f += "__cplusplus=" + std::to_string(__cplusplus);
+  return f;
+}
+
+void print_text(const std::vector<Row>& rows) {
+  std::printf("lugrip bench_core — %s; build %s; flags \"%s\"; macros %s\n", compiler_string().c_str(),
+              LUGRIP_BENCH_BUILD_TYPE, LUGRIP_BENCH_CXX_FLAGS, macro_flags().c_str());
+  std::printf("timer overhead %.1f ns (subtracted); per-call = batch of %d / %d\n\n", g_overhead,
+              kBatch, kBatch);
+  std::printf("%-10s %-34s %10s %10s %10s %10s %8s %6s\n", "group", "case", "median", "p99",
+              "worst", "mean", "iter", "alloc");
+  for (const Row& r : rows) {
+    const char* unit = r.ms ? "ms" : "ns";
+    std::printf("%-10s %-34s %8.2f%s %8.2f%s %8.2f%s %8.2f%s", r.group.c_str(), r.name.c_str(),
+                r.batched.median, unit, r.batched.p99, unit, r.batched.worst, unit, r.batched.mean,
+                unit);
+    if (r.iterations >= 0) std::printf(" %8.2f", r.iterations); else std::printf(" %8s", "-");
+    std::printf(" %6ld\n", r.batched.allocations);
+    if (r.has_single)
+      std::printf("%-10s %-34s %8.2fns %8.2fns %8.2fns %8.2fns\n", "", "  (each call timed alone)",
+                  r.single.median, r.single.p99, r.single.worst, r.single.mean);
+  }
+  std::printf("\nsizeof: LimitSurface %zu, ContactModel %zu, CorEstimator %zu, CorOutput %zu, CorInput %zu\n",
+              sizeof(lugrip::LimitSurface), sizeof(lugrip::ContactModel), sizeof(lugrip::CorEstimator),
+              sizeof(lugrip::CorOutput), sizeof(lugrip::CorInput));
+}
+
+void print_json(const std::vector<Row>& rows, unsigned seed, bool quick) {
+  std::printf("{\n  \"tool\": \"bench_core\",\n  \"seed\": %u,\n  \"quick\": %s,\n", seed,
+              quick ? "true" : "false");
+  std::printf("  \"compiler\": \"%s\",\n", json_escape(compiler_string()).c_str());
+  std::printf("  \"build_type\": \"%s\",\n", json_escape(LUGRIP_BENCH_BUILD_TYPE).c_str());
+  std::printf("  \"cxx_flags\": \"%s\",\n", json_escape(LUGRIP_BENCH_CXX_FLAGS).c_str());
+  std::printf("  \"macros\": \"%s\",\n", json_escape(macro_flags()).c_str());
+  std::printf("  \"batch\": %d,\n  \"timer_overhead_ns\": %s,\n", kBatch, num(g_overhead).c_str());
+  std::printf("  \"sizeof\": {\"LimitSurface\": %zu, \"ContactModel\": %zu, \"CorEstimator\": %zu, "
+              "\"CorOutput\": %zu, \"CorInput\": %zu, \"LsPoint\": %zu},\n",
+              sizeof(lugrip::LimitSurface), sizeof(lugrip::ContactModel), sizeof(lugrip::CorEstimator),
+              sizeof(lugrip::CorOutput), sizeof(lugrip::CorInput), sizeof(lugrip::LsPoint));
+  std::printf("  \"results\": [\n");
+  for (size_t i = 0; i < rows.size(); ++i) {
+    const Row& r = rows[i];
+    std::printf("    {\"group\": \"%s\", \"name\": \"%s\", \"detail\": \"%s\", \"unit\": \"%s\", \"stats\": %s",
+                r.group.c_str(), json_escape(r.name).c_str(), json_escape(r.detail).c_str(),
+                r.ms ? "ms" : "ns", stats_json(r.batched, r.ms ? "ms" : "ns").c_str());
+    if (r.has_single) std::printf(", \"single_call\": %s", stats_json(r.single, "ns").c_str());
+    if (r.iterations >= 0) std::printf(", \"iterations_per_call\": %s", num(r.iterations).c_str());
+    if (r.inside_fraction >= 0) std::printf(", \"inside_fraction\": %s", num(r.inside_fraction).c_str());
+    std::printf("}%s\n", i + 1 < rows.size() ? "," : "");
+  }
+  std::printf("  ]\n}\n");
+}
+
+// ---- benchmarks ------------------------------------------------------------------------------
+
+void bench_ls_eval(std::vector<Row>& rows, std::mt19937& rng, bool quick) {
+  const lugrip::LimitSurface ls(4.0);
+  const int n = 4096;
+  const int rounds = quick ? 40 : 250;
+  std::vector<double> logu(n), unif(n), logu_signed(n), unif_signed(n);
+  std::uniform_real_distribution<double> u03(0.0, 3.0), pm(0.0, 1.0);
+  for (int i = 0; i < n; ++i) {
+    logu[i] = log_uniform(rng, 1e-3, 1e3);
+    unif[i] = u03(rng);
+    logu_signed[i] = (pm(rng) < 0.5 ? -1.0 : 1.0) * logu[i];
+    unif_signed[i] = (pm(rng) < 0.5 ? -1.0 : 1.0) * unif[i];
+  }
+  auto eval_on = [&](const std::vector<double>& x) {
+    return [&ls, &x](int i) {
+      const lugrip::LsPoint p = ls.eval(x[i]);
+      g_sink = g_sink + p.F + p.T + p.dF + p.dT;
+    };
+  };
+  auto pair_on = [&](const std::vector<double>& x) {
+    return [&ls, &x](int i) { g_sink = g_sink + ls.ft_star(x[i]) + ls.tau_star(x[i]); };
+  };
+  const char* d = "k = 4, value and derivative of both curves";
+  rows.push_back({"ls_eval", "eval, c~ log-uniform [1e-3,1e3]", d, time_batched(eval_on(logu), n, rounds)});
+  rows.push_back({"ls_eval", "eval, c~ uniform [0,3]", d, time_batched(eval_on(unif), n, rounds)});
+  const char* d2 = "k = 4, ft_star(c~) + tau_star(c~): two calls";
+  rows.push_back({"ls_eval", "ft_star+tau_star, log-uniform", d2, time_batched(pair_on(logu_signed), n, rounds)});
+  rows.push_back({"ls_eval", "ft_star+tau_star, uniform [-3,3]", d2, time_batched(pair_on(unif_signed), n, rounds)});
+}
+
+void bench_cor(std::vector<Row>& rows, std::mt19937& rng, bool quick, const char* object) {
+  const lugrip::ContactParams p =
+      std::strcmp(object, "table1") == 0 ? lugrip::table1_params() : lugrip::object_params(object);
+  const lugrip::ContactModel model(p);
+  lugrip::CorEstimator est(model);
+  const int pool = 8192;
+  std::vector<lugrip::CorInput> all, inside, outside;
+  all.reserve(pool);
+  lugrip::CorOutput out;
+  long n_inside = 0;
+  for (int i = 0; i < pool; ++i) {
+    const lugrip::CorInput s = make_sample(rng, model);
+    est.step(s, out);
+    all.push_back(s);
+    (out.inside ? inside : outside).push_back(s);
+    n_inside += out.inside ? 1 : 0;
+  }
+  const int rounds = quick ? 8 : 60;
+  auto run_on = [&](const std::vector<lugrip::CorInput>& v, double* iters) {
+    long it = 0;
+    for (const auto& s : v) {  // mean iterations over the set (untimed)
+      est.step(s, out);
+      it += out.iterations;
+    }
+    *iters = static_cast<double>(it) / v.size();
+    return [&est, &out, &v](int i) {
+      est.step(v[i], out);
+      g_sink = g_sink + out.c_tilde;
+    };
+  };
+  const std::string obj = object;
+  const std::string detail = obj + ", f_n in [0.2, 16] N, c~ in [1e-2, 1e2]";
+  double it_in = 0, it_out = 0, it_all = 0;
+  auto f_in = run_on(inside, &it_in);
+  auto f_out = run_on(outside, &it_out);
+  auto f_all = run_on(all, &it_all);
+  Row r_in{"cor_step", obj + ": inside LS", detail, time_batched(f_in, static_cast<int>(inside.size()), rounds)};
+  r_in.iterations = it_in;
+  r_in.inside_fraction = 1.0;
+  Row r_out{"cor_step", obj + ": outside LS", detail, time_batched(f_out, static_cast<int>(outside.size()), rounds)};
+  r_out.iterations = it_out;
+  r_out.inside_fraction = 0.0;
+  Row r_all{"cor_step", obj + ": all", detail, time_batched(f_all, pool, rounds)};
+  r_all.iterations = it_all;
+  r_all.inside_fraction = static_cast<double>(n_inside) / pool;
+  r_all.has_single = true;
+  r_all.single = time_single(f_all, pool, quick ? 4 : 20);
+  rows.push_back(r_in);
+  rows.push_back(r_out);
+  rows.push_back(r_all);
+}
+
+template <class Make>
+Row time_construction(const std::string& name, const std::string& detail, int reps, Make&& make) {
+  std::vector<double> ms;
+  make();  // warm-up
+  for (int r = 0; r < reps; ++r) {
+    const auto t0 = Clock::now();
+    make();
+    const auto t1 = Clock::now();
+    ms.push_back(ns_between(t0, t1) * 1e-6);
+  }
+  Row row{"construct", name, detail, summarize(std::move(ms), reps)};
+  row.ms = true;
+  return row;
+}
+
+void bench_construction(std::vector<Row>& rows, bool quick) {
+  const int reps = quick ? 3 : 15;
+  const double inf = std::numeric_limits<double>::infinity();
+  const struct { const char* label; double k; } ks[] = {{"2", 2.0}, {"3", 3.0}, {"4", 4.0}, {"8", 8.0}, {"inf", inf}};
+  for (const auto& kk : ks) {
+    rows.push_back(time_construction(std::string("LimitSurface(k=") + kk.label + ")",
+                                     "two 257-node Hermite tables by quadrature", reps, [&] {
+                                       const lugrip::LimitSurface ls(kk.k);
+                                       g_sink = g_sink + ls.eval(0.5).F;
+                                     }));
+  }
+  const lugrip::ContactParams p = lugrip::table1_params();
+  rows.push_back(time_construction("ContactModel(Table 1)", "LimitSurface(4) + validation + sigma_LS inverse table",
+                                   reps, [&] {
+                                     const lugrip::ContactModel m(p);
+                                     g_sink = g_sink + m.rho(1.0);
+                                   }));
+  const lugrip::ContactModel shared(p);
+  rows.push_back(time_construction("CorEstimator(model)", "copy of an existing ContactModel", reps, [&] {
+    const lugrip::CorEstimator e(shared);
+    g_sink = g_sink + e.model().rho(1.0);
+  }));
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  bool json = false, quick = false;
+  unsigned seed = 20240521u;
+  for (int i = 1; i < argc; ++i) {
+    if (!std::strcmp(argv[i], "--json")) json = true;
+    else if (!std::strcmp(argv[i], "--quick")) quick = true;
+    else if (!std::strcmp(argv[i], "--seed") && i + 1 < argc) seed = static_cast<unsigned>(std::strtoul(argv[++i], nullptr, 10));
+    else {
+      std::fprintf(stderr, "usage: %s [--quick] [--json] [--seed N]\n", argv[0]);
+      return 2;
+    }
+  }
+  std::mt19937 rng(seed);
+  g_overhead = timer_overhead_ns();
+  std::vector<Row> rows;
+  bench_ls_eval(rows, rng, quick);
+  bench_cor(rows, rng, quick, "table1");
+  bench_cor(rows, rng, quick, "big_resin_block");
+  bench_construction(rows, quick);
+  if (json) print_json(rows, seed, quick); else print_text(rows);
+  return 0;
+}
