@@ -647,4 +647,182 @@ NB_MODULE(_core, m) {
            "sample, record. Finger quantities as <name>_0 / <name>_1. Returns a dict of arrays.");
   }
   // --- end of plant block --------------------------------------------------------------------
+
+  // ===== observer block (issue 3): slider model, sliding-velocity observer ================
+  nb::enum_<Integrator>(m, "Integrator", "Discretisation of the LuGre rotor over one sample.")
+      .value("Implicit", Integrator::Implicit)
+      .value("Rk4", Integrator::Rk4)
+      .value("Rk4Adaptive", Integrator::Rk4Adaptive)
+      .value("Rosenbrock", Integrator::Rosenbrock);
+  nb::enum_<GainMode>(m, "GainMode", "Observer gain: fixed l, or l = bandwidth / sigma_1.")
+      .value("Fixed", GainMode::Fixed)
+      .value("Bandwidth", GainMode::Bandwidth);
+
+  nb::class_<SliderSettings>(m, "SliderSettings")
+      .def(nb::init<>())
+      .def_rw("integrator", &SliderSettings::integrator)
+      .def_rw("max_substep", &SliderSettings::max_substep)
+      .def_rw("max_substeps", &SliderSettings::max_substeps)
+      .def_rw("g_floor", &SliderSettings::g_floor);
+  m.def("validate_slider_settings", [](const SliderSettings& s) {
+    std::string msg;
+    validate(s, &msg);
+    return msg;
+  }, "Empty string when valid, else one line per bad field.");
+
+  nb::class_<SliderOutput>(m, "SliderOutput")
+      .def(nb::init<>())
+      .def_ro("z", &SliderOutput::z)
+      .def_ro("omega", &SliderOutput::omega)
+      .def_ro("zdot", &SliderOutput::zdot)
+      .def_ro("g", &SliderOutput::g)
+      .def_ro("sigma_1", &SliderOutput::sigma_1)
+      .def_ro("dry_torque", &SliderOutput::dry_torque)
+      .def_ro("friction_torque", &SliderOutput::friction_torque)
+      .def_ro("slip", &SliderOutput::slip)
+      .def_ro("substeps", &SliderOutput::substeps)
+      .def_ro("projected", &SliderOutput::projected)
+      .def_ro("status", &SliderOutput::status);
+
+  nb::class_<SliderModel>(m, "SliderModel")
+      .def(nb::init<const ContactParams&, double, const SliderSettings&>(), "params"_a, "J"_a,
+           "settings"_a = SliderSettings())
+      .def(nb::init<const ContactModel&, double, const SliderSettings&>(), "model"_a, "J"_a,
+           "settings"_a = SliderSettings())
+      .def("reset", &SliderModel::reset, "z"_a = 0.0, "omega"_a = 0.0)
+      .def_prop_ro("z", &SliderModel::z)
+      .def_prop_ro("omega", &SliderModel::omega)
+      .def_prop_ro("J", &SliderModel::inertia)
+      .def("step", [](SliderModel& s, double f_n, double c_tilde, double tau_e, double dt) {
+        SliderOutput out;
+        s.step(SliderInput{f_n, c_tilde, tau_e, dt}, out);
+        return out;
+      }, "f_n"_a, "c_tilde"_a, "tau_e"_a, "dt"_a)
+      .def("simulate", [](SliderModel& s, const In1& fn, const In1& ct, const In1& te, const In1& dt) {
+        same_size(fn, ct);
+        same_size(fn, te);
+        same_size(fn, dt);
+        const size_t n = fn.shape(0);
+        auto z = new_array<double>(n), w = new_array<double>(n), zd = new_array<double>(n),
+             g = new_array<double>(n), s1 = new_array<double>(n), dry = new_array<double>(n),
+             fr = new_array<double>(n), slip = new_array<double>(n);
+        auto sub = new_array<int32_t>(n), status = new_array<int32_t>(n);
+        auto proj = new_array<bool>(n);
+        const double *pf = fn.data(), *pc = ct.data(), *pe = te.data(), *pd = dt.data();
+        {
+          nb::gil_scoped_release release;
+          SliderOutput o;
+          for (size_t i = 0; i < n; ++i) {
+            s.step(SliderInput{pf[i], pc[i], pe[i], pd[i]}, o);
+            z.data()[i] = o.z; w.data()[i] = o.omega; zd.data()[i] = o.zdot; g.data()[i] = o.g;
+            s1.data()[i] = o.sigma_1; dry.data()[i] = o.dry_torque; fr.data()[i] = o.friction_torque;
+            slip.data()[i] = o.slip; sub.data()[i] = o.substeps; proj.data()[i] = o.projected;
+            status.data()[i] = static_cast<int32_t>(o.status);
+          }
+        }
+        nb::dict d;
+        d["z"] = z; d["omega"] = w; d["zdot"] = zd; d["g"] = g; d["sigma_1"] = s1;
+        d["dry_torque"] = dry; d["friction_torque"] = fr; d["slip"] = slip; d["substeps"] = sub;
+        d["projected"] = proj; d["status"] = status;
+        return d;
+      }, "f_n"_a, "c_tilde"_a, "tau_e"_a, "dt"_a, "Runs step() over 1-D arrays in C++; returns a dict of arrays.");
+
+  nb::class_<ObserverSettings>(m, "ObserverSettings")
+      .def(nb::init<>())
+      .def_rw("dt", &ObserverSettings::dt)
+      .def_rw("integrator", &ObserverSettings::integrator)
+      .def_rw("gain_mode", &ObserverSettings::gain_mode)
+      .def_rw("gain", &ObserverSettings::gain)
+      .def_rw("bandwidth", &ObserverSettings::bandwidth)
+      .def_rw("gain_min", &ObserverSettings::gain_min)
+      .def_rw("gain_max", &ObserverSettings::gain_max)
+      .def_rw("g_floor", &ObserverSettings::g_floor)
+      .def_rw("torque_cutoff", &ObserverSettings::torque_cutoff)
+      .def_rw("filter_force", &ObserverSettings::filter_force)
+      .def_rw("cor_sign_sigmas", &ObserverSettings::cor_sign_sigmas)
+      .def_rw("max_invalid", &ObserverSettings::max_invalid)
+      .def_rw("max_dt_gap", &ObserverSettings::max_dt_gap)
+      .def_rw("torque_noise", &ObserverSettings::torque_noise)
+      .def_rw("resolution_max", &ObserverSettings::resolution_max)
+      .def_rw("omega_limit", &ObserverSettings::omega_limit)
+      .def_rw("substeps", &ObserverSettings::substeps)
+      .def_rw("max_substeps", &ObserverSettings::max_substeps)
+      .def_rw("cor", &ObserverSettings::cor);
+  m.def("validate_observer_settings", [](const ObserverSettings& s) {
+    std::string msg;
+    validate(s, &msg);
+    return msg;
+  }, "Empty string when valid, else one line per bad field.");
+
+  nb::class_<ObserverOutput>(m, "ObserverOutput")
+      .def(nb::init<>())
+      .def_ro("omega_hat", &ObserverOutput::omega_hat)
+      .def_ro("z_hat", &ObserverOutput::z_hat)
+      .def_ro("S", &ObserverOutput::S)
+      .def_ro("c_tilde", &ObserverOutput::c_tilde)
+      .def_ro("c", &ObserverOutput::c)
+      .def_ro("g", &ObserverOutput::g)
+      .def_ro("sigma_1", &ObserverOutput::sigma_1)
+      .def_ro("y", &ObserverOutput::y)
+      .def_ro("tau_cor", &ObserverOutput::tau_cor)
+      .def_ro("ft_cor", &ObserverOutput::ft_cor)
+      .def_ro("gain", &ObserverOutput::gain)
+      .def_ro("omega_resolution", &ObserverOutput::omega_resolution)
+      .def_ro("speed_observable", &ObserverOutput::speed_observable)
+      .def_ro("inside", &ObserverOutput::inside)
+      .def_ro("saturated", &ObserverOutput::saturated)
+      .def_ro("projected", &ObserverOutput::projected)
+      .def_ro("diverged", &ObserverOutput::diverged)
+      .def_ro("substeps_capped", &ObserverOutput::substeps_capped)
+      .def_ro("substeps", &ObserverOutput::substeps)
+      .def_ro("cor_iterations", &ObserverOutput::cor_iterations)
+      .def_ro("status", &ObserverOutput::status);
+
+  nb::class_<Observer>(m, "Observer")
+      .def(nb::init<const ContactParams&, const ObserverSettings&>(), "params"_a, "settings"_a = ObserverSettings())
+      .def(nb::init<const ContactModel&, const ObserverSettings&>(), "model"_a, "settings"_a = ObserverSettings())
+      .def("reset", &Observer::reset)
+      .def_prop_ro("omega_hat", &Observer::omega_hat)
+      .def_prop_ro("z_hat", &Observer::z_hat)
+      .def("step", [](Observer& o, double f_n, double f_t, double tau, double dt) {
+        ObserverOutput out;
+        o.step(ObserverInput{f_n, f_t, tau, dt}, out);
+        return out;
+      }, "f_n"_a, "f_t"_a, "tau"_a, "dt"_a = 0.0, "One sample (dt = 0: nominal settings.dt).")
+      .def("run", [](Observer& o, const In1& fn, const In1& ft, const In1& tau, const In1& dt) {
+        same_size(fn, ft);
+        same_size(fn, tau);
+        same_size(fn, dt);
+        const size_t n = fn.shape(0);
+        auto w = new_array<double>(n), z = new_array<double>(n), S = new_array<double>(n),
+             ct = new_array<double>(n), c = new_array<double>(n), g = new_array<double>(n),
+             s1 = new_array<double>(n), y = new_array<double>(n), tc = new_array<double>(n),
+             fc = new_array<double>(n), gain = new_array<double>(n), res = new_array<double>(n);
+        auto obs = new_array<bool>(n), inside = new_array<bool>(n), sat = new_array<bool>(n),
+             proj = new_array<bool>(n), div = new_array<bool>(n), cap = new_array<bool>(n);
+        auto sub = new_array<int32_t>(n), iters = new_array<int32_t>(n), status = new_array<int32_t>(n);
+        const double *pf = fn.data(), *pt = ft.data(), *pq = tau.data(), *pd = dt.data();
+        {
+          nb::gil_scoped_release release;
+          ObserverOutput r;
+          for (size_t i = 0; i < n; ++i) {
+            o.step(ObserverInput{pf[i], pt[i], pq[i], pd[i]}, r);
+            w.data()[i] = r.omega_hat; z.data()[i] = r.z_hat; S.data()[i] = r.S;
+            ct.data()[i] = r.c_tilde; c.data()[i] = r.c; g.data()[i] = r.g; s1.data()[i] = r.sigma_1;
+            y.data()[i] = r.y; tc.data()[i] = r.tau_cor; fc.data()[i] = r.ft_cor; gain.data()[i] = r.gain;
+            res.data()[i] = r.omega_resolution; obs.data()[i] = r.speed_observable;
+            inside.data()[i] = r.inside; sat.data()[i] = r.saturated; proj.data()[i] = r.projected;
+            div.data()[i] = r.diverged; cap.data()[i] = r.substeps_capped; sub.data()[i] = r.substeps;
+            iters.data()[i] = r.cor_iterations; status.data()[i] = static_cast<int32_t>(r.status);
+          }
+        }
+        nb::dict d;
+        d["omega_hat"] = w; d["z_hat"] = z; d["S"] = S; d["c_tilde"] = ct; d["c"] = c; d["g"] = g;
+        d["sigma_1"] = s1; d["y"] = y; d["tau_cor"] = tc; d["ft_cor"] = fc; d["gain"] = gain; d["omega_resolution"] = res;
+        d["speed_observable"] = obs; d["inside"] = inside; d["saturated"] = sat; d["projected"] = proj;
+        d["diverged"] = div; d["substeps_capped"] = cap; d["substeps"] = sub; d["cor_iterations"] = iters;
+        d["status"] = status;
+        return d;
+      }, "f_n"_a, "f_t"_a, "tau"_a, "dt"_a, "Runs step() over 1-D arrays in C++ (dt 0: nominal); returns a dict of arrays.");
+  // ===== end of observer block =============================================================
 }

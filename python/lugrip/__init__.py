@@ -16,6 +16,17 @@ from ._contact import (
     shape_factor,
     sigma_1,
 )
+from ._observer import (
+    Observability,
+    Observer,
+    ObserverRun,
+    ObserverSample,
+    SliderModel,
+    SliderState,
+    SliderTrajectory,
+    observability,
+    sensor_wrench,
+)
 from ._params import PRESETS, ContactParams
 from ._controller import (
     ControllerMode,
@@ -51,4 +62,13 @@ __all__ = [
     "LogWarning",
     "read_log",
     "write_log",
+    "Observer",
+    "ObserverSample",
+    "ObserverRun",
+    "SliderModel",
+    "SliderState",
+    "SliderTrajectory",
+    "Observability",
+    "observability",
+    "sensor_wrench",
 ]
