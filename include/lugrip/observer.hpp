@@ -124,9 +124,10 @@ struct ObserverOutput {
 //!   zhat' = omegahat - (sigma0/g) zhat |omegahat|,
 //!   omegahat' = l [y - sigma0 zhat - sigma_1 omegahat - sigma_z zhat'],
 //!
-//! with y = tau - c f_t. Per sample: (1) CoR estimate (CorEstimator) from f_n, f_t and the
-//! low-pass filtered torque (raw torque for y: on translational loads the torque is below the
-//! noise and an unfiltered CoR changes side every few samples, which flips the sign of y);
+//! with y = tau - c f_t. Per sample: (1) CoR estimate (CorEstimator) from f_n and the low-pass
+//! filtered torque (and f_t, filter_force) with sign hysteresis; y uses the raw wrench. On
+//! translational loads the torque is below the noise and an unfiltered CoR changes side every
+//! few samples, which flips the sign of y and drags z_hat across zero;
 //! (2) g, sigma_1 and y at the current sample; (3) one update with the chosen integrator over
 //! the time since the last integrated sample; (4) projection |zhat| <= g/sigma0, so S <= 1.
 //!

@@ -21,17 +21,17 @@ from . import _core
 from ._contact import Status, _as_params, _flat, _model, _shaped
 
 __all__ = [
+    "GAIN_MODES",
+    "INTEGRATORS",
+    "Observability",
     "Observer",
-    "ObserverSample",
     "ObserverRun",
+    "ObserverSample",
     "SliderModel",
     "SliderState",
     "SliderTrajectory",
-    "Observability",
     "observability",
     "sensor_wrench",
-    "INTEGRATORS",
-    "GAIN_MODES",
 ]
 
 INTEGRATORS = {
@@ -42,9 +42,24 @@ INTEGRATORS = {
 }
 GAIN_MODES = {"fixed": _core.GainMode.Fixed, "bandwidth": _core.GainMode.Bandwidth}
 _COR_FIELDS = ("f_n_min", "force_limit", "torque_limit", "zero_force", "zero_torque")
-_OBS_FIELDS = ("dt", "gain", "bandwidth", "gain_min", "gain_max", "g_floor", "torque_cutoff",
-               "filter_force", "cor_sign_sigmas", "max_invalid", "max_dt_gap", "torque_noise",
-               "resolution_max", "omega_limit", "substeps", "max_substeps")
+_OBS_FIELDS = (
+    "dt",
+    "gain",
+    "bandwidth",
+    "gain_min",
+    "gain_max",
+    "g_floor",
+    "torque_cutoff",
+    "filter_force",
+    "cor_sign_sigmas",
+    "max_invalid",
+    "max_dt_gap",
+    "torque_noise",
+    "resolution_max",
+    "omega_limit",
+    "substeps",
+    "max_substeps",
+)
 
 
 def _enum(table: dict, name: str, value):
@@ -102,7 +117,7 @@ class ObserverSample:
     status: Status
 
     @classmethod
-    def _from_core(cls, o) -> "ObserverSample":
+    def _from_core(cls, o) -> ObserverSample:
         values = {f.name: getattr(o, f.name) for f in dataclasses.fields(cls) if f.name != "status"}
         return cls(status=Status(o.status.value), **values)
 
@@ -142,14 +157,18 @@ class ObserverRun:
         return len(self.omega_hat)
 
     def to_dict(self) -> dict[str, np.ndarray]:
-        return {f.name: getattr(self, f.name) for f in dataclasses.fields(self)
-                if getattr(self, f.name) is not None}
+        return {
+            f.name: getattr(self, f.name)
+            for f in dataclasses.fields(self)
+            if getattr(self, f.name) is not None
+        }
 
     @property
     def valid(self) -> np.ndarray:
         """Samples that carry an estimate (Ok, Saturated, Degenerate, Reinitialized)."""
-        return np.isin(self.status, [Status.OK, Status.SATURATED, Status.DEGENERATE,
-                                     Status.REINITIALIZED])
+        return np.isin(
+            self.status, [Status.OK, Status.SATURATED, Status.DEGENERATE, Status.REINITIALIZED]
+        )
 
     def rmse(self, omega, mask=None) -> float:
         """Root-mean-square error of omega_hat against ground truth `omega` [rad/s] over the
@@ -213,9 +232,17 @@ class Observer:
         ValueError: naming every invalid setting.
     """
 
-    def __init__(self, params, *, dt: float = 0.002, integrator: str = "rosenbrock",
-                 gain_mode: str | None = None, gain: float | None = None,
-                 bandwidth: float | None = None, **settings):
+    def __init__(
+        self,
+        params,
+        *,
+        dt: float = 0.002,
+        integrator: str = "rosenbrock",
+        gain_mode: str | None = None,
+        gain: float | None = None,
+        bandwidth: float | None = None,
+        **settings,
+    ):
         self.params = _as_params(params)
         s = _core.ObserverSettings()
         s.dt = float(dt)
@@ -280,8 +307,9 @@ class Observer:
         out = self._obs.step(float(f_n), float(f_t), float(tau), 0.0 if dt is None else float(dt))
         return ObserverSample._from_core(out)
 
-    def step_vector(self, f_n: float, f_x: float, f_y: float, tau: float,
-                    dt: float | None = None) -> ObserverSample:
+    def step_vector(
+        self, f_n: float, f_x: float, f_y: float, tau: float, dt: float | None = None
+    ) -> ObserverSample:
         """As :meth:`step` with the in-plane force vector (f_t = hypot(f_x, f_y))."""
         return self.step(f_n, float(np.hypot(f_x, f_y)), tau, dt)
 
@@ -326,8 +354,10 @@ class Observer:
             d = np.diff(t)
             bad = np.flatnonzero(~(d > 0.0))
             if bad.size:
-                raise ValueError(f"t must be strictly increasing: t[{bad[0] + 1}] = {t[bad[0] + 1]!r}"
-                                 f" <= t[{bad[0]}] = {t[bad[0]]!r}")
+                raise ValueError(
+                    f"t must be strictly increasing: t[{bad[0] + 1}] = {t[bad[0] + 1]!r}"
+                    f" <= t[{bad[0]}] = {t[bad[0]]!r}"
+                )
             dt[1:] = d
         if reset:
             self._obs.reset()
@@ -351,8 +381,10 @@ class Observer:
 
     def __repr__(self) -> str:
         s = self.settings
-        return (f"Observer({self.params!r}, integrator={s['integrator']!r}, "
-                f"gain_mode={s['gain_mode']!r}, gain={s['gain']!r}, bandwidth={s['bandwidth']!r})")
+        return (
+            f"Observer({self.params!r}, integrator={s['integrator']!r}, "
+            f"gain_mode={s['gain_mode']!r}, gain={s['gain']!r}, bandwidth={s['bandwidth']!r})"
+        )
 
 
 # --------------------------------------------------------------------------------------------
@@ -413,9 +445,16 @@ class SliderModel:
         g_floor: lower bound on g [N m].
     """
 
-    def __init__(self, params, J: float, *, integrator: str = "rosenbrock",
-                 max_substep: float | None = None, max_substeps: int | None = None,
-                 g_floor: float | None = None):
+    def __init__(
+        self,
+        params,
+        J: float,
+        *,
+        integrator: str = "rosenbrock",
+        max_substep: float | None = None,
+        max_substeps: int | None = None,
+        g_floor: float | None = None,
+    ):
         self.params = _as_params(params)
         s = _core.SliderSettings()
         s.integrator = _enum(INTEGRATORS, "integrator", integrator)
@@ -448,8 +487,11 @@ class SliderModel:
     def step(self, f_n: float, c_tilde: float, tau_e: float, dt: float) -> SliderState:
         """Advance by dt [s]; invalid input gives Status.INVALID_SAMPLE and leaves the state."""
         o = self._sim.step(float(f_n), float(c_tilde), float(tau_e), float(dt))
-        values = {f.name: getattr(o, f.name) for f in dataclasses.fields(SliderState)
-                  if f.name != "status"}
+        values = {
+            f.name: getattr(o, f.name)
+            for f in dataclasses.fields(SliderState)
+            if f.name != "status"
+        }
         return SliderState(status=Status(o.status.value), **values)
 
     def simulate(self, f_n, c_tilde, tau_e, dt) -> SliderTrajectory:
@@ -485,9 +527,9 @@ class Observability:
         det: det Theta = sigma0^2 * gain_factor * motion_factor.
         gain_factor: 1 - l sigma_1 sigma_z / sigma0 (eq. 29's common factor; zero when
             l sigma_1 sigma_z = sigma0, a degeneracy the paper's proof does not discuss).
-        motion_factor: 1 - sigma0 z sign(omega)/g + sigma_1 |omega|/g; for
-            |z| <= g/sigma0 it is >= 0, and -> 0 in steady sliding (z at the bound) when sigma_1 |omega| << g,
-            i.e. slow slip or weak viscous friction (eqs. 30-31).
+        motion_factor: 1 - sigma0 z sign(omega)/g + sigma_1 |omega|/g; >= 0 for
+            |z| <= g/sigma0, and -> 0 in steady sliding (z at the bound) when
+            sigma_1 |omega| << g, i.e. slow slip or weak viscous friction (eqs. 30-31).
         cond: 2-norm condition number of Theta with unit-norm rows (scale-free).
         rank: numerical rank (singular values of the row-normalised Theta against `rtol`).
         outside_domain: |omega| <= omega_eps: outside M and M' of Proposition 1 (the regularised
@@ -508,13 +550,24 @@ class Observability:
         return len(self.det)
 
 
-def observability(params, z, omega=None, g=None, sigma_1=None, *, gain=200.0, rtol: float = 1e-6,
-                  cond_max: float = 1e4, omega_eps: float = 1e-9) -> Observability:
+def observability(
+    params,
+    z,
+    omega=None,
+    g=None,
+    sigma_1=None,
+    *,
+    gain=200.0,
+    rtol: float = 1e-6,
+    cond_max: float = 1e4,
+    omega_eps: float = 1e-9,
+) -> Observability:
     """Evaluate Theta(x) of eq. 28 (Proposition 1) along a trajectory, with J = 1/l.
 
     Theta = [[sigma0, sigma_1],
-             [-sigma0 sigma_1 l - (sigma0/g)(sigma0 - l sigma_1 sigma_z) |omega|,
-              sigma0 - l sigma_1 (sigma_1 + sigma_z) - (sigma0/g)(sigma0 - l sigma_1 sigma_z) z sign(omega)]]
+             [-sigma0 sigma_1 l - (sigma0/g) k |omega|,
+              sigma0 - l sigma_1 (sigma_1 + sigma_z) - (sigma0/g) k z sign(omega)]],
+    k = sigma0 - l sigma_1 sigma_z
 
     (rows: the gradient of h = sigma0 z + sigma_1 omega and of its Lie derivative along
     eqs. 1-2 with 1/J = l, g and sigma_1 frozen).
@@ -558,7 +611,12 @@ def observability(params, z, omega=None, g=None, sigma_1=None, *, gain=200.0, rt
     outside = np.abs(w) <= omega_eps
     degraded = (rank < 2) | (cond > cond_max) | outside
     return Observability(
-        theta=theta.reshape(shape + (2, 2)), det=_shaped(det, shape),
-        gain_factor=_shaped(gain_factor, shape), motion_factor=_shaped(motion_factor, shape),
-        cond=_shaped(cond, shape), rank=_shaped(rank, shape),
-        outside_domain=_shaped(outside, shape), degraded=_shaped(degraded, shape))
+        theta=theta.reshape(shape + (2, 2)),
+        det=_shaped(det, shape),
+        gain_factor=_shaped(gain_factor, shape),
+        motion_factor=_shaped(motion_factor, shape),
+        cond=_shaped(cond, shape),
+        rank=_shaped(rank, shape),
+        outside_domain=_shaped(outside, shape),
+        degraded=_shaped(degraded, shape),
+    )

@@ -8,12 +8,11 @@ from __future__ import annotations
 import dataclasses
 import math
 
+import lugrip
 import numpy as np
 import pytest
 from hypothesis import given
 from hypothesis import strategies as st
-
-import lugrip
 from lugrip import ContactParams, Observer, SliderModel, Status
 
 DT = 0.002
@@ -27,8 +26,17 @@ RESIN = ContactParams.preset("big_resin_block")
 # ---------------------------------------------------------------------------------------------
 
 
-def maneuvers(p, n_man, seed, *, f_range=(1.0, 10.0), peak_range=(1.2, 20.0), tau_noise=1e-5,
-              force_noise=0.005, ct_max=1.5):
+def maneuvers(
+    p,
+    n_man,
+    seed,
+    *,
+    f_range=(1.0, 10.0),
+    peak_range=(1.2, 20.0),
+    tau_noise=1e-5,
+    force_noise=0.005,
+    ct_max=1.5,
+):
     """Synthetic sliding maneuvers like the paper's Section 4: a slider about a CoR from
     rotation- to translation-dominated, pushed with a growing torque past the limit surface and
     released. Plant = lugrip.SliderModel; sensor = lugrip.sensor_wrench + white noise."""
@@ -39,8 +47,9 @@ def maneuvers(p, n_man, seed, *, f_range=(1.0, 10.0), peak_range=(1.2, 20.0), ta
         f_n = rng.uniform(*f_range)
         ct = rng.choice([-1.0, 1.0]) * ct_max * rng.uniform(0.0, 1.0)
         peak = math.exp(rng.uniform(math.log(peak_range[0]), math.log(peak_range[1])))
-        knots = np.cumsum([0.0, 0.3, rng.uniform(0.3, 1.0), rng.uniform(0.0, 0.3),
-                           rng.uniform(0.1, 0.5), 0.4])
+        knots = np.cumsum(
+            [0.0, 0.3, rng.uniform(0.3, 1.0), rng.uniform(0.0, 0.3), rng.uniform(0.1, 0.5), 0.4]
+        )
         t = np.arange(int(knots[-1] / DT)) * DT
         g = lugrip.g(p, f_n, ct)
         tau_e = np.sign(ct) * np.interp(t, knots, [0, 0, peak, peak, 0, 0]) * g
@@ -48,12 +57,17 @@ def maneuvers(p, n_man, seed, *, f_range=(1.0, 10.0), peak_range=(1.2, 20.0), ta
         tr = sim.simulate(f_n, ct, tau_e, DT)
         ft, tau = lugrip.sensor_wrench(p, f_n, ct, tr.friction_torque)
         n = t.size
-        out.append({
-            "t": t, "f_n": f_n + force_noise * rng.standard_normal(n),
-            "f_t": np.abs(ft + force_noise * rng.standard_normal(n)),
-            "tau": tau + tau_noise * rng.standard_normal(n), "omega": tr.omega, "slip": tr.slip,
-            "c_tilde": ct,
-        })
+        out.append(
+            {
+                "t": t,
+                "f_n": f_n + force_noise * rng.standard_normal(n),
+                "f_t": np.abs(ft + force_noise * rng.standard_normal(n)),
+                "tau": tau + tau_noise * rng.standard_normal(n),
+                "omega": tr.omega,
+                "slip": tr.slip,
+                "c_tilde": ct,
+            }
+        )
     return out
 
 
@@ -68,7 +82,7 @@ def patch_wrench(p, f_n, c, phi, omega, nr=200, nt=256):
     """Wrench the object exerts on the fingertip (sensor reading: f_x, f_y [N], tau [N m]) for a
     rigid rotation omega about the point (c cos phi, c sin phi): quadrature of the dry stress
     mu p v/|v| and the viscous stress beta_A v over the patch, p ~ (1 - (r/rho)^k)^(1/k)."""
-    rho = p.delta * f_n ** p.gamma
+    rho = p.delta * f_n**p.gamma
     r = (np.arange(nr) + 0.5) * rho / nr
     th = (np.arange(nt) + 0.5) * 2 * np.pi / nt
     R, TH = np.meshgrid(r, th, indexing="ij")
@@ -94,7 +108,8 @@ def steady_wrench(p, f_n, ct, y, n):
 
 
 def _ros2(z, w, h, s0, sz, s1, g, l, y):
-    """One ROS2 step (Verwer et al.): (I - gam h J) k1 = f(x); (I - gam h J) k2 = f(x + h k1) - 2 k1."""
+    """One ROS2 step (Verwer et al.):
+    (I - gam h J) k1 = f(x); (I - gam h J) k2 = f(x + h k1) - 2 k1; x += h (3 k1 + k2) / 2."""
     gam = 1.0 + 1.0 / math.sqrt(2.0)
 
     def f(z, w):
@@ -140,7 +155,10 @@ def reference_observer(p, f_n, f_t, tau, s):
     for i in range(1, len(tau)):
         bound = g[i] / s0
         z = min(max(z, -bound), bound)
-        rate = lambda w: s0 * abs(w) / g[i]  # noqa: E731
+        g_i = g[i]
+
+        def rate(w, g_i=g_i):
+            return s0 * abs(w) / g_i
 
         def needed(r):
             m = math.ceil(h * r / 2.0)
@@ -231,14 +249,21 @@ def test_sign_with_a_first_principles_sensor_wrench(omega):
     rho = lugrip.contact_radius(TABLE1, f_n)
     fx, fy, tau = patch_wrench(TABLE1, f_n, 0.7 * rho, 1.1, omega)
     n = 1000
-    log = {"t": np.arange(n) * DT, "f_n": np.full(n, f_n), "f_x": np.full(n, fx),
-           "f_y": np.full(n, fy), "tau": np.full(n, tau)}
+    log = {
+        "t": np.arange(n) * DT,
+        "f_n": np.full(n, f_n),
+        "f_x": np.full(n, fx),
+        "f_y": np.full(n, fy),
+        "tau": np.full(n, tau),
+    }
     run = Observer(TABLE1).run(log)
     assert run.omega_hat[-1] * omega > 0
     assert run.omega_hat[-1] == pytest.approx(omega, rel=0.03)
     assert run.S[-1] == pytest.approx(1.0)
     # the opposite wrench (fingertip on object) returns -omega_hat with the same S
-    flipped = Observer(TABLE1).run({**log, "f_x": -log["f_x"], "f_y": -log["f_y"], "tau": -log["tau"]})
+    flipped = Observer(TABLE1).run(
+        {**log, "f_x": -log["f_x"], "f_y": -log["f_y"], "tau": -log["tau"]}
+    )
     assert flipped.omega_hat[-1] == pytest.approx(-run.omega_hat[-1], rel=1e-12)
     assert flipped.S[-1] == pytest.approx(run.S[-1], rel=1e-12)
 
@@ -327,8 +352,12 @@ def test_observability_matrix_matches_finite_differences():
         dz, dw = _lie_jacobian_fd(TABLE1, z[i], w[i], g[i], s1[i], l[i])
         np.testing.assert_allclose(ob.theta[i, 1], [dz, dw], rtol=1e-8, atol=1e-10 * abs(dz))
         np.testing.assert_allclose(ob.theta[i, 0], [TABLE1.sigma0, s1[i]])
-    np.testing.assert_allclose(ob.det, TABLE1.sigma0**2 * ob.gain_factor * ob.motion_factor,
-                               rtol=1e-9, atol=1e-9 * np.abs(ob.theta).max() ** 2)
+    np.testing.assert_allclose(
+        ob.det,
+        TABLE1.sigma0**2 * ob.gain_factor * ob.motion_factor,
+        rtol=1e-9,
+        atol=1e-9 * np.abs(ob.theta).max() ** 2,
+    )
 
 
 def test_observability_flags_where_it_degrades():
@@ -351,7 +380,7 @@ def test_observability_flags_where_it_degrades():
 
 
 def test_observability_along_an_observer_run():
-    """Accepts an ObserverRun: stick samples (omega_hat ~ 0) and weak-viscous sliding are flagged."""
+    """Accepts an ObserverRun: stick (omega_hat ~ 0) and weak-viscous sliding are flagged."""
     ms = maneuvers(CAN, 1, seed=8, f_range=(2.0, 2.0), peak_range=(1.5, 1.5))
     run = Observer(CAN).run(concat(ms))
     ob = lugrip.observability(CAN, run)
@@ -371,14 +400,25 @@ def test_run_accepts_logs_in_several_shapes(tmp_path):
     m = ms[0]
     base = Observer(TABLE1).run({k: m[k] for k in ("t", "f_n", "f_t", "tau")})
     ang = np.linspace(0, 3, m["t"].size)
-    vec = {"t": m["t"], "f_n": m["f_n"], "f_x": m["f_t"] * np.cos(ang), "f_y": m["f_t"] * np.sin(ang),
-           "tau": m["tau"]}
-    np.testing.assert_allclose(Observer(TABLE1).run(vec).omega_hat, base.omega_hat, rtol=1e-12, atol=1e-15)
-    log = lugrip.SlidingLog.from_arrays(t=m["t"], f_n=m["f_n"], f_t=m["f_t"], tau=m["tau"], omega=m["omega"])
+    vec = {
+        "t": m["t"],
+        "f_n": m["f_n"],
+        "f_x": m["f_t"] * np.cos(ang),
+        "f_y": m["f_t"] * np.sin(ang),
+        "tau": m["tau"],
+    }
+    np.testing.assert_allclose(
+        Observer(TABLE1).run(vec).omega_hat, base.omega_hat, rtol=1e-12, atol=1e-15
+    )
+    log = lugrip.SlidingLog.from_arrays(
+        t=m["t"], f_n=m["f_n"], f_t=m["f_t"], tau=m["tau"], omega=m["omega"]
+    )
     path = tmp_path / "log.csv"
     lugrip.write_log(log, path)
     back = lugrip.read_log(path)
-    np.testing.assert_allclose(Observer(TABLE1).run(back).omega_hat, base.omega_hat, rtol=1e-9, atol=1e-12)
+    np.testing.assert_allclose(
+        Observer(TABLE1).run(back).omega_hat, base.omega_hat, rtol=1e-9, atol=1e-12
+    )
 
     @dataclasses.dataclass
     class Log:
@@ -387,9 +427,12 @@ def test_run_accepts_logs_in_several_shapes(tmp_path):
         f_t: np.ndarray
         tau: np.ndarray
 
-    assert np.array_equal(Observer(TABLE1).run(Log(m["t"], m["f_n"], m["f_t"], m["tau"])).omega_hat,
-                          base.omega_hat)
-    arr = np.zeros(m["t"].size, dtype=[("t", float), ("f_n", float), ("f_t", float), ("tau", float)])
+    assert np.array_equal(
+        Observer(TABLE1).run(Log(m["t"], m["f_n"], m["f_t"], m["tau"])).omega_hat, base.omega_hat
+    )
+    arr = np.zeros(
+        m["t"].size, dtype=[("t", float), ("f_n", float), ("f_t", float), ("tau", float)]
+    )
     for k in ("t", "f_n", "f_t", "tau"):
         arr[k] = m[k]
     assert np.array_equal(Observer(TABLE1).run(arr).omega_hat, base.omega_hat)
@@ -402,20 +445,26 @@ def test_run_restarts_at_maneuver_boundaries():
     run = Observer(TABLE1).run(log)
     starts = np.r_[0, np.cumsum([m["t"].size for m in ms])[:-1]]
     assert np.all(run.status[starts] == Status.REINITIALIZED)
-    second = Observer(TABLE1).run({k: v[starts[1]:starts[2]] for k, v in log.items()})
-    np.testing.assert_array_equal(run.omega_hat[starts[1]:starts[2]], second.omega_hat)
+    second = Observer(TABLE1).run({k: v[starts[1] : starts[2]] for k, v in log.items()})
+    np.testing.assert_array_equal(run.omega_hat[starts[1] : starts[2]], second.omega_hat)
     cont = Observer(TABLE1).run(log, reset_on_maneuver=False)
     assert np.sum(cont.status == Status.REINITIALIZED) == 1
 
 
-@pytest.mark.parametrize("log, match", [
-    ({"f_n": [1.0], "tau": [0.0]}, "f_t"),
-    ({"f_n": [1.0], "f_x": [0.1], "tau": [0.0]}, "f_t"),
-    ({"f_t": [1.0], "tau": [0.0]}, "f_n"),
-    ({"f_n": [1.0, 1.0], "f_t": [1.0], "tau": [0.0, 0.0]}, "f_t has 1"),
-    ({"t": [0.0, 0.0], "f_n": [1.0, 1.0], "f_t": [0.1, 0.1], "tau": [0.0, 0.0]}, "strictly increasing"),
-    ({"t": [0.0, np.nan], "f_n": [1.0, 1.0], "f_t": [0.1, 0.1], "tau": [0.0, 0.0]}, "row 1"),
-])
+@pytest.mark.parametrize(
+    "log, match",
+    [
+        ({"f_n": [1.0], "tau": [0.0]}, "f_t"),
+        ({"f_n": [1.0], "f_x": [0.1], "tau": [0.0]}, "f_t"),
+        ({"f_t": [1.0], "tau": [0.0]}, "f_n"),
+        ({"f_n": [1.0, 1.0], "f_t": [1.0], "tau": [0.0, 0.0]}, "f_t has 1"),
+        (
+            {"t": [0.0, 0.0], "f_n": [1.0, 1.0], "f_t": [0.1, 0.1], "tau": [0.0, 0.0]},
+            "strictly increasing",
+        ),
+        ({"t": [0.0, np.nan], "f_n": [1.0, 1.0], "f_t": [0.1, 0.1], "tau": [0.0, 0.0]}, "row 1"),
+    ],
+)
 def test_run_rejects_malformed_logs(log, match):
     with pytest.raises(ValueError, match=match):
         Observer(TABLE1).run(log)
@@ -424,14 +473,26 @@ def test_run_rejects_malformed_logs(log, match):
 def test_settings_validation_and_modes():
     obs = Observer(TABLE1)
     s = obs.settings
-    assert (s["integrator"], s["gain_mode"], s["bandwidth"], s["torque_cutoff"]) == ("rosenbrock", "bandwidth", 100.0, 2.0)
+    assert (s["integrator"], s["gain_mode"], s["bandwidth"], s["torque_cutoff"]) == (
+        "rosenbrock",
+        "bandwidth",
+        100.0,
+        2.0,
+    )
     assert Observer(TABLE1, gain=300.0).settings["gain_mode"] == "fixed"
     assert Observer(TABLE1, gain=300.0, bandwidth=50.0).settings["gain_mode"] == "bandwidth"
-    assert Observer("aluminium_can", integrator="rk4_adaptive", f_n_min=0.1).settings["f_n_min"] == 0.1
-    for kwargs, field in [({"dt": 0.0}, "dt"), ({"bandwidth": -1.0}, "bandwidth"),
-                          ({"gain_max": 0.5}, "gain_max"), ({"torque_cutoff": -2.0}, "torque_cutoff"),
-                          ({"max_dt_gap": 0.001}, "max_dt_gap"), ({"f_n_min": -1.0}, "cor.f_n_min"),
-                          ({"max_substeps": 0}, "max_substeps")]:
+    assert (
+        Observer("aluminium_can", integrator="rk4_adaptive", f_n_min=0.1).settings["f_n_min"] == 0.1
+    )
+    for kwargs, field in [
+        ({"dt": 0.0}, "dt"),
+        ({"bandwidth": -1.0}, "bandwidth"),
+        ({"gain_max": 0.5}, "gain_max"),
+        ({"torque_cutoff": -2.0}, "torque_cutoff"),
+        ({"max_dt_gap": 0.001}, "max_dt_gap"),
+        ({"f_n_min": -1.0}, "cor.f_n_min"),
+        ({"max_substeps": 0}, "max_substeps"),
+    ]:
         with pytest.raises(ValueError, match=field):
             Observer(TABLE1, **kwargs)
     with pytest.raises(ValueError, match="integrator"):
@@ -492,20 +553,38 @@ def test_sensor_wrench_round_trips_through_the_cor_estimate():
 
 
 _values = st.one_of(
-    st.floats(-20.0, 20.0), st.floats(-1e-3, 1e-3),
-    st.sampled_from([0.0, -0.0, math.nan, math.inf, -math.inf, 1e300, -1e300, 5e-324]))
+    st.floats(-20.0, 20.0),
+    st.floats(-1e-3, 1e-3),
+    st.sampled_from([0.0, -0.0, math.nan, math.inf, -math.inf, 1e300, -1e300, 5e-324]),
+)
 
 
-@given(st.lists(st.tuples(_values, _values, _values, st.sampled_from([None, DT, 0.0, -DT, 0.5, math.nan])),
-                min_size=1, max_size=80),
-       st.sampled_from(["rosenbrock", "implicit", "rk4", "rk4_adaptive"]))
+@given(
+    st.lists(
+        st.tuples(_values, _values, _values, st.sampled_from([None, DT, 0.0, -DT, 0.5, math.nan])),
+        min_size=1,
+        max_size=80,
+    ),
+    st.sampled_from(["rosenbrock", "implicit", "rk4", "rk4_adaptive"]),
+)
 def test_random_samples_keep_outputs_finite_and_bounded(samples, integrator):
     """Any sequence of samples (NaN, Inf, zero/negative f_n, huge values, bad dt): outputs finite,
     S in [0, 1], |sigma0 z_hat| <= g, statuses valid."""
     obs = Observer(TABLE1, integrator=integrator)
     for f_n, f_t, tau, dt in samples:
         s = obs.step(f_n, f_t, tau, dt)
-        values = [s.omega_hat, s.z_hat, s.S, s.c_tilde, s.c, s.g, s.sigma_1, s.y, s.gain, s.omega_resolution]
+        values = [
+            s.omega_hat,
+            s.z_hat,
+            s.S,
+            s.c_tilde,
+            s.c,
+            s.g,
+            s.sigma_1,
+            s.y,
+            s.gain,
+            s.omega_resolution,
+        ]
         assert all(math.isfinite(v) for v in values)
         assert 0.0 <= s.S <= 1.0
         assert TABLE1.sigma0 * abs(s.z_hat) <= s.g * (1 + 1e-12)
