@@ -407,14 +407,18 @@ void bench_cor(std::vector<Row>& rows, std::mt19937& rng, bool quick, const char
 template <class Make>
 Row time_construction(const std::string& name, const std::string& detail, int reps, Make&& make) {
   std::vector<double> ms;
+  ms.reserve(reps);
   make();  // warm-up
+  const long alloc0 = g_allocations.load();
   for (int r = 0; r < reps; ++r) {
     const auto t0 = Clock::now();
     make();
     const auto t1 = Clock::now();
     ms.push_back(ns_between(t0, t1) * 1e-6);
   }
+  const long alloc1 = g_allocations.load();
   Row row{"construct", name, detail, summarize(std::move(ms), reps)};
+  row.batched.allocations = (alloc1 - alloc0) / reps;  // per construction (allowed there)
   row.ms = true;
   return row;
 }

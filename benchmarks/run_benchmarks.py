@@ -365,18 +365,19 @@ def write_report(path: Path, cpp: dict, py: dict, api: dict, chk: dict, meta: di
     # --- construction
     w("## Construction")
     w("")
-    w("| object | median | p99 | worst | builds |")
-    w("|---|---|---|---|---|")
+    w("| object | median | p99 | worst | builds | heap allocations per build |")
+    w("|---|---|---|---|---|---|")
     for r in C:
         if r["group"] == "construct":
             s = r["stats"]
             w(
-                f"| C++ `{r['name']}` | {s['median_ms']:.2f} ms | {s['p99_ms']:.2f} ms | {s['worst_ms']:.2f} ms | {s['calls']} |"
+                f"| C++ `{r['name']}` | {s['median_ms']:.2f} ms | {s['p99_ms']:.2f} ms "
+                f"| {s['worst_ms']:.2f} ms | {s['calls']} | {s['allocations']} |"
             )
     q = find(P, "construct", "LsTable(k=4)")
     qs = q["stats"]
     c4 = find(C, "construct", "LimitSurface(k=4)")["stats"]
-    w(f"| scipy LS table, k = 4 ({q['method']}) | {qs['median_ms'] / 1e3:.1f} s | | | 1 |")
+    w(f"| scipy LS table, k = 4 ({q['method']}) | {qs['median_ms'] / 1e3:.1f} s | | | 1 | |")
     w("")
     w(
         f"C++ `LimitSurface(4)` vs the scipy table: {fmt_ratio(qs['median_ms'] / c4['median_ms'])} faster "
