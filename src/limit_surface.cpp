@@ -46,9 +46,9 @@ double shape_factor(double k) {
 }
 
 LimitSurface::LimitSurface(double k, int intervals) : k_(k), n_(intervals > 0 ? intervals : 256) {
-  if (std::isnan(k) || !(k > 0.0))
+  if (std::isnan(k) || !(k >= kMinPressureExponent))
     throw std::invalid_argument("LimitSurface: k = " + std::to_string(k) +
-                                ": the pressure exponent must be > 0 (inf for uniform pressure)");
+                                ": the pressure exponent must be >= 0.5 (inf for uniform pressure)");
   if (n_ < 16 || n_ > 100000) throw std::invalid_argument("LimitSurface: intervals must be in [16, 1e5]");
   xi_ = shape_factor(k);
   if (std::isinf(k)) {
@@ -68,6 +68,18 @@ LimitSurface::LimitSurface(double k, int intervals) : k_(k), n_(intervals > 0 ? 
   }
   const double alpha = std::isinf(k) ? 0.0 : 1.0 / k;
   detail::gauss_gegenbauer(16, alpha, gj_x_, gj_w_);
+  // For k not an even integer, (1 - r^k) has a cusp |r|^k where a chord passes the disc centre;
+  // those chords are split at their midpoint (the point nearest the centre) and each half is
+  // integrated with y = s^2 (which smooths the cusp) and the one-sided rim weight (1 - s)^(1/k).
+  split_chords_ = !std::isinf(k) && !(k == std::floor(k) && std::fmod(k, 2.0) == 0.0);
+  if (split_chords_) {  // store y = s^2 and the node's full weight in half_x_, half_w_
+    detail::gauss_jacobi(8, alpha, 0.0, half_x_, half_w_);
+    for (size_t j = 0; j < half_x_.size(); ++j) {
+      const double s = 0.5 * (1.0 + half_x_[j]), y = s * s;
+      half_w_[j] *= std::pow(2.0, -alpha) * s * std::pow((1.0 + s) * (1.0 + y), alpha);
+      half_x_[j] = y;
+    }
+  }
   detail::gauss_gegenbauer(48, 0.0, gl_x_, gl_w_);
   detail::gauss_gegenbauer(160, 0.0, near_x_, near_w_);
 
@@ -124,6 +136,7 @@ LsPoint LimitSurface::quad(double a, const std::vector<double>& ox, const std::v
   const double lexp = uniform ? 1.0 : 1.0 + 2.0 / k_;
   const double half_k = 0.5 * k_, inv_k = uniform ? 0.0 : 1.0 / k_;
   const bool hertz = (k_ == 2.0);
+  const int even_k = (!uniform && !split_chords_ && k_ <= 64.0) ? static_cast<int>(k_) : 0;
   double sf = 0.0, st = 0.0, sd = 0.0;
   const int no = static_cast<int>(ox.size()), ni = static_cast<int>(gj_x_.size());
   for (int io = 0; io < no; ++io) {
@@ -145,20 +158,37 @@ LsPoint LimitSurface::quad(double a, const std::vector<double>& ox, const std::v
     if (half <= 0.0) continue;
     const double mid = -a * cphi;
     double i0 = 0.0, i1 = 0.0, i2 = 0.0;
-    for (int j = 0; j < ni; ++j) {
-      const double t = mid + half * gj_x_[j];
-      double q = 1.0;
-      if (!uniform && !hertz) {
-        double u = a * a + 2.0 * a * t * cphi + t * t;  // r^2 along the chord
-        u = std::fmin(std::fmax(u, 0.0), 1.0);
-        const double om = 1.0 - u;
-        const double h = om < 1e-14 ? half_k : -std::expm1(half_k * std::log(u)) / om;
-        q = std::pow(h, inv_k);
+    auto q_of = [&](double t) {  // (h_k(r^2))^(1/k) at chord position t
+      if (uniform || hertz) return 1.0;
+      double u = a * a + 2.0 * a * t * cphi + t * t;  // r^2 along the chord
+      u = std::fmin(std::fmax(u, 0.0), 1.0);
+      if (even_k > 0) {  // h_k(u) = 1 + u + ... + u^(k/2 - 1)
+        double h = 1.0;
+        for (int i = 1; i < even_k / 2; ++i) h = 1.0 + u * h;
+        return even_k == 4 ? std::sqrt(std::sqrt(h)) : std::pow(h, inv_k);
       }
-      const double wq = gj_w_[j] * q;
-      i0 += wq;
-      i1 += wq * t;
-      i2 += wq * t * t;
+      const double om = 1.0 - u;
+      const double h = om < 1e-14 ? half_k : -std::expm1(half_k * std::log(u)) / om;
+      return std::pow(h, inv_k);
+    };
+    if (split_chords_) {
+      for (size_t j = 0; j < half_x_.size(); ++j) {
+        for (double side : {-1.0, 1.0}) {
+          const double t = mid + side * half * half_x_[j];
+          const double wq = half_w_[j] * q_of(t);
+          i0 += wq;
+          i1 += wq * t;
+          i2 += wq * t * t;
+        }
+      }
+    } else {
+      for (int j = 0; j < ni; ++j) {
+        const double t = mid + half * gj_x_[j];
+        const double wq = gj_w_[j] * q_of(t);
+        i0 += wq;
+        i1 += wq * t;
+        i2 += wq * t * t;
+      }
     }
     const double lf = std::pow(half, lexp);
     i0 *= lf;

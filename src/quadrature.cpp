@@ -94,4 +94,31 @@ void gauss_gegenbauer(int n, double alpha, std::vector<double>& x, std::vector<d
   if (n % 2 == 1) x[n / 2] = 0.0;
 }
 
+void gauss_jacobi(int n, double alpha, double beta, std::vector<double>& x, std::vector<double>& w) {
+  if (n < 1 || !(alpha > -1.0) || !(beta > -1.0)) throw std::invalid_argument("gauss_jacobi: bad arguments");
+  const double ab = alpha + beta;
+  std::vector<double> d(n), e(n > 1 ? n - 1 : 0), first;
+  for (int j = 0; j < n; ++j) {
+    const double s = 2.0 * j + ab;
+    d[j] = (j == 0) ? (beta - alpha) / (ab + 2.0) : (beta * beta - alpha * alpha) / (s * (s + 2.0));
+  }
+  for (int j = 1; j < n; ++j) {
+    const double jj = j, s = 2.0 * jj + ab;
+    e[j - 1] = std::sqrt(4.0 * jj * (jj + alpha) * (jj + beta) * (jj + ab) / (s * s * (s + 1.0) * (s - 1.0)));
+  }
+  tridiagonal_eigen(d, e, first);
+  // mu0 = int (1-x)^alpha (1+x)^beta dx = 2^(alpha+beta+1) B(alpha+1, beta+1)
+  const double mu0 = std::exp((ab + 1.0) * std::log(2.0) + std::lgamma(alpha + 1.0) + std::lgamma(beta + 1.0) -
+                              std::lgamma(ab + 2.0));
+  std::vector<int> order(n);
+  std::iota(order.begin(), order.end(), 0);
+  std::sort(order.begin(), order.end(), [&](int a, int b) { return d[a] < d[b]; });
+  x.resize(n);
+  w.resize(n);
+  for (int i = 0; i < n; ++i) {
+    x[i] = d[order[i]];
+    w[i] = mu0 * first[order[i]] * first[order[i]];
+  }
+}
+
 }  // namespace lugrip::detail

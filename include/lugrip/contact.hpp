@@ -34,8 +34,6 @@ class ContactModel {
   //! |c~| on the limit surface for a given |sigma| (eq. 13, first line); monotone inverse of
   //! sigma_LS, not clipped. Bracketed safeguarded Newton; `iterations` (optional) counts steps.
   double invert_sigma(double sigma_abs, int* iterations = nullptr) const noexcept;
-  //! Root of h(a) = f - F(a) - 2 xi a (t - T(a)) on [0, c_max] (eq. 13, second line,
-  //! MODEL.md 5.4); returns c_max when h(c_max) > 0.
   //! Inverse of the CoR estimation, for simulators and tests: the sensor-convention wrench
   //! (f_t >= 0 [N], tau [N m]) whose estimated CoR has |c~| = |c_tilde| and whose friction
   //! torque about the CoR, tau - c f_t, equals `y` [N m]. The CoR side follows the sign of y
@@ -44,6 +42,8 @@ class ContactModel {
   //! along (2 xi a, 1) (eqs. 9-10). Exact round trip with CorEstimator for |c~| < c_max.
   void wrench_at(double f_n, double c_tilde, double y, double& f_t, double& tau) const noexcept;
 
+  //! Root of h(a) = f - F(a) - 2 xi a (t - T(a)) on [0, c_max] (eq. 13, second line,
+  //! MODEL.md 5.4); returns c_max when h(c_max) > 0.
   //! `guess` (optional, e.g. the inside-LS estimate) starts the iteration.
   double solve_outside(double ft_abs, double tau_abs, int* iterations = nullptr,
                        double guess = -1.0) const noexcept;

@@ -5,6 +5,10 @@
 
 namespace lugrip {
 
+//! Smallest supported pressure exponent. Below it the pressure is a sharp central peak
+//! (xi -> 0) that the fixed-size tables cannot resolve to 1e-6.
+inline constexpr double kMinPressureExponent = 0.5;
+
 //! Torsional shape factor xi(k) = (3/4) Gamma(3/k)^2 / (Gamma(2/k) Gamma(4/k)), so that
 //! tau_max = mu xi rho f_n. xi(2) = 3 pi/16, xi(4) = 0.6354098, xi(inf) = 2/3.
 //! k must be > 0 (std::numeric_limits<double>::infinity() for a uniform pressure).
@@ -25,13 +29,16 @@ struct LsPoint {
 //! 1-D reduction (CoR-centred chords) on two tables, a in [0, 1] and u = 1/a in [0, 1], values
 //! and exact derivatives at every node; evaluation is cubic Hermite interpolation: constant
 //! time, no allocation, C1 everywhere, exact at c~ = 0 and c~ -> inf. Absolute error <= 1e-6
-//! for k >= 1 (tests/python/test_limit_surface.py against an independent quadrature).
+//! (tests against an independent quadrature for k = 1.5, 2, 3, 4, 6, 8, inf; about 1e-7 or
+//! better). For k not an even integer the chords are split at the point nearest the disc
+//! centre, where the pressure has a |r|^k cusp.
 //!
 //! Sign convention (MODEL.md 3.2): f~* is odd with the sign opposite to c~, tau~* is even
 //! and positive.
 class LimitSurface {
  public:
-  //! k: pressure exponent, > 0, may be +infinity. Throws std::invalid_argument otherwise.
+  //! k: pressure exponent, >= kMinPressureExponent (0.5), may be +infinity. Throws
+  //! std::invalid_argument otherwise.
   explicit LimitSurface(double k = 4.0, int intervals = 0);
 
   double k() const noexcept { return k_; }
@@ -67,6 +74,8 @@ class LimitSurface {
   double k_, xi_, p_k_, m_k_, s_k_, a_f_, a_tau_;
   int n_;
   std::vector<double> gj_x_, gj_w_;  // Gauss-Jacobi (alpha = beta = 1/k) on [-1, 1]
+  std::vector<double> half_x_, half_w_;  // half-chord rule: y = s^2 and weights (alpha = 1/k)
+  bool split_chords_ = false;  // k not an even integer: |r|^k has a cusp at the disc centre
   std::vector<double> gl_x_, gl_w_;  // Gauss-Legendre on [-1, 1] (outer integral)
   std::vector<double> near_x_, near_w_;  // finer outer rule for nodes near the rim
   std::vector<double> inner_;  // (n+1) x 4: F, h dF/da, T, h dT/da at a = i/n (h = 1/n)

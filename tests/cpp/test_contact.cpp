@@ -135,7 +135,7 @@ TEST(ContactParamsValidation, OneBadFieldAtATime) {
       {"sigma_z", &ContactParams::sigma_z, {-1e-9, kNaN, kInf}, {0.0, 2.0}},
       {"delta", &ContactParams::delta, {0.0, -0.0018, 1.0, kNaN, kInf}, {1e-6, 0.0018}},
       {"gamma", &ContactParams::gamma, {0.0, -0.1, 1.0 / 3.0, 0.5, kNaN, kInf}, {1e-6, 0.254, 0.333}},
-      {"k", &ContactParams::k, {0.0, -4.0, kNaN, -kInf}, {0.5, 2.0, 4.0, kInf}},
+      {"k", &ContactParams::k, {0.0, 0.4, -4.0, kNaN, -kInf}, {0.5, 2.0, 4.0, kInf}},
       {"c_max", &ContactParams::c_max, {0.0, -1.5, kNaN, kInf, 1e4}, {1e-3, 1.5, 1000.0}},
   };
   for (const Case& c : cases) {

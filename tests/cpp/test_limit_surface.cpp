@@ -124,6 +124,8 @@ TEST(ShapeFactor, RejectsInvalidK) {
     EXPECT_THROW(shape_factor(k), std::invalid_argument) << "k = " << k;
     EXPECT_THROW(LimitSurface{k}, std::invalid_argument) << "k = " << k;
   }
+  EXPECT_THROW(LimitSurface{0.4}, std::invalid_argument);  // below kMinPressureExponent
+  EXPECT_NO_THROW(LimitSurface{0.5});
   EXPECT_THROW(LimitSurface(4.0, 3), std::invalid_argument);  // too few table intervals
   EXPECT_NO_THROW(LimitSurface{kInf});
 }
@@ -245,17 +247,9 @@ void check_reference(double k, double tol_table, double tol_integrate) {
 TEST(LimitSurfaceReference, IndependentQuadratureEveryK) {
   const std::vector<double> ks = reference_ks();
   ASSERT_GE(ks.size(), 5u);
-  for (double k : ks) {
-    if (k < 2.0) continue;  // see KnownGapBelowK2 below
-    check_reference(k, 1e-6, 1e-6);
-  }
+  // Non-even k (1.5, 3) exercise the split-chord rule for the |r|^k cusp at the disc centre.
+  for (double k : ks) check_reference(k, 1e-6, 1e-6);
 }
-
-// The header documents <= 1e-6 for k >= 1, but for non-even k < 2 the chord rule does not
-// resolve the |r|^k cusp of the pressure at the disc centre: k = 1.5 is off by 2.1e-5
-// (a near-constant relative error of 2e-5 in F). Reported; enable once the quadrature splits
-// the chords at the point closest to the centre.
-TEST(LimitSurfaceReference, DISABLED_KnownGapBelowK2) { check_reference(1.5, 1e-6, 1e-6); }
 
 // ----------------------------------------------------- parity and signs (MODEL.md 3.2) ----
 

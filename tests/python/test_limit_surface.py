@@ -29,11 +29,7 @@ SPEC_TABLE = np.array([
 
 @pytest.mark.parametrize(
     "k",
-    [pytest.param(
-        1.5,
-        marks=pytest.mark.xfail(strict=True, reason="chord quadrature misses the |r|^k cusp at the "
-                                "disc centre for non-even k < 2: error 2.1e-5 (reported)"))]
-    + [k for k in REF_KS if k != 1.5],
+    list(REF_KS),
     ids=lambda k: f"k={k:g}",
 )
 def test_reference_every_k(k, ls_reference, lsk):

@@ -28,7 +28,7 @@ BAD = {
     "sigma_z": [-2.0, math.nan, -math.inf],
     "delta": [0.0, -0.0018, 1.0, math.nan, math.inf],
     "gamma": [0.0, -0.1, 1 / 3, 0.5, math.nan],
-    "k": [0.0, -4.0, math.nan, -math.inf],
+    "k": [0.0, 0.4, -4.0, math.nan, -math.inf],
     "c_max": [0.0, -1.5, math.nan, math.inf, 1e4],
 }
 
@@ -46,7 +46,7 @@ def valid_rule(name: str, v: float) -> bool:
     if name == "gamma":
         return 0 < v < 1 / 3
     if name == "k":
-        return v > 0
+        return v >= 0.5
     if name == "c_max":
         return math.isfinite(v) and 0 < v <= 1000
     raise KeyError(name)
