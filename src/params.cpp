@@ -2,6 +2,7 @@
 
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
 #include <stdexcept>
 
 #include "lugrip/limit_surface.hpp"
@@ -10,9 +11,13 @@
 namespace lugrip {
 
 namespace {
+// Shortest decimal that reads back as the same double (0.4, not 0.40000000000000002).
 std::string fmt(double v) {
   char buf[40];
-  std::snprintf(buf, sizeof buf, "%.17g", v);
+  for (int precision = 6; precision <= 17; ++precision) {
+    std::snprintf(buf, sizeof buf, "%.*g", precision, v);
+    if (std::strtod(buf, nullptr) == v || std::isnan(v)) break;
+  }
   return buf;
 }
 }  // namespace
