@@ -199,7 +199,7 @@ TEST(ContactParamsValidation, PrintableAndStatusStrings) {
   ContactParams p = table1_params();
   p.k = kInf;
   const std::string s = to_string(p);
-  for (const char* f : {"mu=0.47,", "beta_a=4900000000,", "sigma0=", "sigma_z=", "delta=", "gamma=", "k=float('inf')",
+  for (const char* f : {"mu=0.47,", "beta_a=4.9e+09,", "sigma0=", "sigma_z=", "delta=", "gamma=", "k=float('inf')",
                         "c_max=1.5"})
     EXPECT_NE(s.find(f), std::string::npos) << f << " in " << s;
   std::vector<std::string> seen;
