@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import atexit
 import enum
 import functools
 from dataclasses import dataclass
@@ -119,6 +120,11 @@ class LimitSurface:
 @functools.lru_cache(maxsize=32)
 def _model(params: ContactParams) -> _core.ContactModel:
     return _core.ContactModel(params.to_core())
+
+
+# Release the cached C++ models before the interpreter tears the extension down (otherwise
+# nanobind reports them as leaked at exit).
+atexit.register(_model.cache_clear)
 
 
 def _as_params(params) -> ContactParams:
