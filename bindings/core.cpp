@@ -825,4 +825,111 @@ NB_MODULE(_core, m) {
         return d;
       }, "f_n"_a, "f_t"_a, "tau"_a, "dt"_a, "Runs step() over 1-D arrays in C++ (dt 0: nominal); returns a dict of arrays.");
   // ===== end of observer block =============================================================
+
+  // --- closed loop ---------------------------------------------------------------------------
+  // Closed-loop simulation (include/lugrip/closed_loop.hpp): config, and a batch run() that
+  // loops in C++ (GIL released) and hands the columns over to numpy without copying.
+  {
+    nb::enum_<ControllerKind>(m, "ControllerKind", "Law computing the grasp-force command.")
+        .value("Lugrip", ControllerKind::Lugrip)
+        .value("ConstantForce", ControllerKind::ConstantForce)
+        .value("FrictionCone", ControllerKind::FrictionCone);
+    nb::enum_<ModeAction>(m, "ModeAction", "Scheduled controller action.")
+        .value("Pivot", ModeAction::Pivot)
+        .value("SlippingAvoidance", ModeAction::SlippingAvoidance)
+        .value("DynamicOn", ModeAction::DynamicOn)
+        .value("DynamicOff", ModeAction::DynamicOff);
+    nb::class_<ModeEvent>(m, "ModeEvent")
+        .def(nb::init<>())
+        .def_rw("time", &ModeEvent::time)
+        .def_rw("action", &ModeEvent::action);
+    nb::class_<ClosedLoopConfig>(m, "ClosedLoopConfig")
+        .def(nb::init<>())
+        .def_rw("plant", &ClosedLoopConfig::plant)
+        .def_rw("observer", &ClosedLoopConfig::observer)
+        .def_rw("controller", &ClosedLoopConfig::controller)
+        .def_rw("kind", &ClosedLoopConfig::kind)
+        .def_rw("controller_start", &ClosedLoopConfig::controller_start)
+        .def_rw("constant_force", &ClosedLoopConfig::constant_force)
+        .def_rw("cone_margin", &ClosedLoopConfig::cone_margin)
+        .def_rw("cone_release_rate", &ClosedLoopConfig::cone_release_rate)
+        .def("clear_schedule", [](ClosedLoopConfig& c) { c.schedule.clear(); })
+        .def("add_event", [](ClosedLoopConfig& c, double t, ModeAction a) { c.schedule.push_back(ModeEvent{t, a}); },
+             "time"_a, "action"_a)
+        .def_prop_ro("n_events", [](const ClosedLoopConfig& c) { return c.schedule.size(); });
+    m.def("validate_closed_loop_config", [](const ClosedLoopConfig& c) {
+      std::string msg;
+      validate(c, &msg);
+      return msg;
+    }, "Empty string when valid, else one line per problem.");
+
+    nb::class_<ClosedLoop>(m, "ClosedLoop")
+        .def(nb::init<const ClosedLoopConfig&>(), "config"_a)
+        .def("reset", &ClosedLoop::reset)
+        .def_prop_ro("time", &ClosedLoop::time)
+        .def_prop_ro("samples", &ClosedLoop::samples)
+        .def_prop_ro("sample_period", &ClosedLoop::sample_period)
+        .def_prop_ro("plant_state", [](const ClosedLoop& c) { return c.plant().state(); })
+        .def_prop_ro("mode", [](const ClosedLoop& c) { return static_cast<int>(c.controller().mode()); })
+        .def("run", [](ClosedLoop& c, int64_t samples) {
+          if (samples < 0) throw std::invalid_argument("samples must be >= 0");
+          auto* log = new ClosedLoopLog();
+          try {
+            nb::gil_scoped_release release;
+            c.run(samples, *log);
+          } catch (...) {
+            delete log;
+            throw;
+          }
+          // One capsule owns the log; every column is a view into it.
+          nb::capsule owner(log, [](void* p) noexcept { delete static_cast<ClosedLoopLog*>(p); });
+          nb::dict d;
+          auto put = [&](const char* name, auto& v) {
+            using T = typename std::decay_t<decltype(v)>::value_type;
+            d[name] = nb::ndarray<nb::numpy, T, nb::ndim<1>>(v.data(), {v.size()}, owner);
+          };
+          put("t", log->t);
+          put("command", log->command);
+          put("static_force", log->static_force);
+          put("dynamic_force", log->dynamic_force);
+          put("f_n", log->f_n);
+          const char* suffix[] = {"_0", "_1"};
+          for (int i = 0; i < 2; ++i) {
+            const std::string s = suffix[i];
+            put(("f_n_meas" + s).c_str(), log->f_n_meas[i]);
+            put(("f_t_meas" + s).c_str(), log->f_t_meas[i]);
+            put(("tau_meas" + s).c_str(), log->tau_meas[i]);
+            put(("f_t_true" + s).c_str(), log->f_t_true[i]);
+            put(("tau_true" + s).c_str(), log->tau_true[i]);
+            put(("omega_hat" + s).c_str(), log->omega_hat[i]);
+            put(("S" + s).c_str(), log->slippage[i]);
+            put(("c_tilde" + s).c_str(), log->c_tilde[i]);
+            put(("omega_true" + s).c_str(), log->omega_true[i]);
+            put(("c_tilde_true" + s).c_str(), log->c_tilde_true[i]);
+            put(("observer_status" + s).c_str(), log->observer_status[i]);
+          }
+          put("slip_x", log->slip_x);
+          put("slip_y", log->slip_y);
+          put("slip", log->slip);
+          put("rotation", log->rotation);
+          put("theta", log->theta);
+          put("cog_x", log->cog_x);
+          put("cog_y", log->cog_y);
+          put("gripper_y", log->gripper_y);
+          put("ext_fx", log->ext_fx);
+          put("ext_fy", log->ext_fy);
+          put("ext_tau", log->ext_tau);
+          put("mode", log->mode);
+          put("pivot_end", log->pivot_end);
+          put("command_issued", log->command_issued);
+          put("pivot_finished", log->pivot_finished);
+          put("supported", log->supported);
+          put("dropped", log->dropped);
+          put("finite", log->finite);
+          return d;
+        }, "samples"_a,
+           "Runs `samples` closed-loop samples in C++ from the current state; returns a dict of "
+           "arrays (per-finger columns suffixed _0/_1; flags as uint8).");
+  }
+  // --- end of closed loop block --------------------------------------------------------------
 }

@@ -1,6 +1,7 @@
 // lugrip — model-based slip detection, slip avoidance and pivoting for force/torque fingertips.
 #pragma once
 
+#include "lugrip/closed_loop.hpp"
 #include "lugrip/contact.hpp"
 #include "lugrip/grasp_controller.hpp"
 #include "lugrip/grasp_plant.hpp"
