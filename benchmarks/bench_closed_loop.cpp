@@ -1,0 +1,261 @@
+// lugrip — closed-loop simulation speed (issue 5): steps per second on one core and the ratio to
+// real time, for the lumped-slider plant and the distributed (patch) contact plant.
+//
+//   bench_closed_loop [--quick] [--json]
+//
+// One closed-loop step = one sensor sample (500 Hz): the plant advanced by one sample period
+// (two 1 kHz plant steps, or one with the 500 Hz lumped variant), both fingertip observers and
+// the grasp controller (MODEL.md 9.7). "x real time" = simulated seconds per wall-clock second.
+// The scenario is a lift of a 0.5 kg block grasped beside its CoG with a push (every branch:
+// support, lift-off transient, hold, disturbance), repeated from reset() until the time budget
+// is spent. Components are timed alone with the same inputs (plant open loop at a constant
+// command; one observer replaying the recorded sensor samples; the controller replaying the
+// recorded observer outputs). Timing: std::chrono::steady_clock around whole runs (best and
+// median of the repetitions), plus a per-step pass (each step timed alone, clock overhead
+// subtracted) for p99 / worst. Benchmarks are not tests: nothing here asserts a timing; the
+// allocation count of the timed loops is reported.
+#include <algorithm>
+#include <atomic>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <cstring>
+#include <new>
+#include <string>
+#include <vector>
+
+#include "lugrip/closed_loop.hpp"
+
+#ifndef LUGRIP_BENCH_CXX_FLAGS
+#define LUGRIP_BENCH_CXX_FLAGS "unknown"
+#endif
+#ifndef LUGRIP_BENCH_BUILD_TYPE
+#define LUGRIP_BENCH_BUILD_TYPE "unknown"
+#endif
+
+namespace {
+std::atomic<long> g_allocations{0};
+}
+void* operator new(std::size_t n) {
+  g_allocations.fetch_add(1, std::memory_order_relaxed);
+  if (void* p = std::malloc(n ? n : 1)) return p;
+  throw std::bad_alloc();
+}
+void* operator new[](std::size_t n) { return operator new(n); }
+void operator delete(void* p) noexcept { std::free(p); }
+void operator delete[](void* p) noexcept { std::free(p); }
+void operator delete(void* p, std::size_t) noexcept { std::free(p); }
+void operator delete[](void* p, std::size_t) noexcept { std::free(p); }
+
+using namespace lugrip;
+
+namespace {
+
+using Clock = std::chrono::steady_clock;
+volatile double g_sink = 0.0;
+
+double seconds_between(Clock::time_point a, Clock::time_point b) {
+  return std::chrono::duration<double>(b - a).count();
+}
+
+ClosedLoopConfig scenario(PlantModel model, double plant_rate) {
+  ClosedLoopConfig c;
+  c.plant.contact = object_params("small_resin_block");
+  c.plant.model = model;
+  c.plant.rate = plant_rate;
+  c.plant.object.mass = 0.3;
+  c.plant.object.inertia = 6e-4;
+  c.plant.object.cog_x = 0.003;
+  c.plant.actuator.f_init = 2.0;
+  c.plant.support = true;
+  c.plant.moves.push_back(GripperMove{0.5, 1.5, 0.0, 0.05});
+  c.plant.disturbances.push_back(Disturbance{4.0, 0.5, PulseShape::HalfSine, 0.0, -1.0, 0.0, 0.0, 0.0});
+  c.observer.cor_sign_sigmas = 100.0;
+  return c;
+}
+
+struct Result {
+  std::string name;
+  double steps_per_s_best = 0, steps_per_s_median = 0, realtime_best = 0, realtime_median = 0;
+  double plant_steps_per_sample = 0;
+  double p50_ns = 0, p99_ns = 0, worst_ns = 0;
+  long steps = 0, allocations = 0;
+  int cells = 0;
+};
+
+double percentile(std::vector<double>& v, double q) {
+  if (v.empty()) return 0.0;
+  const size_t i = std::min(v.size() - 1, static_cast<size_t>(q * (v.size() - 1) + 0.5));
+  std::nth_element(v.begin(), v.begin() + static_cast<long>(i), v.end());
+  return v[i];
+}
+
+// Whole runs of `samples` closed-loop steps from reset(), repeated `reps` times.
+Result bench_loop(const char* name, const ClosedLoopConfig& cfg, long samples, int reps) {
+  ClosedLoop loop(cfg);
+  ClosedLoopSample s;
+  Result r;
+  r.name = name;
+  r.cells = loop.plant().cells();
+  r.plant_steps_per_sample = loop.plant().steps_per_sample();
+  std::vector<double> rates;
+  rates.reserve(static_cast<size_t>(reps));
+  long allocations = 0;
+  for (int k = 0; k < reps; ++k) {
+    loop.reset();
+    const long a0 = g_allocations.load();
+    const auto t0 = Clock::now();
+    for (long n = 0; n < samples; ++n) loop.step(s);
+    const auto t1 = Clock::now();
+    allocations += g_allocations.load() - a0;
+    g_sink = g_sink + s.command;
+    rates.push_back(samples / seconds_between(t0, t1));
+    r.steps += samples;
+  }
+  r.allocations = allocations;
+  std::sort(rates.begin(), rates.end());
+  r.steps_per_s_best = rates.back();
+  r.steps_per_s_median = rates[rates.size() / 2];
+  r.realtime_best = r.steps_per_s_best * loop.sample_period();
+  r.realtime_median = r.steps_per_s_median * loop.sample_period();
+  // per-step pass: every step timed alone (overhead of an empty timed region subtracted)
+  std::vector<double> empty(2000);
+  for (double& e : empty) {
+    const auto a = Clock::now();
+    const auto b = Clock::now();
+    e = std::chrono::duration<double, std::nano>(b - a).count();
+  }
+  const double overhead = percentile(empty, 0.5);
+  std::vector<double> each(static_cast<size_t>(samples));
+  loop.reset();
+  for (long n = 0; n < samples; ++n) {
+    const auto a = Clock::now();
+    loop.step(s);
+    const auto b = Clock::now();
+    each[static_cast<size_t>(n)] = std::max(0.0, std::chrono::duration<double, std::nano>(b - a).count() - overhead);
+  }
+  r.worst_ns = *std::max_element(each.begin(), each.end());
+  r.p99_ns = percentile(each, 0.99);
+  r.p50_ns = percentile(each, 0.5);
+  return r;
+}
+
+// Components alone on the same data: plant open loop, one observer, the controller.
+struct Parts {
+  double plant_ns = 0, observer_ns = 0, controller_ns = 0;
+};
+
+Parts bench_parts(const ClosedLoopConfig& cfg, long samples) {
+  Parts p;
+  // record the closed loop once (inputs for the observer and controller replays)
+  ClosedLoop loop(cfg);
+  std::vector<ObserverInput> obs_in(static_cast<size_t>(samples));
+  std::vector<GraspControllerInput> ctrl_in(static_cast<size_t>(samples));
+  std::vector<double> cmd(static_cast<size_t>(samples));
+  ClosedLoopSample s;
+  for (long n = 0; n < samples; ++n) {
+    loop.step(s);
+    obs_in[static_cast<size_t>(n)] = ObserverInput{s.f_n_meas[0], s.f_t_meas[0], s.tau_meas[0], 0.0};
+    for (int i = 0; i < 2; ++i) {
+      FingerInput& f = ctrl_in[static_cast<size_t>(n)].fingers[i];
+      f.omega_hat = s.omega_hat[i];
+      f.slippage = s.slippage[i];
+      f.c_tilde = s.c_tilde[i];
+      f.f_t = s.f_t_meas[i];
+      f.status = static_cast<Status>(s.observer_status[i]);
+    }
+    cmd[static_cast<size_t>(n)] = s.command;
+  }
+  {
+    GraspPlant plant(cfg.plant);
+    const auto t0 = Clock::now();
+    for (long n = 0; n < samples; ++n) {
+      plant.set_command(cmd[static_cast<size_t>(n)]);
+      plant.advance_sample();
+    }
+    const auto t1 = Clock::now();
+    g_sink = g_sink + plant.state().f_n;
+    p.plant_ns = seconds_between(t0, t1) * 1e9 / samples;
+  }
+  {
+    Observer obs(cfg.plant.contact, cfg.observer);
+    ObserverOutput o;
+    const auto t0 = Clock::now();
+    for (const ObserverInput& in : obs_in) obs.step(in, o);
+    const auto t1 = Clock::now();
+    g_sink = g_sink + o.S;
+    p.observer_ns = seconds_between(t0, t1) * 1e9 / samples;
+  }
+  {
+    GraspController ctrl(cfg.plant.contact, cfg.controller);
+    GraspControllerOutput o;
+    const auto t0 = Clock::now();
+    for (const GraspControllerInput& in : ctrl_in) ctrl.step(in, o);
+    const auto t1 = Clock::now();
+    g_sink = g_sink + o.force;
+    p.controller_ns = seconds_between(t0, t1) * 1e9 / samples;
+  }
+  return p;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  bool quick = false, json = false;
+  for (int i = 1; i < argc; ++i) {
+    if (!std::strcmp(argv[i], "--quick")) quick = true;
+    else if (!std::strcmp(argv[i], "--json")) json = true;
+    else {
+      std::fprintf(stderr, "usage: %s [--quick] [--json]\n", argv[0]);
+      return 2;
+    }
+  }
+  const long samples = 3000;  // 6 s simulated per run
+  const int reps_lumped = quick ? 5 : 30, reps_patch = quick ? 2 : 8;
+  const int plant_rate_default = 1000;
+
+  std::vector<Result> rs;
+  std::vector<Parts> parts;
+  const ClosedLoopConfig lumped = scenario(PlantModel::Lumped, plant_rate_default);
+  const ClosedLoopConfig lumped500 = scenario(PlantModel::Lumped, 500.0);
+  const ClosedLoopConfig patch = scenario(PlantModel::Patch, plant_rate_default);
+  rs.push_back(bench_loop("lumped (plant 1 kHz)", lumped, samples, reps_lumped));
+  rs.push_back(bench_loop("lumped (plant 500 Hz)", lumped500, samples, reps_lumped));
+  rs.push_back(bench_loop("patch (plant 1 kHz, 314 cells)", patch, samples, reps_patch));
+  parts.push_back(bench_parts(lumped, samples));
+  parts.push_back(bench_parts(lumped500, samples));
+  parts.push_back(bench_parts(patch, samples));
+
+  if (json) {
+    std::printf("{\n  \"build_type\": \"%s\",\n  \"cxx_flags\": \"%s\",\n  \"sizeof_closed_loop\": %zu,\n  \"results\": [\n",
+                LUGRIP_BENCH_BUILD_TYPE, LUGRIP_BENCH_CXX_FLAGS, sizeof(ClosedLoop));
+    for (size_t i = 0; i < rs.size(); ++i) {
+      const Result& r = rs[i];
+      const Parts& p = parts[i];
+      std::printf("    {\"name\": \"%s\", \"cells\": %d, \"plant_steps_per_sample\": %.0f, \"steps\": %ld, "
+                  "\"steps_per_s_best\": %.6g, \"steps_per_s_median\": %.6g, \"realtime_best\": %.6g, "
+                  "\"realtime_median\": %.6g, \"p50_ns\": %.6g, \"p99_ns\": %.6g, \"worst_ns\": %.6g, "
+                  "\"allocations\": %ld, \"plant_ns\": %.6g, \"observer_ns\": %.6g, \"controller_ns\": %.6g}%s\n",
+                  r.name.c_str(), r.cells, r.plant_steps_per_sample, r.steps, r.steps_per_s_best,
+                  r.steps_per_s_median, r.realtime_best, r.realtime_median, r.p50_ns, r.p99_ns, r.worst_ns,
+                  r.allocations, p.plant_ns, p.observer_ns, p.controller_ns, i + 1 < rs.size() ? "," : "");
+    }
+    std::printf("  ]\n}\n");
+    return 0;
+  }
+  std::printf("closed loop: plant -> 2 sensors -> 2 observers -> controller (one step = one 500 Hz sample)\n");
+  std::printf("build %s, flags \"%s\", sizeof(ClosedLoop) = %zu B\n\n", LUGRIP_BENCH_BUILD_TYPE,
+              LUGRIP_BENCH_CXX_FLAGS, sizeof(ClosedLoop));
+  std::printf("%-32s %14s %14s %12s %10s %10s %10s %7s\n", "plant", "steps/s best", "steps/s med",
+              "x real time", "p50", "p99", "worst", "allocs");
+  for (const Result& r : rs)
+    std::printf("%-32s %14.3e %14.3e %12.0f %8.2f us %8.2f us %8.1f us %7ld\n", r.name.c_str(), r.steps_per_s_best,
+                r.steps_per_s_median, r.realtime_median, r.p50_ns / 1e3, r.p99_ns / 1e3, r.worst_ns / 1e3,
+                r.allocations);
+  std::printf("\nper step, components alone (same data): plant advance to the next sample, one observer, controller\n");
+  for (size_t i = 0; i < rs.size(); ++i)
+    std::printf("%-32s plant %8.1f ns   observer %7.1f ns (x2)   controller %6.1f ns\n", rs[i].name.c_str(),
+                parts[i].plant_ns, parts[i].observer_ns, parts[i].controller_ns);
+  return 0;
+}

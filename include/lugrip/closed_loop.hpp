@@ -1,0 +1,176 @@
+// lugrip — closed-loop grasp simulation: plant -> two fingertip sensors -> two observers ->
+// grasp-force controller -> gripper command (MODEL.md 9.7, 9.8, 10.1), plus the two baseline
+// controllers of the experiments (constant force, friction-cone threshold).
+//
+// Multi-rate (MODEL.md 9.7): the plant steps at PlantConfig::rate (1 kHz); both sensors are
+// sampled at sensor.rate (500 Hz) and each sample goes through its finger's Observer and the
+// controller at once (no computation delay); the controller issues a command every
+// command_ratio samples (50 Hz), which the plant's zero-order hold latches at its command tick
+// (the same instant) and passes through the first-order actuator lag.
+#pragma once
+
+#include <array>
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "lugrip/grasp_controller.hpp"
+#include "lugrip/grasp_plant.hpp"
+#include "lugrip/observer.hpp"
+
+namespace lugrip {
+
+//! Which law computes the grasp-force command. Stable integer values.
+enum class ControllerKind : int {
+  //! GraspController (paper eqs. 34-37: slipping avoidance + pivoting), fed by the observers.
+  Lugrip = 0,
+  //! Baseline: a constant command (ClosedLoopConfig::constant_force) from controller_start on.
+  ConstantForce = 1,
+  //! Baseline: friction-cone threshold controller, blind to torsion. At each command the
+  //! translational utilisation u = max_i |f_t,i| / (mu f_n,i) of the measured forces (mean over
+  //! the command period) is compared with cone_margin; the command starts at controller.f_min
+  //! (at controller_start) and, when u >= cone_margin, is raised
+  //! to max_i |f_t,i| / (mu cone_margin) (never lowered, except by cone_release_rate while
+  //! u < cone_margin). Same force range and rate limits as the GraspController settings.
+  FrictionCone = 2,
+};
+
+//! Mode-schedule actions (the experiment's operator or task logic). Stable integer values.
+enum class ModeAction : int {
+  Pivot = 0,              //!< GraspController::request_pivoting()
+  SlippingAvoidance = 1,  //!< GraspController::request_slipping_avoidance()
+  DynamicOn = 2,          //!< GraspController::set_dynamic_enabled(true)
+  DynamicOff = 3,         //!< GraspController::set_dynamic_enabled(false)
+};
+
+const char* to_string(ControllerKind k) noexcept;
+const char* to_string(ModeAction a) noexcept;
+
+//! One scheduled action, applied before the first sensor sample with t >= time.
+struct ModeEvent {
+  double time = 0.0;  //!< [s]
+  ModeAction action = ModeAction::Pivot;
+};
+
+//! Everything a closed-loop run needs. The observer's dt and the controller's rates must match
+//! the plant: observer.dt = 1/sensor.rate, controller.sensor_rate = sensor.rate and
+//! controller.command_ratio = sensor.rate / actuator.command_rate (validated).
+//!
+//! | field | meaning | unit | default |
+//! |---|---|---|---|
+//! | plant | object, contact, actuator, sensors, moves, disturbances (GraspPlant) | | (required) |
+//! | observer | settings of both fingers' Observer | | ObserverSettings() |
+//! | controller | GraspController settings (also the range/rate limits of the baselines) | | GraspControllerSettings() |
+//! | kind | which law computes the command | | Lugrip |
+//! | controller_start | before this time the command stays at plant.actuator.f_init | s | 0 |
+//! | constant_force | ConstantForce command | N | 1 |
+//! | cone_margin | FrictionCone target utilisation, in (0, 1] | - | 0.8 |
+//! | cone_release_rate | FrictionCone decrease rate while below the margin (0: ratchet) | N/s | 0 |
+//! | schedule | mode actions (sorted by time at construction) | | {} |
+struct ClosedLoopConfig {
+  PlantConfig plant;
+  ObserverSettings observer;
+  GraspControllerSettings controller;
+  ControllerKind kind = ControllerKind::Lugrip;
+  double controller_start = 0.0;
+  double constant_force = 1.0;
+  double cone_margin = 0.8;
+  double cone_release_rate = 0.0;
+  std::vector<ModeEvent> schedule;
+};
+
+//! Checks the plant config, the observer and controller settings, the rate consistency and the
+//! baseline fields; one line per problem in *message. Returns true when valid.
+bool validate(const ClosedLoopConfig& c, std::string* message);
+
+//! One closed-loop sample (sensor time t). Measured and estimated values are those the
+//! controller used at t; plant values are the true state at t (before the plant advances).
+struct ClosedLoopSample {
+  int64_t index = 0;   //!< sample number (t = index / sensor.rate)
+  double t = 0.0;      //!< [s]
+  double command = 0.0;        //!< grasp-force command sent to the gripper (held between commands) [N]
+  double static_force = 0.0;   //!< f_ns of the last command (Lugrip; else the command) [N]
+  double dynamic_force = 0.0;  //!< f_nd of the last command (Lugrip; else 0) [N]
+  double f_n = 0.0;            //!< true normal force of each finger (actuator) [N]
+  // per finger: measured (sensor frame) and estimated
+  std::array<double, 2> f_n_meas{}, f_t_meas{}, tau_meas{};  //!< [N], [N], [N m]
+  std::array<double, 2> f_t_true{}, tau_true{};  //!< true friction load [N], [N m]
+  std::array<double, 2> omega_hat{}, slippage{}, c_tilde{};  //!< [rad/s], [-], [-]
+  std::array<double, 2> omega_true{}, c_tilde_true{};  //!< true slip velocity [rad/s], CoR [-]
+  std::array<int, 2> observer_status{};  //!< Status codes
+  // object (ground truth)
+  double slip_x = 0.0, slip_y = 0.0;  //!< displacement of the grasped object point [m]
+  double slip = 0.0;                   //!< |(slip_x, slip_y)| (patch) or slip length (lumped) [m]
+  double rotation = 0.0;               //!< theta - theta0 [rad]
+  double theta = 0.0;                  //!< object angle [rad]
+  double cog_x = 0.0, cog_y = 0.0;     //!< CoG relative to the grasp point (gripper axes) [m]
+  double gripper_y = 0.0;              //!< grasp-point height [m]
+  double ext_fx = 0.0, ext_fy = 0.0, ext_tau = 0.0;  //!< disturbance [N], [N m]
+  int mode = 0;                 //!< ControllerMode code (Lugrip; else 0)
+  bool command_issued = false;  //!< a command was computed at this sample
+  bool pivot_finished = false;  //!< pivoting ended at this sample
+  int pivot_end = 0;            //!< PivotEnd code when pivot_finished
+  bool supported = false;       //!< object resting on the support
+  bool dropped = false;         //!< a drop criterion has been met (latched)
+  bool finite = true;           //!< every value of this sample is finite
+};
+
+//! Arrays of a batch run, one entry per sample (columns of ClosedLoopSample).
+struct ClosedLoopLog {
+  std::vector<double> t, command, static_force, dynamic_force, f_n;
+  std::array<std::vector<double>, 2> f_n_meas, f_t_meas, tau_meas, f_t_true, tau_true, omega_hat,
+      slippage, c_tilde, omega_true, c_tilde_true;
+  std::array<std::vector<int32_t>, 2> observer_status;
+  std::vector<double> slip_x, slip_y, slip, rotation, theta, cog_x, cog_y, gripper_y, ext_fx, ext_fy, ext_tau;
+  std::vector<int32_t> mode, pivot_end;
+  std::vector<uint8_t> command_issued, pivot_finished, supported, dropped, finite;
+
+  void reserve(size_t n);
+  void append(const ClosedLoopSample& s);
+  size_t size() const noexcept { return t.size(); }
+};
+
+//! The closed loop. Lifecycle: construct (validates, allocates) -> step() (noexcept, no
+//! allocation) -> reset(). Deterministic: the same config gives the same run.
+class ClosedLoop {
+ public:
+  //! Throws std::invalid_argument (every problem listed) for an invalid config.
+  explicit ClosedLoop(const ClosedLoopConfig& config);
+
+  //! Back to t = 0 (plant, observers, controller, schedule).
+  void reset() noexcept;
+  //! Processes the current sensor sample (schedule, observers, controller, command), records it
+  //! in `out`, then advances the plant to the next sample.
+  void step(ClosedLoopSample& out) noexcept;
+  //! Runs `samples` steps, appending to `log` (allocates: not for real-time use).
+  void run(int64_t samples, ClosedLoopLog& log);
+
+  const ClosedLoopConfig& config() const noexcept { return cfg_; }
+  const GraspPlant& plant() const noexcept { return plant_; }
+  const GraspController& controller() const noexcept { return ctrl_; }
+  const Observer& observer(int finger) const noexcept { return obs_[finger & 1]; }
+  double time() const noexcept { return plant_.time(); }
+  double sample_period() const noexcept { return dt_; }
+  int64_t samples() const noexcept { return n_; }
+
+ private:
+  ClosedLoopConfig cfg_;
+  GraspPlant plant_;
+  std::array<Observer, 2> obs_;
+  GraspController ctrl_;
+  double dt_ = 0.002;
+  int ratio_ = 10;
+  int64_t n_ = 0;
+  size_t next_event_ = 0;
+  double command_ = 0.0;        // command sent to the plant [N]
+  bool started_ = false;        // the controller/baseline is active
+  std::array<double, 2> cone_fn_sum_{}, cone_ft_sum_{};  // friction cone: sums this period
+  int cone_count_ = 0;
+  GraspControllerOutput cout_;
+  std::array<ObserverOutput, 2> oout_;
+
+  void apply_events(double t) noexcept;
+  void cone_command() noexcept;
+};
+
+}  // namespace lugrip

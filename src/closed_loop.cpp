@@ -1,0 +1,338 @@
+// Closed-loop grasp simulation: plant, two sensors, two observers, controller or baseline.
+#include "lugrip/closed_loop.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <sstream>
+#include <stdexcept>
+
+namespace lugrip {
+
+namespace {
+
+std::string num(double v) {
+  char buf[40];
+  std::snprintf(buf, sizeof buf, "%.15g", v);
+  if (std::strtod(buf, nullptr) != v) std::snprintf(buf, sizeof buf, "%.17g", v);
+  return buf;
+}
+
+// Prefixes every line of a sub-validator's message.
+void append_prefixed(std::string& msg, const std::string& sub, const char* prefix) {
+  std::istringstream lines(sub);
+  for (std::string line; std::getline(lines, line);)
+    if (!line.empty()) msg += std::string(prefix) + line + "\n";
+}
+
+bool close_rel(double a, double b) { return std::fabs(a - b) <= 1e-9 * std::max(std::fabs(a), std::fabs(b)); }
+
+double clampd(double v, double lo, double hi) noexcept { return v < lo ? lo : (v > hi ? hi : v); }
+
+const ClosedLoopConfig& checked(const ClosedLoopConfig& c) {
+  std::string msg;
+  if (!validate(c, &msg)) throw std::invalid_argument("invalid ClosedLoopConfig:\n" + msg);
+  return c;
+}
+
+ClosedLoopConfig sorted(ClosedLoopConfig c) {
+  std::stable_sort(c.schedule.begin(), c.schedule.end(),
+                   [](const ModeEvent& a, const ModeEvent& b) { return a.time < b.time; });
+  return c;
+}
+
+}  // namespace
+
+const char* to_string(ControllerKind k) noexcept {
+  switch (k) {
+    case ControllerKind::Lugrip: return "lugrip";
+    case ControllerKind::ConstantForce: return "constant_force";
+    case ControllerKind::FrictionCone: return "friction_cone";
+  }
+  return "unknown";
+}
+
+const char* to_string(ModeAction a) noexcept {
+  switch (a) {
+    case ModeAction::Pivot: return "pivot";
+    case ModeAction::SlippingAvoidance: return "slipping_avoidance";
+    case ModeAction::DynamicOn: return "dynamic_on";
+    case ModeAction::DynamicOff: return "dynamic_off";
+  }
+  return "unknown";
+}
+
+bool validate(const ClosedLoopConfig& c, std::string* message) {
+  std::string msg, sub;
+  if (!validate(c.plant, &sub)) append_prefixed(msg, sub, "plant.");
+  if (!validate(c.observer, &sub)) append_prefixed(msg, sub, "observer.");
+  if (!validate(c.controller, &sub)) append_prefixed(msg, sub, "controller.");
+  const double fs = c.plant.sensor.rate;
+  if (std::isfinite(fs) && fs > 0.0) {
+    if (!close_rel(c.observer.dt * fs, 1.0))
+      msg += "observer.dt = " + num(c.observer.dt) + ": must equal 1 / plant.sensor.rate = " + num(1.0 / fs) + "\n";
+    if (!close_rel(c.controller.sensor_rate, fs))
+      msg += "controller.sensor_rate = " + num(c.controller.sensor_rate) + ": must equal plant.sensor.rate = " +
+             num(fs) + "\n";
+    const double fc = c.plant.actuator.command_rate;
+    if (!close_rel(c.controller.command_ratio * fc, fs))
+      msg += "controller.command_ratio = " + std::to_string(c.controller.command_ratio) +
+             ": must equal plant.sensor.rate / plant.actuator.command_rate = " + num(fs / fc) + "\n";
+  }
+  const int kind = static_cast<int>(c.kind);
+  if (kind < 0 || kind > 2) msg += "kind = " + std::to_string(kind) + ": unknown controller kind\n";
+  if (!(std::isfinite(c.controller_start) && c.controller_start >= 0.0))
+    msg += "controller_start = " + num(c.controller_start) + ": must be finite and >= 0 [s]\n";
+  if (!(std::isfinite(c.constant_force) && c.constant_force >= 0.0))
+    msg += "constant_force = " + num(c.constant_force) + ": must be finite and >= 0 [N]\n";
+  if (!(c.cone_margin > 0.0 && c.cone_margin <= 1.0))
+    msg += "cone_margin = " + num(c.cone_margin) + ": must satisfy 0 < cone_margin <= 1\n";
+  if (!(std::isfinite(c.cone_release_rate) && c.cone_release_rate >= 0.0))
+    msg += "cone_release_rate = " + num(c.cone_release_rate) + ": must be finite and >= 0 [N/s]\n";
+  for (size_t i = 0; i < c.schedule.size(); ++i) {
+    const ModeEvent& e = c.schedule[i];
+    const std::string f = "schedule[" + std::to_string(i) + "].";
+    if (!std::isfinite(e.time)) msg += f + "time = " + num(e.time) + ": must be finite [s]\n";
+    const int a = static_cast<int>(e.action);
+    if (a < 0 || a > 3) msg += f + "action = " + std::to_string(a) + ": unknown action\n";
+  }
+  if (message) *message = msg;
+  return msg.empty();
+}
+
+// --- log -------------------------------------------------------------------------------------
+
+void ClosedLoopLog::reserve(size_t n) {
+  for (auto* v : {&t, &command, &static_force, &dynamic_force, &f_n, &slip_x, &slip_y, &slip, &rotation,
+                  &theta, &cog_x, &cog_y, &gripper_y, &ext_fx, &ext_fy, &ext_tau})
+    v->reserve(n);
+  for (int i = 0; i < 2; ++i) {
+    for (auto* v : {&f_n_meas[i], &f_t_meas[i], &tau_meas[i], &f_t_true[i], &tau_true[i], &omega_hat[i],
+                    &slippage[i], &c_tilde[i], &omega_true[i], &c_tilde_true[i]})
+      v->reserve(n);
+    observer_status[i].reserve(n);
+  }
+  mode.reserve(n);
+  pivot_end.reserve(n);
+  for (auto* v : {&command_issued, &pivot_finished, &supported, &dropped, &finite}) v->reserve(n);
+}
+
+void ClosedLoopLog::append(const ClosedLoopSample& s) {
+  t.push_back(s.t);
+  command.push_back(s.command);
+  static_force.push_back(s.static_force);
+  dynamic_force.push_back(s.dynamic_force);
+  f_n.push_back(s.f_n);
+  for (int i = 0; i < 2; ++i) {
+    f_n_meas[i].push_back(s.f_n_meas[i]);
+    f_t_meas[i].push_back(s.f_t_meas[i]);
+    tau_meas[i].push_back(s.tau_meas[i]);
+    f_t_true[i].push_back(s.f_t_true[i]);
+    tau_true[i].push_back(s.tau_true[i]);
+    omega_hat[i].push_back(s.omega_hat[i]);
+    slippage[i].push_back(s.slippage[i]);
+    c_tilde[i].push_back(s.c_tilde[i]);
+    omega_true[i].push_back(s.omega_true[i]);
+    c_tilde_true[i].push_back(s.c_tilde_true[i]);
+    observer_status[i].push_back(s.observer_status[i]);
+  }
+  slip_x.push_back(s.slip_x);
+  slip_y.push_back(s.slip_y);
+  slip.push_back(s.slip);
+  rotation.push_back(s.rotation);
+  theta.push_back(s.theta);
+  cog_x.push_back(s.cog_x);
+  cog_y.push_back(s.cog_y);
+  gripper_y.push_back(s.gripper_y);
+  ext_fx.push_back(s.ext_fx);
+  ext_fy.push_back(s.ext_fy);
+  ext_tau.push_back(s.ext_tau);
+  mode.push_back(s.mode);
+  pivot_end.push_back(s.pivot_end);
+  command_issued.push_back(s.command_issued);
+  pivot_finished.push_back(s.pivot_finished);
+  supported.push_back(s.supported);
+  dropped.push_back(s.dropped);
+  finite.push_back(s.finite);
+}
+
+// --- loop ------------------------------------------------------------------------------------
+
+ClosedLoop::ClosedLoop(const ClosedLoopConfig& config)
+    : cfg_(sorted(checked(config))),
+      plant_(cfg_.plant),
+      obs_{Observer(plant_.contact_model(), cfg_.observer), Observer(plant_.contact_model(), cfg_.observer)},
+      ctrl_(cfg_.plant.contact, cfg_.controller) {
+  dt_ = 1.0 / cfg_.plant.sensor.rate;
+  ratio_ = cfg_.controller.command_ratio;
+  reset();
+}
+
+void ClosedLoop::reset() noexcept {
+  plant_.reset();
+  for (auto& o : obs_) o.reset();
+  command_ = plant_.state().f_cmd;
+  ctrl_.reset(command_);
+  cout_ = GraspControllerOutput();
+  cout_.force = command_;
+  cout_.static_force = command_;
+  for (auto& o : oout_) o = ObserverOutput();
+  n_ = 0;
+  next_event_ = 0;
+  started_ = false;
+  cone_fn_sum_ = {0.0, 0.0};
+  cone_ft_sum_ = {0.0, 0.0};
+  cone_count_ = 0;
+}
+
+void ClosedLoop::apply_events(double t) noexcept {
+  // Half a sample of tolerance: an event at t is applied at the sample taken at t.
+  while (next_event_ < cfg_.schedule.size() && cfg_.schedule[next_event_].time <= t + 0.5 * dt_) {
+    if (cfg_.kind == ControllerKind::Lugrip) {
+      switch (cfg_.schedule[next_event_].action) {
+        case ModeAction::Pivot: ctrl_.request_pivoting(); break;
+        case ModeAction::SlippingAvoidance: ctrl_.request_slipping_avoidance(); break;
+        case ModeAction::DynamicOn: ctrl_.set_dynamic_enabled(true); break;
+        case ModeAction::DynamicOff: ctrl_.set_dynamic_enabled(false); break;
+      }
+    }
+    ++next_event_;
+  }
+}
+
+void ClosedLoop::cone_command() noexcept {
+  const GraspControllerSettings& s = cfg_.controller;
+  const double mu = cfg_.plant.contact.mu, margin = cfg_.cone_margin;
+  const double T = ratio_ * dt_;
+  double u = 0.0, ft_max = 0.0;
+  for (int i = 0; i < 2; ++i) {
+    const double fn = cone_fn_sum_[i] / cone_count_, ft = cone_ft_sum_[i] / cone_count_;
+    if (fn > 0.0 && std::isfinite(fn) && std::isfinite(ft)) u = std::max(u, ft / (mu * fn));
+    if (std::isfinite(ft)) ft_max = std::max(ft_max, ft);
+  }
+  const double required = ft_max / (mu * margin);
+  double target = command_;
+  if (u >= margin) target = std::max(command_, required);
+  else if (cfg_.cone_release_rate > 0.0) target = std::max(required, command_ - cfg_.cone_release_rate * T);
+  const double f = clampd(target, command_ - s.max_rate_down * T, command_ + s.max_rate_up * T);
+  command_ = clampd(f, s.f_min, s.f_max);
+  cone_fn_sum_ = {0.0, 0.0};
+  cone_ft_sum_ = {0.0, 0.0};
+  cone_count_ = 0;
+}
+
+void ClosedLoop::step(ClosedLoopSample& out) noexcept {
+  const double t = static_cast<double>(n_) * dt_;
+  apply_events(t);
+  const bool tick = n_ % ratio_ == 0;
+  if (!started_ && tick && t >= cfg_.controller_start - 0.5 * dt_) {
+    started_ = true;
+    if (cfg_.kind == ControllerKind::Lugrip) ctrl_.reset(command_);
+    if (cfg_.kind == ControllerKind::FrictionCone) command_ = cfg_.controller.f_min;  // starts at the floor
+  }
+
+  GraspControllerInput cin;
+  for (int i = 0; i < 2; ++i) {
+    const FingerSample& s = plant_.sensor_sample(i);
+    const ObserverInput in = ObserverInput::from_force_vector(s.f_n, s.f_x, s.f_y, s.tau);
+    obs_[i].step(in, oout_[i]);
+    const ObserverOutput& o = oout_[i];
+    FingerInput& f = cin.fingers[i];
+    f.omega_hat = o.omega_hat;
+    f.slippage = o.S;
+    f.c_tilde = o.c_tilde;
+    f.f_t = in.f_t;
+    f.status = o.status;
+    f.present = true;
+    out.f_n_meas[i] = s.f_n;
+    out.f_t_meas[i] = in.f_t;
+    out.tau_meas[i] = s.tau;
+    out.f_t_true[i] = std::hypot(s.true_f_x, s.true_f_y);
+    out.tau_true[i] = s.true_tau;
+    out.omega_hat[i] = o.omega_hat;
+    out.slippage[i] = o.S;
+    out.c_tilde[i] = o.c_tilde;
+    out.omega_true[i] = s.omega;
+    out.c_tilde_true[i] = s.c_tilde;
+    out.observer_status[i] = static_cast<int>(o.status);
+  }
+
+  out.command_issued = false;
+  out.pivot_finished = false;
+  out.pivot_end = 0;
+  if (started_) {
+    switch (cfg_.kind) {
+      case ControllerKind::Lugrip:
+        ctrl_.step(cin, cout_);
+        command_ = cout_.force;
+        out.command_issued = cout_.command_issued;
+        out.pivot_finished = cout_.pivot_finished;
+        out.pivot_end = static_cast<int>(cout_.pivot_end);
+        break;
+      case ControllerKind::ConstantForce:
+        if (tick) {
+          command_ = cfg_.constant_force;
+          out.command_issued = true;
+        }
+        break;
+      case ControllerKind::FrictionCone:
+        for (int i = 0; i < 2; ++i) {
+          cone_fn_sum_[i] += out.f_n_meas[i];
+          cone_ft_sum_[i] += out.f_t_meas[i];
+        }
+        ++cone_count_;
+        if (tick) {
+          cone_command();
+          out.command_issued = true;
+        }
+        break;
+    }
+  }
+  plant_.set_command(command_);
+
+  const PlantState& st = plant_.state();
+  out.index = n_;
+  out.t = t;
+  out.command = command_;
+  const bool lugrip = cfg_.kind == ControllerKind::Lugrip && started_;
+  out.static_force = lugrip ? cout_.static_force : command_;
+  out.dynamic_force = lugrip ? cout_.dynamic_force : 0.0;
+  out.mode = lugrip ? static_cast<int>(cout_.mode) : 0;
+  out.f_n = st.f_n;
+  out.slip_x = st.slip_x;
+  out.slip_y = st.slip_y;
+  out.slip = cfg_.plant.model == PlantModel::Patch ? std::hypot(st.slip_x, st.slip_y) : st.max_slip;
+  out.rotation = st.slip_angle;
+  out.theta = st.theta;
+  out.cog_x = st.x;
+  out.cog_y = st.y;
+  out.gripper_y = st.gripper_y;
+  out.ext_fx = st.ext_fx;
+  out.ext_fy = st.ext_fy;
+  out.ext_tau = st.ext_tau;
+  out.supported = st.supported;
+  out.dropped = st.dropped;
+  bool ok = std::isfinite(out.command) && std::isfinite(out.static_force) && std::isfinite(out.dynamic_force) &&
+            std::isfinite(out.f_n) && std::isfinite(out.slip) && std::isfinite(out.theta);
+  for (int i = 0; i < 2; ++i)
+    ok = ok && std::isfinite(out.f_n_meas[i]) && std::isfinite(out.f_t_meas[i]) && std::isfinite(out.tau_meas[i]) &&
+         std::isfinite(out.omega_hat[i]) && std::isfinite(out.slippage[i]) && std::isfinite(out.c_tilde[i]) &&
+         std::isfinite(out.f_t_true[i]) && std::isfinite(out.tau_true[i]);
+  out.finite = ok;
+
+  plant_.advance_sample();
+  ++n_;
+}
+
+void ClosedLoop::run(int64_t samples, ClosedLoopLog& log) {
+  if (samples <= 0) return;
+  log.reserve(log.size() + static_cast<size_t>(samples));
+  ClosedLoopSample s;
+  for (int64_t k = 0; k < samples; ++k) {
+    step(s);
+    log.append(s);
+  }
+}
+
+}  // namespace lugrip

@@ -1,0 +1,65 @@
+// ClosedLoop::step() never allocates (plant, both observers, controller or baselines, schedule):
+// this binary replaces the global operator new and counts calls while stepping.
+#include <gtest/gtest.h>
+
+#include <atomic>
+#include <cmath>
+#include <cstdlib>
+#include <new>
+
+#include "lugrip/closed_loop.hpp"
+
+namespace {
+std::atomic<long> g_allocations{0};
+}  // namespace
+
+void* operator new(std::size_t n) {
+  ++g_allocations;
+  if (void* p = std::malloc(n ? n : 1)) return p;
+  throw std::bad_alloc();
+}
+void* operator new[](std::size_t n) {
+  ++g_allocations;
+  if (void* p = std::malloc(n ? n : 1)) return p;
+  throw std::bad_alloc();
+}
+void operator delete(void* p) noexcept { std::free(p); }
+void operator delete[](void* p) noexcept { std::free(p); }
+void operator delete(void* p, std::size_t) noexcept { std::free(p); }
+void operator delete[](void* p, std::size_t) noexcept { std::free(p); }
+
+using namespace lugrip;
+
+TEST(NoAllocation, ClosedLoopStep) {
+  for (PlantModel model : {PlantModel::Patch, PlantModel::Lumped}) {
+    for (ControllerKind kind : {ControllerKind::Lugrip, ControllerKind::ConstantForce, ControllerKind::FrictionCone}) {
+      ClosedLoopConfig c;
+      c.plant.contact = object_params("plastic_bottle");
+      c.plant.model = model;
+      c.plant.object.mass = 0.3;
+      c.plant.object.inertia = 1e-3;
+      c.plant.object.cog_x = 0.005;
+      c.plant.actuator.f_init = 2.0;
+      c.plant.support = true;
+      c.plant.drop.rotation_limit = INFINITY;
+      c.plant.moves.push_back(GripperMove{0.2, 1.0, 0.02, 0.05});
+      c.plant.disturbances.push_back(Disturbance{1.5, 0.3, PulseShape::HalfSine, 0.5, -2.0, 0.002, 0.0, 0.0});
+      c.kind = kind;
+      c.constant_force = 5.0;
+      c.cone_release_rate = 1.0;
+      c.schedule.push_back(ModeEvent{0.1, ModeAction::DynamicOff});
+      c.schedule.push_back(ModeEvent{0.15, ModeAction::DynamicOn});
+      c.schedule.push_back(ModeEvent{2.0, ModeAction::Pivot});
+      c.schedule.push_back(ModeEvent{3.0, ModeAction::SlippingAvoidance});
+      ClosedLoop loop(c);  // allocates (construction)
+      ClosedLoopSample s;
+      const long before = g_allocations.load();
+      for (int n = 0; n < 2000; ++n) loop.step(s);  // 4 s: lift, push, pivot, back
+      loop.reset();
+      for (int n = 0; n < 500; ++n) loop.step(s);
+      const long used = g_allocations.load() - before;
+      EXPECT_EQ(used, 0) << to_string(model) << " " << to_string(kind);
+      EXPECT_TRUE(s.finite);
+    }
+  }
+}
