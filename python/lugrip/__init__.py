@@ -37,6 +37,7 @@ from ._controller import (
     static_slippage,
 )
 from .io import LogError, LogWarning, SlidingLog, read_log, write_log
+from .sliding import simulate_sliding
 
 __all__ = [
     "__version__",
@@ -71,4 +72,5 @@ __all__ = [
     "Observability",
     "observability",
     "sensor_wrench",
+    "simulate_sliding",
 ]
