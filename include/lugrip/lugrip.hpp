@@ -5,6 +5,7 @@
 #include "lugrip/contact.hpp"
 #include "lugrip/grasp_controller.hpp"
 #include "lugrip/grasp_plant.hpp"
+#include "lugrip/identification.hpp"
 #include "lugrip/limit_surface.hpp"
 #include "lugrip/observer.hpp"
 #include "lugrip/params.hpp"
