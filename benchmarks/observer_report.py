@@ -642,9 +642,9 @@ def render(R) -> str:
             "With β_A 230-400× smaller than Table 1 the same speeds need only a few per cent of load "
             "above g, and the speed enters the wrench only through σ1 ω (MODEL.md §6-7): the RMSE "
             "is a large fraction of the RMS speed (Table 1: "
-            f"{d1['rmse'] / d1['rms_omega']:.2f}), worst for rotation-dominated slips at low force "
-            "where σ1 is smallest, while S still flags the slips (negative median delay: S reaches "
-            "0.9 while the load approaches the LS) with no false alarm in stick."
+            f"{d1['rmse'] / d1['rms_omega']:.2f}), worst for rotation-dominated slips, where σ1 "
+            "(∝ c~² + 1/2) is smallest, while S still flags the slips (negative median delay: S "
+            "reaches 0.9 while the load approaches the LS) with no false alarm in stick."
         ),
         "",
     ]
