@@ -1,5 +1,7 @@
 """Grasp simulation: the planar grasp plant (distributed-contact or lumped slider), gripper
-actuator, fingertip sensors, robot moves and disturbances (MODEL.md 10). The loops run in C++.
+actuator, fingertip sensors, robot moves and disturbances (MODEL.md 10), and the closed loop with
+the observers and the grasp-force controller or a baseline (``run_closed_loop``; the paper's
+experiments as scenarios in :mod:`lugrip.sim.scenarios`). The loops run in C++.
 
     >>> from lugrip.sim import GraspPlant, PlantConfig
     >>> plant = GraspPlant({"contact": "aluminium_can",
@@ -10,6 +12,7 @@ actuator, fingertip sensors, robot moves and disturbances (MODEL.md 10). The loo
     True
 """
 
+from ._closed_loop import ClosedLoopRun, closed_loop_config, run_closed_loop
 from ._plant import (
     ActuatorConfig,
     Disturbance,
@@ -26,6 +29,9 @@ from ._plant import (
 )
 
 __all__ = [
+    "ClosedLoopRun",
+    "closed_loop_config",
+    "run_closed_loop",
     "ActuatorConfig",
     "Disturbance",
     "DropConfig",

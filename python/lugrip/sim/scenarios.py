@@ -1,0 +1,639 @@
+"""The paper's experiments as closed-loop scenarios: YAML loading, runner, baselines, metrics and
+pass criteria (MODEL.md 10).
+
+A scenario file (``scenarios/<name>.yaml``) holds::
+
+    name: exp1_big_resin_block
+    title: ...                       # one line
+    figure: 11                       # the paper's figure it reproduces
+    group: null                      # scenarios sharing one figure (exp4 full + empty)
+    description: ...                 # what is shown
+    choices: {...}                   # documented choice of mass, geometry, loads (free mapping)
+    duration: 22.0                   # [s]
+    plant: {...}                     # PlantConfig.from_dict layout (object, lift, disturbances)
+    controller: {...}                # GraspController settings
+    observer: {...}                  # Observer settings
+    schedule: [{time: 11.5, action: pivot}]
+    hold_start: null                 # [s] default: end of the last gripper move (the lift)
+    steady_window: [10.0, 13.9]      # [s] where the steady force is measured
+    criteria: {...}                  # see CRITERIA
+    baselines: {constant_force: true, friction_cone: true}
+    short: {...}                     # overrides for --short (top-level keys; plant merged)
+
+Slip and rotation are measured in the *hold* phases: from ``hold_start`` (object lifted) to the
+end, minus the pivoting manoeuvre; after a pivot the reference pose is the one at its end. The
+slip and rotation of the grasp and lift phase (the object sits on the table while the force
+rises from its floor, then the lift-off transient) are reported separately.
+"""
+
+from __future__ import annotations
+
+import copy
+import dataclasses
+import math
+import os
+import time
+from collections.abc import Mapping, Sequence
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+import yaml
+
+from .. import __version__
+from .._controller import static_grasp_force
+from .._params import ContactParams
+from ._closed_loop import ClosedLoopRun, run_closed_loop
+from ._plant import PlantConfig
+
+__all__ = [
+    "CRITERIA",
+    "Scenario",
+    "ScenarioResult",
+    "compute_metrics",
+    "constant_force_search",
+    "evaluate_cross",
+    "find_scenario",
+    "list_scenarios",
+    "load_scenario",
+    "metrics_document",
+    "run_scenario",
+    "scenario_dir",
+]
+
+#: Criteria a scenario may list, with their meaning (value compared with the YAML limit).
+CRITERIA = {
+    "no_drop": "the object is never dropped (plant drop criteria: slip, rotation, contact)",
+    "no_nan": "every logged value is finite",
+    "command_in_limits": "the command stays finite and inside [f_min, f_max]",
+    "max_hold_slip_mm": "max translational slip while holding (incl. disturbances) [mm] <= limit",
+    "max_hold_rotation_deg": "max rotational slip while holding (incl. disturbances) [deg] <= limit",
+    "steady_slippage": "mean S in the steady window inside [lo, hi]",
+    "steady_force_range": "steady grasp force inside [lo, hi] [N] (the paper's range)",
+    "static_force_tolerance": "|steady / static_grasp_force - 1| <= limit",
+    "pivot_final_hang_deg": "after pivoting the CoG hangs below the grasp point within limit [deg]",
+    "pivot_returns_to_avoidance": "pivoting ends on |c~| > threshold and avoidance resumes",
+    "force_ratio": "steady force / steady force of `reference` >= min",
+    "constant_force_exceeds_steady": "the constant-force baseline needs more than lugrip's steady force",
+    "friction_cone_fails": "the friction-cone baseline fails (drop or hold slip) where lugrip holds",
+}
+
+
+def scenario_dir() -> Path | None:
+    """Directory of the bundled scenario files: $LUGRIP_SCENARIOS, ./scenarios, or the
+    repository's scenarios/ next to an in-tree package. None when none exists."""
+    env = os.environ.get("LUGRIP_SCENARIOS")
+    candidates = [Path(env)] if env else []
+    candidates += [Path.cwd() / "scenarios", Path(__file__).resolve().parents[3] / "scenarios"]
+    for c in candidates:
+        if c.is_dir() and any(c.glob("*.yaml")):
+            return c
+    return None
+
+
+def list_scenarios(directory: str | Path | None = None) -> list[str]:
+    """Names of the scenario files in `directory` (default: :func:`scenario_dir`), sorted."""
+    d = Path(directory) if directory is not None else scenario_dir()
+    if d is None:
+        return []
+    return sorted(p.stem for p in d.glob("*.yaml"))
+
+
+def find_scenario(name: str | Path) -> Path:
+    """Path of a scenario given as a file path or a name in :func:`scenario_dir`."""
+    p = Path(name)
+    if p.suffix in (".yaml", ".yml") or p.exists():
+        if not p.is_file():
+            raise ValueError(f"scenario file {p} does not exist")
+        return p
+    d = scenario_dir()
+    if d is not None and (d / f"{name}.yaml").is_file():
+        return d / f"{name}.yaml"
+    known = ", ".join(list_scenarios()) or "none found (set LUGRIP_SCENARIOS)"
+    raise ValueError(f"unknown scenario {str(name)!r}; known: {known}")
+
+
+def _merge(base: dict, over: Mapping) -> dict:
+    out = copy.deepcopy(base)
+    for k, v in over.items():
+        if k == "plant" and isinstance(v, Mapping):
+            plant = dict(out.get("plant", {}))
+            plant.update(copy.deepcopy(dict(v)))
+            out["plant"] = plant
+        else:
+            out[k] = copy.deepcopy(v)
+    return out
+
+
+_KEYS = {
+    "name", "title", "figure", "group", "description", "choices", "duration", "plant",
+    "controller", "observer", "schedule", "hold_start", "steady_window", "criteria",
+    "baselines", "short",
+}
+
+
+@dataclasses.dataclass
+class Scenario:
+    """One experiment (see the module docstring for the YAML layout)."""
+
+    name: str
+    title: str
+    duration: float
+    plant: dict
+    figure: int | None = None
+    group: str | None = None
+    description: str = ""
+    choices: dict = dataclasses.field(default_factory=dict)
+    controller: dict = dataclasses.field(default_factory=dict)
+    observer: dict = dataclasses.field(default_factory=dict)
+    schedule: list = dataclasses.field(default_factory=list)
+    hold_start: float | None = None
+    steady_window: tuple[float, float] | None = None
+    criteria: dict = dataclasses.field(default_factory=dict)
+    baselines: dict = dataclasses.field(default_factory=dict)
+    short: dict = dataclasses.field(default_factory=dict)
+    source: Path | None = None
+
+    @classmethod
+    def from_dict(cls, data: Mapping[str, Any], source: Path | None = None) -> Scenario:
+        where = str(source) if source else "scenario"
+        if not isinstance(data, Mapping):
+            raise ValueError(f"{where}: expected a mapping at the top level")
+        unknown = sorted(set(data) - _KEYS)
+        if unknown:
+            raise ValueError(f"{where}: unknown key(s) {', '.join(unknown)}")
+        for key in ("name", "title", "duration", "plant"):
+            if key not in data:
+                raise ValueError(f"{where}: missing key {key!r}")
+        unknown = sorted(set(data.get("criteria") or {}) - set(CRITERIA))
+        if unknown:
+            raise ValueError(f"{where}: unknown criteria {', '.join(unknown)}")
+        sw = data.get("steady_window")
+        s = cls(
+            name=str(data["name"]),
+            title=str(data["title"]),
+            duration=float(data["duration"]),
+            plant=dict(data["plant"]),
+            figure=data.get("figure"),
+            group=data.get("group"),
+            description=str(data.get("description") or "").strip(),
+            choices=dict(data.get("choices") or {}),
+            controller=dict(data.get("controller") or {}),
+            observer=dict(data.get("observer") or {}),
+            schedule=list(data.get("schedule") or []),
+            hold_start=None if data.get("hold_start") is None else float(data["hold_start"]),
+            steady_window=None if sw is None else (float(sw[0]), float(sw[1])),
+            criteria=dict(data.get("criteria") or {}),
+            baselines=dict(data.get("baselines") or {}),
+            short=dict(data.get("short") or {}),
+            source=source,
+        )
+        PlantConfig.from_dict(s.plant)  # validates the plant block now, naming bad fields
+        return s
+
+    def to_dict(self) -> dict:
+        d = dataclasses.asdict(self)
+        d.pop("source")
+        if d["steady_window"] is not None:
+            d["steady_window"] = list(d["steady_window"])
+        return d
+
+    def shortened(self) -> Scenario:
+        """The scenario with its ``short`` overrides applied (for CI)."""
+        if not self.short:
+            return self
+        return Scenario.from_dict(_merge(self.to_dict() | {"short": {}}, self.short), self.source)
+
+    def plant_config(self, model: str | None = None, seed: int | None = None) -> PlantConfig:
+        d = copy.deepcopy(self.plant)
+        if model is not None:
+            d["model"] = model
+        if seed is not None:
+            d["seed"] = int(seed)
+        return PlantConfig.from_dict(d)
+
+    @property
+    def lift_end(self) -> float:
+        """End of the last gripper move [s] (0 without moves)."""
+        cfg = self.plant_config()
+        return max((m.t_start + m.duration for m in cfg.moves), default=0.0)
+
+    @property
+    def lift_start(self) -> float:
+        cfg = self.plant_config()
+        return min((m.t_start for m in cfg.moves), default=0.0)
+
+    @property
+    def hold_time(self) -> float:
+        return self.lift_end if self.hold_start is None else self.hold_start
+
+    @property
+    def has_pivot(self) -> bool:
+        return any(str(e.get("action", "")).startswith("pivot") for e in self.schedule)
+
+    @property
+    def params(self) -> ContactParams:
+        return self.plant_config().contact
+
+
+def load_scenario(name: str | Path) -> Scenario:
+    """Load a scenario from a YAML file or by name (``exp1_big_resin_block``)."""
+    path = find_scenario(name)
+    with open(path) as f:
+        data = yaml.safe_load(f)
+    return Scenario.from_dict(data, source=path)
+
+
+# --- metrics ---------------------------------------------------------------------------------
+
+
+def _axis_deg(run: ClosedLoopRun, cfg: PlantConfig) -> np.ndarray:
+    """Angle of the object's grasp-point -> CoG axis (object frame, fixed) from the downward
+    vertical [deg], wrapped to (-180, 180]."""
+    cx, cy = cfg.object.cog
+    a = np.degrees(run["theta"] + math.atan2(cy, cx)) + 90.0
+    return (a + 180.0) % 360.0 - 180.0
+
+
+def _hold_increment(run: ClosedLoopRun, phases, lumped: bool) -> tuple[float, float]:
+    """Max slip [mm] and rotation [deg] relative to the pose at each phase start."""
+    slip = rot = 0.0
+    for t0, t1 in phases:
+        sl = run.window(t0, t1)
+        if sl.stop <= sl.start:
+            continue
+        i0 = sl.start
+        if lumped:
+            ds = run["slip"][sl] - run["slip"][i0]
+        else:
+            ds = np.hypot(run["slip_x"][sl] - run["slip_x"][i0], run["slip_y"][sl] - run["slip_y"][i0])
+        slip = max(slip, float(np.max(np.abs(ds))) * 1e3)
+        rot = max(rot, float(np.degrees(np.max(np.abs(run["rotation"][sl] - run["rotation"][i0])))))
+    return slip, rot
+
+
+def compute_metrics(
+    scenario: Scenario,
+    run: ClosedLoopRun,
+    *,
+    cfg: PlantConfig | None = None,
+    controller: Mapping[str, Any] | None = None,
+    pivot: bool = True,
+) -> dict[str, Any]:
+    """Metrics of one run: slip and rotation (lift and hold), forces (peak, steady, static
+    references), pivoting, drop, finiteness. Forces per finger [N]."""
+    cfg = cfg or scenario.plant_config()
+    ctrl = dict(controller if controller is not None else scenario.controller)
+    f_min = float(ctrl.get("f_min", 0.1))
+    f_max = float(ctrl.get("f_max", 20.0))
+    s_ref = float(ctrl.get("s_ref", 0.8))
+    t = run["t"]
+    end = float(t[-1]) + (t[1] - t[0] if len(t) > 1 else 0.0)
+    hold = scenario.hold_time
+    lumped = cfg.model == "lumped"
+    m: dict[str, Any] = {}
+
+    # pivoting manoeuvre (lugrip with a pivot in the schedule)
+    pivot_t = [float(e["time"]) for e in scenario.schedule if str(e.get("action", "")).startswith("pivot")]
+    pivoting = pivot and bool(pivot_t) and bool(np.any(run["mode"] == 1))
+    phases = [(hold, end)]
+    if pivoting:
+        p0 = pivot_t[0]
+        fin = np.flatnonzero(run["pivot_finished"])
+        fin = fin[t[fin] >= p0]
+        p1 = float(t[fin[0]]) if fin.size else math.inf
+        reason = int(run["pivot_end"][fin[0]]) if fin.size else 0
+        phases = [(hold, p0)] + ([(p1, end)] if math.isfinite(p1) else [])
+        axis = _axis_deg(run, cfg)
+        m.update(
+            pivot_start=p0,
+            pivot_end=p1 if math.isfinite(p1) else None,
+            pivot_duration=(p1 - p0) if math.isfinite(p1) else None,
+            pivot_end_reason={0: "none", 1: "cor_threshold", 2: "timeout", 3: "requested"}[reason],
+            pivot_rotation_deg=float(np.degrees(run["theta"][-1] - run["theta"][run.index(p0)])),
+            final_hang_deg=float(abs(run.hang_deg[-1])),
+            final_axis_deg=float(abs(axis[-1])),
+            initial_axis_deg=float(abs(axis[run.index(p0)])),
+            final_mode="slipping_avoidance" if int(run["mode"][-1]) == 0 else "pivoting",
+            returned_to_avoidance=bool(fin.size and reason == 1 and int(run["mode"][-1]) == 0),
+        )
+    hold_slip, hold_rot = _hold_increment(run, phases, lumped)
+    i_hold = run.index(hold)
+    lift = run.window(0.0, hold)
+    finite = all(np.all(np.isfinite(np.asarray(v, dtype=float))) for v in run.values())
+    cmd = run["command"]
+    m.update(
+        dropped=bool(run["dropped"][-1]),
+        drop_time=float(t[np.argmax(run["dropped"] > 0)]) if run["dropped"][-1] else None,
+        max_slip_mm=float(np.max(run["slip"]) * 1e3),
+        max_rotation_deg=float(np.degrees(np.max(np.abs(run["rotation"])))),
+        lift_slip_mm=float(run["slip"][i_hold] * 1e3),
+        lift_rotation_deg=float(np.degrees(np.max(np.abs(run["rotation"][lift])))) if lift.stop > lift.start else 0.0,
+        hold_slip_mm=hold_slip,
+        hold_rotation_deg=hold_rot,
+        hold_phases=[[a, b] for a, b in phases],
+        # after the lift starts (before it the command is the initial grasp force decaying)
+        peak_force=float(np.max(cmd[run.window(scenario.lift_start, end)])),
+        peak_normal_force=float(np.max(run["f_n"][run.window(scenario.lift_start, end)])),
+        finite=bool(finite and np.all(run["finite"])),
+        command_in_limits=bool(np.all(np.isfinite(cmd)) and np.all(cmd >= f_min - 1e-12) and np.all(cmd <= f_max + 1e-12)),
+    )
+    if scenario.steady_window is not None:
+        sw = run.window(*scenario.steady_window)
+        ft = float(np.mean(0.5 * (run["f_t_true_0"][sw] + run["f_t_true_1"][sw])))
+        tau = float(np.mean(0.5 * (np.abs(run["tau_true_0"][sw]) + np.abs(run["tau_true_1"][sw]))))
+        static = float(static_grasp_force(cfg.contact, ft, tau, s_ref))
+        minimum = float(static_grasp_force(cfg.contact, ft, tau, 1.0))
+        steady = float(np.mean(cmd[sw]))
+        c_tilde = 0.5 * (np.abs(run["c_tilde_0"][sw]) + np.abs(run["c_tilde_1"][sw]))
+        m.update(
+            steady_window=list(scenario.steady_window),
+            steady_force=steady,
+            steady_slippage=float(np.mean(run.S[sw])),
+            steady_c_tilde=float(np.mean(c_tilde)),
+            steady_f_t=ft,
+            steady_tau_nmm=tau * 1e3,
+            static_force=static,
+            min_force=minimum,
+            steady_over_static=steady / static if static > 0 else None,
+            steady_over_min=steady / minimum if minimum > 0 else None,
+        )
+    return m
+
+
+def _survives(scenario: Scenario, metrics: Mapping[str, Any], reference: Mapping[str, Any] | None = None) -> bool:
+    """The run held the object: no drop, finite, hold slip/rotation within the criteria and,
+    given the `reference` run (lugrip without pivoting), a whole-run slip and rotation at most
+    the reference's plus the same limits (a baseline must hold the object at least as well as
+    lugrip, including the lift; otherwise a weak constant force "survives" by letting the object
+    swing into a pose with less torque)."""
+    c = scenario.criteria
+    slip_lim = float(c.get("max_hold_slip_mm", 1.0))
+    rot_lim = float(c.get("max_hold_rotation_deg", 1.0))
+    ok = (
+        not metrics["dropped"]
+        and metrics["finite"]
+        and metrics["hold_slip_mm"] <= slip_lim
+        and metrics["hold_rotation_deg"] <= rot_lim
+    )
+    if ok and reference is not None:
+        ok = (metrics["max_slip_mm"] <= reference["max_slip_mm"] + slip_lim
+              and metrics["max_rotation_deg"] <= reference["max_rotation_deg"] + rot_lim)
+    return ok
+
+
+def constant_force_search(
+    scenario: Scenario,
+    cfg: PlantConfig,
+    *,
+    start: float,
+    reference: Mapping[str, Any] | None = None,
+    tolerance: float = 0.01,
+    f_max: float | None = None,
+    max_runs: int = 24,
+) -> dict[str, Any]:
+    """Minimum constant grasp force [N] with which the scenario (without pivoting) is survived
+    (:func:`_survives`, compared with the `reference` metrics), by bisection on log(force) to a
+    relative `tolerance`, starting from `start` [N].
+
+    Returns {force, run, metrics, history: [[force, survived], ...], found}. ``force`` is the
+    smallest surviving force tried (None when even f_max fails).
+    """
+    f_max = float(f_max if f_max is not None else scenario.controller.get("f_max", 20.0))
+    history: list[list[Any]] = []
+    cache: dict[float, tuple[bool, ClosedLoopRun, dict]] = {}
+
+    def attempt(f: float):
+        if f not in cache:
+            run = run_closed_loop(cfg, scenario.controller, scenario.observer, None, scenario.duration,
+                                  kind="constant_force", constant_force=f)
+            m = compute_metrics(scenario, run, cfg=cfg, pivot=False)
+            ok = _survives(scenario, m, reference)
+            history.append([f, ok])
+            cache[f] = (ok, run, m)
+        return cache[f]
+
+    hi = f_max
+    if not attempt(hi)[0]:
+        return {"force": None, "run": cache[hi][1], "metrics": cache[hi][2], "history": history, "found": False}
+    lo = min(max(start, 1e-3), hi)
+    while attempt(lo)[0] and len(history) < max_runs:
+        hi, lo = lo, lo / 2.0
+    while hi / lo > 1.0 + tolerance and len(history) < max_runs:
+        mid = math.sqrt(lo * hi)
+        if attempt(mid)[0]:
+            hi = mid
+        else:
+            lo = mid
+    ok, run, m = cache[hi]
+    return {"force": hi, "run": run, "metrics": m, "history": history, "found": True}
+
+
+@dataclasses.dataclass
+class ScenarioResult:
+    """Runs, metrics and criteria of one scenario.
+
+    runs/metrics keys: ``lugrip``, ``lugrip_no_pivot`` (scenarios with a pivot), ``constant_force``
+    and ``friction_cone`` (when enabled). criteria: name -> {value, limit, pass} (pass None when
+    not evaluated, e.g. a cross-scenario ratio without its reference).
+    """
+
+    scenario: Scenario
+    plant_model: str
+    short: bool
+    runs: dict[str, ClosedLoopRun]
+    metrics: dict[str, dict[str, Any]]
+    search: dict[str, Any] | None
+    criteria: dict[str, dict[str, Any]]
+    elapsed: float
+
+    @property
+    def name(self) -> str:
+        return self.scenario.name
+
+    @property
+    def passed(self) -> bool:
+        return all(c["pass"] is not False for c in self.criteria.values())
+
+    def to_json(self) -> dict[str, Any]:
+        s = self.scenario
+        search = None
+        if self.search is not None:
+            search = {k: v for k, v in self.search.items() if k not in ("run", "metrics")}
+        return {
+            "title": s.title,
+            "figure": s.figure,
+            "source": str(s.source) if s.source else None,
+            "plant_model": self.plant_model,
+            "short": self.short,
+            "duration": s.duration,
+            "pass": self.passed,
+            "criteria": self.criteria,
+            "metrics": self.metrics,
+            "constant_force_search": search,
+            "choices": s.choices,
+            "elapsed_s": self.elapsed,
+        }
+
+
+def _criterion(value, limit, ok) -> dict[str, Any]:
+    return {"value": value, "limit": limit, "pass": None if ok is None else bool(ok)}
+
+
+def _evaluate(scenario: Scenario, metrics: dict[str, dict[str, Any]], search) -> dict[str, dict]:
+    c = scenario.criteria
+    m = metrics["lugrip"]
+    out: dict[str, dict] = {}
+    for name, limit in c.items():
+        if name == "no_drop":
+            out[name] = _criterion(m["dropped"], False, not m["dropped"])
+        elif name == "no_nan":
+            ok = all(mm["finite"] for mm in metrics.values())
+            out[name] = _criterion(ok, True, ok)
+        elif name == "command_in_limits":
+            out[name] = _criterion(m["command_in_limits"], True, m["command_in_limits"])
+        elif name == "max_hold_slip_mm":
+            out[name] = _criterion(m["hold_slip_mm"], limit, m["hold_slip_mm"] <= float(limit))
+        elif name == "max_hold_rotation_deg":
+            out[name] = _criterion(m["hold_rotation_deg"], limit, m["hold_rotation_deg"] <= float(limit))
+        elif name == "steady_slippage":
+            v = m.get("steady_slippage")
+            out[name] = _criterion(v, list(limit), v is not None and limit[0] <= v <= limit[1])
+        elif name == "steady_force_range":
+            v = m.get("steady_force")
+            out[name] = _criterion(v, list(limit), v is not None and limit[0] <= v <= limit[1])
+        elif name == "static_force_tolerance":
+            v = m.get("steady_over_static")
+            ok = v is not None and abs(v - 1.0) <= float(limit)
+            out[name] = _criterion(v, limit, ok)
+        elif name == "pivot_final_hang_deg":
+            v = m.get("final_hang_deg")
+            out[name] = _criterion(v, limit, v is not None and v <= float(limit))
+        elif name == "pivot_returns_to_avoidance":
+            v = m.get("returned_to_avoidance", False)
+            out[name] = _criterion(v, True, v)
+        elif name == "force_ratio":
+            out[name] = _criterion(None, dict(limit), None)  # filled by evaluate_cross
+        elif name == "constant_force_exceeds_steady":
+            f = None if search is None else search["force"]
+            steady = metrics.get("lugrip_no_pivot", m).get("steady_force")
+            ok = None if search is None else (f is None or (steady is not None and f > steady))
+            if limit == "group":  # one constant force for the whole group: filled by evaluate_cross
+                ok = None
+            out[name] = _criterion({"constant_force": f, "lugrip_steady_force": steady},
+                                   "group constant > steady" if limit == "group" else "constant > steady", ok)
+        elif name == "friction_cone_fails":
+            cone = metrics.get("friction_cone")
+            hold = metrics.get("lugrip_no_pivot", m)
+            if cone is None:
+                out[name] = _criterion(None, True, None)
+            else:
+                cone_fails = not _survives(scenario, cone, hold)
+                lugrip_holds = _survives(scenario, hold)
+                out[name] = _criterion(
+                    {"friction_cone_fails": cone_fails, "lugrip_holds": lugrip_holds,
+                     "cone_dropped": cone["dropped"], "cone_hold_slip_mm": cone["hold_slip_mm"],
+                     "cone_max_rotation_deg": cone["max_rotation_deg"]},
+                    "cone fails, lugrip holds", cone_fails and lugrip_holds)
+    return out
+
+
+def run_scenario(
+    scenario: Scenario | str | Path,
+    *,
+    plant_model: str | None = None,
+    short: bool = False,
+    baselines: bool = True,
+    seed: int | None = None,
+) -> ScenarioResult:
+    """Run a scenario with lugrip's controller and (optionally) the baselines.
+
+    Args:
+        scenario: a Scenario, a name or a YAML path.
+        plant_model: "patch" (default of the files) or "lumped" (faster; no translational slip).
+        short: apply the scenario's ``short`` overrides and a coarser constant-force search (5 %
+            instead of 1 %), for CI.
+        baselines: also run the constant-force search and the friction-cone baseline (as the
+            scenario's ``baselines`` block enables them; both without the pivoting schedule).
+        seed: override the plant's noise seed.
+    """
+    t_start = time.perf_counter()
+    scn = scenario if isinstance(scenario, Scenario) else load_scenario(scenario)
+    if short:
+        scn = scn.shortened()
+    cfg = scn.plant_config(plant_model, seed)
+    runs: dict[str, ClosedLoopRun] = {}
+    metrics: dict[str, dict] = {}
+    runs["lugrip"] = run_closed_loop(cfg, scn.controller, scn.observer, scn.schedule, scn.duration)
+    metrics["lugrip"] = compute_metrics(scn, runs["lugrip"], cfg=cfg)
+    if scn.has_pivot:
+        runs["lugrip_no_pivot"] = run_closed_loop(cfg, scn.controller, scn.observer, None, scn.duration)
+        metrics["lugrip_no_pivot"] = compute_metrics(scn, runs["lugrip_no_pivot"], cfg=cfg, pivot=False)
+    search = None
+    if baselines and scn.baselines.get("constant_force", True):
+        steady = metrics.get("lugrip_no_pivot", metrics["lugrip"]).get("steady_force") or 1.0
+        reference = metrics.get("lugrip_no_pivot", metrics["lugrip"])
+        search = constant_force_search(scn, cfg, start=0.5 * steady, reference=reference,
+                                       tolerance=0.05 if short else 0.01)
+        runs["constant_force"] = search["run"]
+        metrics["constant_force"] = dict(search["metrics"], constant_force=search["force"])
+    if baselines and scn.baselines.get("friction_cone", True):
+        cone = scn.baselines.get("friction_cone")
+        opts = dict(cone) if isinstance(cone, Mapping) else {}
+        runs["friction_cone"] = run_closed_loop(cfg, scn.controller, scn.observer, None, scn.duration,
+                                                kind="friction_cone", **opts)
+        metrics["friction_cone"] = compute_metrics(scn, runs["friction_cone"], cfg=cfg, pivot=False)
+    criteria = _evaluate(scn, metrics, search)
+    return ScenarioResult(scn, cfg.model, short, runs, metrics, search, criteria, time.perf_counter() - t_start)
+
+
+def evaluate_cross(results: Mapping[str, ScenarioResult] | Sequence[ScenarioResult]) -> None:
+    """Fill the cross-scenario criteria of results whose partners ran too: ``force_ratio``
+    (steady force / the reference scenario's) and ``constant_force_exceeds_steady: group`` (a
+    constant-force gripper does not know which object of the group it holds: the constant force
+    that survives every member, i.e. the largest of their minima, against each member's steady
+    force)."""
+    by_name = {r.name: r for r in (results.values() if isinstance(results, Mapping) else results)}
+    groups: dict[str, list[ScenarioResult]] = {}
+    for r in by_name.values():
+        if r.scenario.group:
+            groups.setdefault(r.scenario.group, []).append(r)
+    for r in by_name.values():
+        if r.scenario.criteria.get("constant_force_exceeds_steady") != "group" or r.search is None:
+            continue
+        members = groups.get(r.scenario.group, [r])
+        forces = [x.search["force"] if x.search is not None else None for x in members]
+        crit = r.criteria["constant_force_exceeds_steady"]
+        steady = crit["value"]["lugrip_steady_force"]
+        if any(f is None for f in forces) or steady is None:
+            group_force = None
+            ok = None if any(x.search is None for x in members) else True
+        else:
+            group_force = max(forces)
+            ok = group_force > steady
+        crit["value"] = dict(crit["value"], group_constant_force=group_force,
+                             group=[x.name for x in members])
+        crit["pass"] = ok
+    for r in by_name.values():
+        spec = r.scenario.criteria.get("force_ratio")
+        if spec is None:
+            continue
+        ref = by_name.get(spec["reference"])
+        own = r.metrics["lugrip"].get("steady_force")
+        if ref is None or own is None:
+            r.criteria["force_ratio"] = _criterion(None, dict(spec), None)
+            continue
+        other = ref.metrics["lugrip"].get("steady_force")
+        ratio = own / other if other else math.inf
+        r.criteria["force_ratio"] = _criterion(ratio, dict(spec), ratio >= float(spec["min"]))
+
+
+def metrics_document(results: Sequence[ScenarioResult]) -> dict[str, Any]:
+    """The metrics.json content: per scenario its metrics and a pass flag per criterion."""
+    scenarios = {r.name: r.to_json() for r in results}
+    return {
+        "lugrip_version": __version__,
+        "criteria_meaning": CRITERIA,
+        "scenarios": scenarios,
+        "pass": all(s["pass"] for s in scenarios.values()),
+    }
