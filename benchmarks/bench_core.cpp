@@ -303,6 +303,7 @@ void print_json(const std::vector<Row>& rows, unsigned seed, bool quick) {
   std::printf("  \"cxx_flags\": \"%s\",\n", json_escape(LUGRIP_BENCH_CXX_FLAGS).c_str());
   std::printf("  \"macros\": \"%s\",\n", json_escape(macro_flags()).c_str());
   std::printf("  \"batch\": %d,\n  \"timer_overhead_ns\": %s,\n", kBatch, num(g_overhead).c_str());
+  std::printf("  \"ls_table_nodes\": %d,\n", lugrip::LimitSurface(4.0).intervals() + 1);
   std::printf("  \"sizeof\": {\"LimitSurface\": %zu, \"ContactModel\": %zu, \"CorEstimator\": %zu, "
               "\"CorOutput\": %zu, \"CorInput\": %zu, \"LsPoint\": %zu},\n",
               sizeof(lugrip::LimitSurface), sizeof(lugrip::ContactModel), sizeof(lugrip::CorEstimator),
@@ -429,7 +430,7 @@ void bench_construction(std::vector<Row>& rows, bool quick) {
   const struct { const char* label; double k; } ks[] = {{"2", 2.0}, {"3", 3.0}, {"4", 4.0}, {"8", 8.0}, {"inf", inf}};
   for (const auto& kk : ks) {
     rows.push_back(time_construction(std::string("LimitSurface(k=") + kk.label + ")",
-                                     "two 257-node Hermite tables by quadrature", reps, [&] {
+                                     "two Hermite tables by quadrature", reps, [&] {
                                        const lugrip::LimitSurface ls(kk.k);
                                        g_sink = g_sink + ls.eval(0.5).F;
                                      }));

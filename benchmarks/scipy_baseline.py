@@ -18,13 +18,14 @@ Written as a user would write it with scipy (it does not import lugrip):
   spline, 60 halvings): the baseline for the vectorized Python path.
 
 Per-call timings use ``time.perf_counter_ns`` around every call (the calls take microseconds,
-the clock ~0.1 us). Run ``python benchmarks/scipy_baseline.py [--quick] [--json]``; the
+the clock ~0.1 us), with the cyclic garbage collector disabled while timing, as ``timeit`` does. Run ``python benchmarks/scipy_baseline.py [--quick] [--json]``; the
 benchmark driver is run_benchmarks.py.
 """
 
 from __future__ import annotations
 
 import argparse
+import gc
 import json
 import math
 import sys
@@ -266,13 +267,20 @@ def stats(ns) -> dict:
 
 
 def time_calls(fn, args_list):
+    """Times every call alone; the cyclic garbage collector is off meanwhile (as in timeit)."""
     out, ns = [], []
     clock = time.perf_counter_ns
-    for args in args_list:
-        t0 = clock()
-        r = fn(*args)
-        ns.append(clock() - t0)
-        out.append(r)
+    gc_was_on = gc.isenabled()
+    gc.disable()
+    try:
+        for args in args_list:
+            t0 = clock()
+            r = fn(*args)
+            ns.append(clock() - t0)
+            out.append(r)
+    finally:
+        if gc_was_on:
+            gc.enable()
     return out, ns
 
 
