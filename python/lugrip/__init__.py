@@ -39,6 +39,15 @@ from ._controller import (
 from .io import LogError, LogWarning, SlidingLog, read_log, write_log
 from .sliding import simulate_sliding
 
+# lugrip.identify is the function (the subpackage stays importable: from lugrip.identify import ...)
+from .identify import (
+    IdentificationError,
+    IdentificationResult,
+    RubbingEstimate,
+    estimate_rubbing,
+    identify,
+)
+
 __all__ = [
     "__version__",
     "ContactParams",
@@ -73,4 +82,9 @@ __all__ = [
     "observability",
     "sensor_wrench",
     "simulate_sliding",
+    "identify",
+    "IdentificationResult",
+    "IdentificationError",
+    "estimate_rubbing",
+    "RubbingEstimate",
 ]

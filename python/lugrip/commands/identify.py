@@ -1,0 +1,348 @@
+"""``lugrip identify``: contact parameters from sliding logs with ground-truth velocity (paper
+Section 4, MODEL.md 8), or an object's mu and beta_A from a rubbing log (paper Section 6)."""
+
+from __future__ import annotations
+
+import argparse
+import math
+import sys
+import time
+from pathlib import Path
+
+from . import CliError, positive_float
+
+__all__ = ["ProgressBar", "register", "run", "write_report"]
+
+_EPILOG = """\
+examples:
+  lugrip identify logs/*.csv --out fingertip.yaml --report out/
+  lugrip identify obj/*.parquet --free mu,beta_a --params0 fingertip.yaml --out object.yaml
+  lugrip identify rub.csv --rubbing --params0 fingertip.yaml --out object.yaml
+
+The cost runs the online observer (same settings as 'lugrip observe': give the same
+--bandwidth/--gain/--integrator you run online). Every log needs an 'omega' column (ground
+truth, rad/s); maneuvers come from the 'maneuver' column and are never integrated across a gap.
+"""
+
+
+def register(subparsers) -> None:
+    p = subparsers.add_parser(
+        "identify",
+        help="identify contact parameters from sliding logs (SQP on the observer's velocity error)",
+        description=(
+            "Identify the contact parameters (mu, beta_A, sigma0, sigma_z, delta, gamma) from "
+            "sliding logs with ground-truth velocity by minimising the online observer's "
+            "velocity error (paper eqs. 32-33), or with --rubbing an object's mu and beta_A "
+            "from a rubbing log at known angular velocity."
+        ),
+        epilog=_EPILOG,
+        formatter_class=argparse.RawDescriptionHelpFormatter,
+    )
+    p.add_argument(
+        "logs",
+        nargs="+",
+        type=Path,
+        metavar="LOG",
+        help="sliding logs (CSV, Parquet, MCAP, ROS bags) with an omega column",
+    )
+    p.add_argument(
+        "--out",
+        type=Path,
+        required=True,
+        metavar="YAML",
+        help="write the identified parameters (value, unit, std. error, bounds)",
+    )
+    p.add_argument(
+        "--free",
+        default=None,
+        metavar="NAMES",
+        help="comma-separated parameters to identify (default: all six; the "
+        "per-object step is mu,beta_a)",
+    )
+    p.add_argument(
+        "--params0",
+        type=Path,
+        metavar="YAML",
+        help="start point and values of the fixed parameters (default: computed "
+        "from the data; required with --free)",
+    )
+    p.add_argument(
+        "--start",
+        choices=("data", "params0"),
+        help="start from the data-computed guess or from --params0 (default: params0 when given)",
+    )
+    p.add_argument(
+        "--report",
+        type=Path,
+        metavar="DIR",
+        help="write the report: parameter table, Figure-5-style plot of the "
+        "validation maneuvers, per-maneuver RMSE, cost trace",
+    )
+    p.add_argument(
+        "--validation",
+        type=float,
+        default=0.2,
+        metavar="FRACTION",
+        help="fraction of maneuvers held out for validation (default 0.2)",
+    )
+    p.add_argument("--seed", type=int, default=0, help="seed of the validation split")
+    p.add_argument("--loss", choices=("squared", "huber"), default="squared")
+    p.add_argument(
+        "--huber-scale",
+        type=positive_float,
+        default=0.05,
+        metavar="RAD_S",
+        help="Huber loss: residuals above this count linearly [rad/s]",
+    )
+    p.add_argument(
+        "--weighting",
+        choices=("maneuver", "sample"),
+        default="maneuver",
+        help="each maneuver weighs the same (default) or each sample",
+    )
+    p.add_argument(
+        "--method",
+        choices=("gauss-newton", "slsqp", "trust-constr"),
+        default="gauss-newton",
+        help="optimiser: SQP with the Gauss-Newton Hessian (default), scipy SLSQP or trust-constr",
+    )
+    p.add_argument("--max-iterations", type=int, default=200, metavar="N")
+    p.add_argument(
+        "--uncertainty",
+        choices=("gauss-newton", "sandwich", "bootstrap"),
+        default="gauss-newton",
+        help="standard errors (default: Gauss-Newton)",
+    )
+    p.add_argument(
+        "--bootstrap", type=int, default=20, metavar="N", help="refits for --uncertainty bootstrap"
+    )
+    p.add_argument(
+        "--bandwidth",
+        type=positive_float,
+        metavar="B",
+        help="observer bandwidth l sigma_1 [1/s] (as online)",
+    )
+    p.add_argument(
+        "--gain",
+        type=positive_float,
+        metavar="L",
+        help="fixed observer gain l [1/(kg m^2)] (as online)",
+    )
+    p.add_argument(
+        "--integrator",
+        choices=("rosenbrock", "implicit", "rk4", "rk4_adaptive"),
+        default="rosenbrock",
+        help="observer integrator (as online)",
+    )
+    p.add_argument("--threads", type=int, default=0, help="C++ worker threads (0: all cores)")
+    p.add_argument(
+        "--rubbing",
+        action="store_true",
+        help="rubbing estimate of mu and beta_A instead: the logs' omega is the "
+        "known angular velocity of a rotation about the patch centre "
+        "(needs --params0 for delta and gamma)",
+    )
+    p.add_argument("--quiet", action="store_true", help="no progress bar")
+    p.set_defaults(run=run)
+
+
+class ProgressBar:
+    """Plain-text progress: a bar over the iteration budget, the cost and its reduction.
+    Redraws in place on a terminal, one line per ``every`` iterations otherwise."""
+
+    def __init__(self, total: int, stream=None, width: int = 28, every: int = 10):
+        self.total = max(int(total), 1)
+        self.stream = sys.stderr if stream is None else stream
+        self.width = width
+        self.every = every
+        self.t0 = time.perf_counter()
+        self.first: float | None = None
+        self.tty = bool(getattr(self.stream, "isatty", lambda: False)())
+        self.drawn = False
+
+    def line(self, it: int, cost: float) -> str:
+        if self.first is None:
+            self.first = cost
+        frac = min(it / self.total, 1.0)
+        fill = round(frac * self.width)
+        rel = cost / self.first if self.first else float("nan")
+        return (
+            f"identify [{'#' * fill}{'.' * (self.width - fill)}] it {it:3d}  "
+            f"RMSE {math.sqrt(max(cost, 0.0)):.4g} rad/s  cost x{rel:.3g} of the first  "
+            f"{time.perf_counter() - self.t0:5.1f} s"
+        )
+
+    def __call__(self, it: int, cost: float, params=None) -> None:
+        text = self.line(it, cost)
+        if self.tty:
+            self.stream.write("\r" + text)
+            self.drawn = True
+        elif it == 1 or it % self.every == 0:
+            self.stream.write(text + "\n")
+        self.stream.flush()
+
+    def close(self) -> None:
+        if self.drawn:
+            self.stream.write("\n")
+            self.stream.flush()
+
+
+def write_report(result, out_dir: Path, *, title: str | None = None) -> list[Path]:
+    """Parameter table (text), per-maneuver RMSE (CSV), the cost trace and the Figure-5-style
+    plot of the validation maneuvers (PNG). Returns the written paths."""
+    import numpy as np
+
+    from .. import plot
+
+    out_dir = Path(out_dir)
+    out_dir.mkdir(parents=True, exist_ok=True)
+    written = []
+    path = out_dir / "identification.txt"
+    path.write_text(result.summary() + "\n")
+    written.append(path)
+    path = out_dir / "maneuver_rmse.csv"
+    val = set(result.validation_keys)
+    lines = ["maneuver,set,rmse_rad_s"]
+    for key, v in result.maneuver_rmse.items():
+        lines.append(f"{key},{'validation' if key in val else 'train'},{v:.6g}")
+    path.write_text("\n".join(lines) + "\n")
+    written.append(path)
+    written.append(result.save_yaml(out_dir / "params.yaml"))
+
+    with plot.style():
+        fig, ax = plot.new_figure(1, 1, width=6.0, row_height=3.0)
+        ax.semilogy(
+            np.arange(len(result.cost_trace)),
+            np.sqrt(result.cost_trace),
+            marker="o",
+            color=plot.color(0),
+        )
+        ax.set_xlabel(plot.axis_label("iteration"))
+        ax.set_ylabel(plot.axis_label("training error", r"\sqrt{C}", "rad/s"))
+        ax.set_title(f"{result.status}, {result.iterations} iterations, {result.fit_time:.2f} s")
+        written.append(plot.save(fig, out_dir / "cost_trace.png"))
+
+    tr = result.validation_trace
+    if tr is not None and len(tr["omega"]):
+        # a continuous time axis over the validation maneuvers, in log order
+        t = np.asarray(tr["t"], dtype=float)
+        man = np.asarray(tr["maneuver"])
+        t_plot = np.empty_like(t)
+        offset = 0.0
+        for i in range(man.max() + 1):
+            sel = man == i
+            ti = t[sel] - t[sel][0]
+            t_plot[sel] = ti + offset
+            offset += ti[-1] + 0.1
+        name = "fig05_identification"
+        heading = title or (f"validation maneuvers ({len(tr['keys'])}): identified parameters")
+        try:
+            from ..plot_observer import figure5
+        except ImportError:  # pragma: no cover - the plot module ships with the package
+            figure5 = None
+        if figure5 is not None:
+            fig = figure5(
+                t_plot,
+                tr["omega_hat"],
+                tr["omega"],
+                None,
+                maneuver=man,
+                title=heading,
+                rmse=result.rmse_validation,
+            )
+        else:  # pragma: no cover
+            with plot.style():
+                fig, ax = plot.new_figure(1, 1, width=10.0)
+                ax.plot(t_plot, tr["omega"], color=plot.color(0), lw=0.8, label="omega")
+                ax.plot(t_plot, tr["omega_hat"], color=plot.color(1), lw=0.8, label="omega_hat")
+                ax.legend()
+        written.append(plot.save(fig, out_dir / f"{name}.png"))
+    return written
+
+
+def run(args) -> int:
+    import warnings
+
+    from ..identify import IdentificationError, estimate_rubbing, identify
+    from ..io import read_log
+
+    for path in args.logs:
+        if not path.exists():
+            raise CliError(f"{path}: no such file")
+    if args.rubbing:
+        if args.params0 is None:
+            raise CliError("--rubbing needs --params0 (the fingertip's delta and gamma)")
+        from .._params import ContactParams
+
+        base = ContactParams.from_yaml(args.params0)
+        results = []
+        for path in args.logs:
+            est = estimate_rubbing(read_log(path, allow_gaps=True), base, mode="rotation")
+            results.append(est)
+            print(f"{path}: {est}")
+        est = results[0] if len(results) == 1 else None
+        if est is None:  # several logs: combine by inverse-variance weighting
+            import numpy as np
+
+            w_mu = np.array([1 / r.mu_stderr**2 for r in results])
+            w_b = np.array([1 / r.beta_a_stderr**2 for r in results])
+            mu = float(np.sum(w_mu * [r.mu for r in results]) / w_mu.sum())
+            beta = float(np.sum(w_b * [r.beta_a for r in results]) / w_b.sum())
+        else:
+            mu, beta = est.mu, est.beta_a
+        params = base.replace(mu=mu, beta_a=beta)
+        args.out.parent.mkdir(parents=True, exist_ok=True)
+        params.to_yaml(
+            args.out,
+            comment=f"lugrip identify --rubbing: mu and beta_A from "
+            f"{', '.join(str(p) for p in args.logs)}",
+        )
+        print(f"wrote {args.out}")
+        return 0
+
+    observer = {"integrator": args.integrator}
+    if args.bandwidth is not None:
+        observer["bandwidth"] = args.bandwidth
+    if args.gain is not None:
+        observer["gain"] = args.gain
+    if args.free is not None and args.params0 is None:
+        raise CliError("--free needs --params0 for the values of the fixed parameters")
+    bar = None if args.quiet else ProgressBar(args.max_iterations)
+    logs = [read_log(p, allow_gaps=True) for p in args.logs]
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        try:
+            result = identify(
+                logs,
+                None if args.params0 is None else args.params0,
+                free=args.free
+                if args.free is not None
+                else ("mu", "beta_a", "sigma0", "sigma_z", "delta", "gamma"),
+                observer=observer,
+                validation=args.validation,
+                seed=args.seed,
+                loss=args.loss,
+                huber_scale=args.huber_scale,
+                weighting=args.weighting,
+                method=args.method,
+                max_iterations=args.max_iterations,
+                uncertainty=args.uncertainty,
+                n_bootstrap=args.bootstrap,
+                start=args.start,
+                threads=args.threads,
+                progress=bar,
+            )
+        except IdentificationError as err:
+            raise CliError(str(err)) from None
+        finally:
+            if bar is not None:
+                bar.close()
+    for w in caught:
+        print(f"warning: {w.message}", file=sys.stderr)
+    print(result.summary())
+    result.save_yaml(args.out)
+    print(f"wrote {args.out}")
+    if args.report is not None:
+        for path in write_report(result, args.report):
+            print(f"wrote {path}")
+    return 0

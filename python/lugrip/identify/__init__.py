@@ -1,0 +1,42 @@
+"""Offline identification of the contact parameters (paper Section 4, MODEL.md 8) and the
+per-object "rubbing" estimate of mu and beta_A (paper Section 6).
+
+    >>> import lugrip
+    >>> result = lugrip.identify(logs)                      # all six parameters
+    >>> result.save_yaml("fingertip.yaml")
+    >>> obj = lugrip.identify(object_logs, "fingertip.yaml", free=("mu", "beta_a"))
+
+The cost and its exact gradient run in C++ over all maneuvers in parallel; the observer inside
+the cost is the online one (:class:`lugrip.Observer`).
+"""
+
+from ._fit import (
+    DEFAULT_BOUNDS,
+    PARAMETERS,
+    IdentifiabilityWarning,
+    IdentificationError,
+    IdentificationResult,
+    IdentificationWarning,
+    InitialGuess,
+    ParameterEstimate,
+    identify,
+    initial_guess,
+    load_maneuvers,
+)
+from ._rubbing import RubbingEstimate, estimate_rubbing
+
+__all__ = [
+    "DEFAULT_BOUNDS",
+    "PARAMETERS",
+    "IdentifiabilityWarning",
+    "IdentificationError",
+    "IdentificationResult",
+    "IdentificationWarning",
+    "InitialGuess",
+    "ParameterEstimate",
+    "RubbingEstimate",
+    "estimate_rubbing",
+    "identify",
+    "initial_guess",
+    "load_maneuvers",
+]
