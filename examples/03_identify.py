@@ -1,0 +1,100 @@
+"""Example 03 (Python): identify the contact parameters from sliding logs, then an object's
+mu and beta_A (paper Sections 4 and 6).
+
+1. Simulate Section-4 maneuvers of a fingertip on the Table 1 slider (the "fingertip logs",
+   with ground-truth velocity) and write them as a CSV sliding log.
+2. Identify all six parameters with lugrip.identify: the start point is computed from the data,
+   the cost is the online observer's velocity error (eq. 32) in C++ with its exact gradient;
+   the fit reports the validation RMSE, standard errors and what the data cannot separate.
+3. Per-object step: a few fast maneuvers on a Table 2 object, refit of mu and beta_A only.
+4. The rubbing alternative: rub the fingertip at known angular speeds and regress the torque.
+
+    python examples/03_identify.py [OUT_DIR]
+
+The same with the command line:
+    lugrip simulate-sliding --out fingertip.csv --maneuvers 60
+    lugrip identify fingertip.csv --out fingertip.yaml --report OUT_DIR
+    lugrip identify object.csv --free mu,beta_a --params0 fingertip.yaml --out object.yaml
+"""
+
+from __future__ import annotations
+
+import sys
+import tempfile
+import warnings
+from pathlib import Path
+
+import lugrip
+import numpy as np
+from lugrip.identify import IdentificationWarning
+from lugrip.sim import PatchContact
+from lugrip.sliding import simulate_sliding
+
+# The observer used online; identification must use the same. A fast one (bandwidth 3000/s)
+# gives back the physical parameters; with the default (100/s) sigma0 and sigma_z also absorb
+# the observer's lag (BENCHMARKS.md, issue 4).
+ONLINE = {"bandwidth": 3000.0}
+
+
+def main(out_dir: str | None = None) -> lugrip.ContactParams:
+    truth = lugrip.ContactParams.table1()
+    log = simulate_sliding(truth, 60, seed=3, c_range=(0.02, 1.4), omega_range=(0.002, 0.5))
+    with tempfile.TemporaryDirectory() as tmp:
+        log = lugrip.read_log(lugrip.write_log(log, Path(tmp) / "fingertip.csv"))
+    print(f"fingertip logs: {len(np.unique(log.maneuver))} maneuvers, {len(log)} samples")
+
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", IdentificationWarning)
+        fit = lugrip.identify(log, observer=ONLINE)  # start from the data, all six free
+    print(fit.summary())
+    for name in ("mu", "beta_a", "sigma0", "sigma_z", "delta", "gamma"):
+        print(
+            f"  {name:8s} identified / true = {getattr(fit.params, name) / getattr(truth, name):.4f}"
+        )
+    if out_dir is not None:
+        from lugrip.commands.identify import write_report
+
+        for path in write_report(fit, out_dir):
+            print(f"wrote {path}")
+
+    # Per-object step: the fingertip's parameters stay, mu and beta_A are refitted from ten
+    # maneuvers that slide fast enough (0.5-5 rad/s) for the weak viscous friction to show.
+    obj = lugrip.ContactParams.preset("aluminium_can")
+    obj_log = simulate_sliding(
+        obj, 10, seed=4, c_range=(0.02, 1.4), omega_range=(0.5, 5.0), stick_fraction=0.0
+    )
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", IdentificationWarning)
+        refit = lugrip.identify(
+            obj_log, fit.params, free="mu,beta_a", observer={"bandwidth": 1000.0}, validation=0.0
+        )
+    print(
+        f"object refit: mu {refit.params.mu:.4f} (true {obj.mu}), beta_A "
+        f"{refit.params.beta_a:.4g} (true {obj.beta_a:.4g}) in {refit.fit_time:.2f} s"
+    )
+
+    # Rubbing: rotate the fingertip on the object at known speeds (here on the distributed
+    # patch-contact model) and regress |tau| = mu xi rho f_n + beta_A (pi/2) rho^4 |omega|.
+    pad = PatchContact(obj)
+    f_n, tau, omega = [], [], []
+    for w in (2.0, 4.0, 8.0):
+        for _ in range(200):
+            _, _, tz = pad.advance(5.0, 0.0, 0.0, w, 0.002)
+            f_n.append(5.0)
+            tau.append(-tz)
+            omega.append(w)
+    est = lugrip.estimate_rubbing(
+        None,
+        fit.params,
+        mode="rotation",
+        velocity=np.array(omega),
+        f_n=np.array(f_n),
+        tau=np.array(tau),
+        t=np.arange(len(f_n)) * 0.002,
+    )
+    print(est)
+    return fit.params
+
+
+if __name__ == "__main__":
+    main(sys.argv[1] if len(sys.argv) > 1 else None)
