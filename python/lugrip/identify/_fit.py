@@ -1116,6 +1116,24 @@ def identify(
     train = _Problem(train_m, settings, weighting)
     val = _Problem(val_m, settings, weighting) if val_m else None
 
+    # A computed start can be poor when the data break its assumptions (e.g. a robot that
+    # imposes the motion: the friction at the first sliding sample is far below mu f_n); keep
+    # it only if its cost beats the paper's Table 1 fingertip as a prior guess.
+    if start == "data":
+        prior = ContactParams.table1().replace(k=kk, c_max=cm)
+        cand = p0.replace(**{n: getattr(prior, n) for n in free_t})
+        c_guess = float(train.evaluate(p0, False)["cost"])
+        c_prior = float(train.evaluate(cand, False)["cost"])
+        if math.isfinite(c_prior) and not (c_guess <= c_prior):
+            notes.append(
+                f"the start computed from the data (cost {c_guess:.3g}) was worse than "
+                f"the Table 1 values (cost {c_prior:.3g}): started from Table 1"
+            )
+            guess_notes = {
+                n: "Table 1 (better cost than the data-computed guess)" for n in PARAMETERS
+            }
+            p0 = cand
+
     # --- optimisation in x = ln(p / p0) over the free parameters
     scale = np.array([getattr(p0, n) for n in free_t])
     lo = np.log(np.array([bnds[n][0] for n in free_t]) / scale)
@@ -1263,14 +1281,17 @@ def identify(
     wsum = float(ev["weight_sum"])
     dof = max(n_sc - len(free_t), 1)
     cov = np.full((len(free_t), len(free_t)), np.nan)
+    # parameters at a bound are held there: the covariance is that of the interior ones
+    inner = np.array([lo[i] + 1e-6 < x[i] < hi[i] - 1e-6 for i in range(len(free_t))])
+    ii = np.ix_(inner, inner)
     try:
         if uncertainty == "gauss-newton":
             sigma2 = float(ev["cost"]) * wsum / dof if loss == "squared" else float(sse.sum()) / dof
-            cov = 2.0 * sigma2 / wsum * np.linalg.inv(H)
+            cov[ii] = 2.0 * sigma2 / wsum * np.linalg.inv(H[ii])
         elif uncertainty == "sandwich":
             G = train.maneuver_gradients(ev)[:, idx] * s_free  # d(sum w loss)/d ln p per maneuver
-            Hi = np.linalg.inv(H * wsum)  # Hessian of sum w loss
-            cov = Hi @ (G.T @ G) @ Hi
+            Hi = np.linalg.inv(H[ii] * wsum)  # Hessian of sum w loss
+            cov[ii] = Hi @ (G[:, inner].T @ G[:, inner]) @ Hi
     except np.linalg.LinAlgError:
         notes.append("Gauss-Newton matrix singular: standard errors not available")
     if uncertainty == "bootstrap":
@@ -1286,9 +1307,11 @@ def identify(
         else:
             notes.append("bootstrap needs two or more training maneuvers")
     stderr_log = np.sqrt(np.abs(np.diag(cov)))
-    if np.all(np.isfinite(cov)):
+    if uncertainty != "bootstrap":
+        stderr_log[~inner] = np.nan
+    if np.all(np.isfinite(cov[ii])) and inner.any():
         s = np.sqrt(np.maximum(np.diag(cov), 1e-300))
-        corr = cov / np.outer(s, s)
+        corr = np.where(np.outer(inner, inner), cov / np.outer(s, s), np.nan)
 
     ident = list(notes)
     for ratio, weights in dirs:
@@ -1301,12 +1324,15 @@ def identify(
     # least determined combinations: principal axes of the covariance of the log-parameters
     # (statistical spread only; model mismatch, e.g. the observer's lag, biases beyond it)
     weak: list[tuple[float, dict[str, float]]] = []
-    if np.all(np.isfinite(cov)):
-        var, vec = np.linalg.eigh(cov)
+    names_in = [n for n, k in zip(free_t, inner) if k]
+    if names_in and np.all(np.isfinite(cov[ii])):
+        var, vec = np.linalg.eigh(cov[ii])
         for ax in np.argsort(var)[::-1]:
             v = vec[:, ax] / np.max(np.abs(vec[:, ax]))
             sd = math.sqrt(max(var[ax], 0.0)) * float(np.linalg.norm(v))
-            weak.append((sd, {n: float(round(c, 3)) for n, c in zip(free_t, v) if abs(c) >= 0.05}))
+            weak.append(
+                (sd, {n: float(round(c, 3)) for n, c in zip(names_in, v) if abs(c) >= 0.05})
+            )
         for sd, weights in weak:
             if sd > 0.05 and len(weights) > 1:
                 ident.append(
@@ -1315,7 +1341,7 @@ def identify(
                 )
     for i in range(len(free_t)):
         for j in range(i + 1, len(free_t)):
-            if abs(corr[i, j]) > 0.99:
+            if np.isfinite(corr[i, j]) and abs(corr[i, j]) > 0.99:
                 # the best-determined combination ln p_i + c ln p_j, c = -cov_ij / cov_jj
                 c = -cov[i, j] / cov[j, j]
                 sd = math.sqrt(max(cov[i, i] + 2 * c * cov[i, j] + c * c * cov[j, j], 0.0))

@@ -71,24 +71,25 @@ class RubbingEstimate:
 
 
 def _steady(speed: np.ndarray, dt: np.ndarray, settle: float, tol: float) -> np.ndarray:
-    """Samples whose |speed| stayed within a relative `tol` of its current value for the last
-    `settle` seconds (bristle transients and accelerations excluded)."""
+    """Samples whose speed stayed within a relative `tol` of its current value (same sign) for
+    the preceding `settle` seconds: bristle transients and accelerations are left out."""
     n = speed.size
     keep = np.zeros(n, dtype=bool)
-    t = np.concatenate([[0.0], np.cumsum(dt[1:])]) if n else np.zeros(0)
-    j = 0
-    for i in range(n):
-        while t[i] - t[j] > settle:
-            j += 1
-        if t[i] - t[0] < settle:
-            continue
-        window = speed[max(j - 1, 0) : i + 1]
-        s = abs(speed[i])
-        keep[i] = (
-            s > 0
-            and np.all(np.abs(np.abs(window) - s) <= tol * s)
-            and np.all(np.sign(window) == np.sign(speed[i]))
-        )
+    if n == 0:
+        return keep
+    step = float(np.median(dt[1:])) if n > 1 else 0.002
+    w = max(round(settle / step) if step > 0 else 1, 1) + 1
+    if n < w:
+        return keep
+    from numpy.lib.stride_tricks import sliding_window_view
+
+    win = sliding_window_view(speed, w)  # windows ending at samples w-1 .. n-1
+    cur = speed[w - 1 :]
+    lo, hi = win.min(axis=1), win.max(axis=1)
+    mag = np.abs(cur)
+    ok = (mag > 0) & (np.sign(lo) == np.sign(cur)) & (np.sign(hi) == np.sign(cur))
+    ok &= (hi - lo) <= tol * mag
+    keep[w - 1 :] = ok
     return keep
 
 
@@ -179,6 +180,8 @@ def estimate_rubbing(
         )
     vmin = 0.1 * vmax if min_speed is None else float(min_speed)
     keep = ok & (np.abs(v) >= vmin) & _steady(np.where(ok, v, 0.0), dt, settle, steady_tol)
+    # a step of the normal force restarts the bristles too (noise-tolerant: 10 %)
+    keep &= _steady(np.where(ok, f_n, 0.0), dt, settle, 0.1)
     m = int(np.count_nonzero(keep))
     if m < 10:
         raise IdentificationError(
