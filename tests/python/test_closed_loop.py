@@ -39,8 +39,22 @@ def test_columns_shapes_and_multirate_timing():
     r = run_closed_loop(plant(), None, OBS, None, 2.0)
     assert isinstance(r, ClosedLoopRun)
     n = 1000
-    for name in ("t", "command", "f_n", "S_0", "S_1", "c_tilde_0", "omega_hat_1", "tau_meas_0",
-                 "f_t_true_1", "slip", "rotation", "mode", "dropped", "finite"):
+    for name in (
+        "t",
+        "command",
+        "f_n",
+        "S_0",
+        "S_1",
+        "c_tilde_0",
+        "omega_hat_1",
+        "tau_meas_0",
+        "f_t_true_1",
+        "slip",
+        "rotation",
+        "mode",
+        "dropped",
+        "finite",
+    ):
         assert r[name].shape == (n,), name
     np.testing.assert_allclose(r.t, 0.002 * np.arange(n), atol=1e-12)
     issued = r.command_issued.astype(bool)
@@ -107,9 +121,14 @@ def test_schedule_forms_and_pivot_request():
 
 
 def test_constant_force_and_friction_cone_baselines():
-    const = run_closed_loop(plant(), None, OBS, [(1.0, "pivot")], 2.5, kind="constant_force",
-                            constant_force=4.0)
-    assert np.all(const.command == 4.0) and np.all(const.mode == 0) and np.all(const.dynamic_force == 0)
+    const = run_closed_loop(
+        plant(), None, OBS, [(1.0, "pivot")], 2.5, kind="constant_force", constant_force=4.0
+    )
+    assert (
+        np.all(const.command == 4.0)
+        and np.all(const.mode == 0)
+        and np.all(const.dynamic_force == 0)
+    )
     cone = run_closed_loop(plant(), None, OBS, None, 3.0, kind="friction_cone")
     assert cone.command[0] == pytest.approx(0.1)
     assert np.all(np.diff(cone.command) >= 0.0), "the threshold controller only raises the force"
@@ -162,17 +181,27 @@ def test_python_and_core_agree():
     cog_y=st.floats(-0.05, 0.0),
     f_min=st.floats(0.05, 1.0),
     gs=st.sampled_from([0.0, 3.0]),
-    contact=st.sampled_from(["big_resin_block", "small_resin_block", "plastic_bottle", "aluminium_can"]),
+    contact=st.sampled_from(
+        ["big_resin_block", "small_resin_block", "plastic_bottle", "aluminium_can"]
+    ),
     kind=st.sampled_from(["lugrip", "friction_cone"]),
     push=st.floats(-3.0, 3.0),
     pivot=st.booleans(),
 )
-def test_property_command_finite_in_limits(mass, cog_x, cog_y, f_min, gs, contact, kind, push, pivot):
+def test_property_command_finite_in_limits(
+    mass, cog_x, cog_y, f_min, gs, contact, kind, push, pivot
+):
     """Any object, load and setting: every value finite, the command in [f_min, f_max], S in
     [0, 1] (MODEL.md 10.3 criterion 6)."""
-    d = plant(mass, (cog_x, cog_y), contact,
-              disturbances=[{"t_start": 2.2, "duration": 0.3, "shape": "half_sine", "force": [push, push]}],
-              drop={"rotation_limit": math.inf})
+    d = plant(
+        mass,
+        (cog_x, cog_y),
+        contact,
+        disturbances=[
+            {"t_start": 2.2, "duration": 0.3, "shape": "half_sine", "force": [push, push]}
+        ],
+        drop={"rotation_limit": math.inf},
+    )
     ctrl = {"f_min": f_min, "f_max": 15.0, "gain_schedule_force": gs}
     r = run_closed_loop(d, ctrl, OBS, [(2.0, "pivot")] if pivot else None, 3.0, kind=kind)
     assert np.all(r.finite.astype(bool))

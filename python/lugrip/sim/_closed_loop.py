@@ -19,7 +19,13 @@ from .._controller import _core_settings
 from .._observer import Observer
 from ._plant import PlantConfig
 
-__all__ = ["CONTROLLER_KINDS", "MODE_ACTIONS", "ClosedLoopRun", "closed_loop_config", "run_closed_loop"]
+__all__ = [
+    "CONTROLLER_KINDS",
+    "MODE_ACTIONS",
+    "ClosedLoopRun",
+    "closed_loop_config",
+    "run_closed_loop",
+]
 
 #: Accepted names of the command laws.
 CONTROLLER_KINDS = {
@@ -109,13 +115,17 @@ def _schedule(mode_schedule) -> list[tuple[float, Any]]:
         if isinstance(item, Mapping):
             unknown = set(item) - {"time", "action"}
             if unknown or "time" not in item or "action" not in item:
-                raise ValueError(f"mode_schedule[{k}]: expected {{time, action}}, got {dict(item)!r}")
+                raise ValueError(
+                    f"mode_schedule[{k}]: expected {{time, action}}, got {dict(item)!r}"
+                )
             t, action = item["time"], item["action"]
         else:
             try:
                 t, action = item
             except (TypeError, ValueError):
-                raise ValueError(f"mode_schedule[{k}]: expected (time, action), got {item!r}") from None
+                raise ValueError(
+                    f"mode_schedule[{k}]: expected (time, action), got {item!r}"
+                ) from None
         if isinstance(action, str):
             key = action.lower().replace("-", "_").replace(" ", "_")
             if key not in MODE_ACTIONS:

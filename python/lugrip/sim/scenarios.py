@@ -126,9 +126,22 @@ def _merge(base: dict, over: Mapping) -> dict:
 
 
 _KEYS = {
-    "name", "title", "figure", "group", "description", "choices", "duration", "plant",
-    "controller", "observer", "schedule", "hold_start", "steady_window", "criteria",
-    "baselines", "short",
+    "name",
+    "title",
+    "figure",
+    "group",
+    "description",
+    "choices",
+    "duration",
+    "plant",
+    "controller",
+    "observer",
+    "schedule",
+    "hold_start",
+    "steady_window",
+    "criteria",
+    "baselines",
+    "short",
 }
 
 
@@ -158,7 +171,7 @@ class Scenario:
     def from_dict(cls, data: Mapping[str, Any], source: Path | None = None) -> Scenario:
         where = str(source) if source else "scenario"
         if not isinstance(data, Mapping):
-            raise ValueError(f"{where}: expected a mapping at the top level")
+            raise ValueError(f"{where}: expected a mapping at the top level")  # noqa: TRY004 (file content)
         unknown = sorted(set(data) - _KEYS)
         if unknown:
             raise ValueError(f"{where}: unknown key(s) {', '.join(unknown)}")
@@ -266,7 +279,9 @@ def _hold_increment(run: ClosedLoopRun, phases, lumped: bool) -> tuple[float, fl
         if lumped:
             ds = run["slip"][sl] - run["slip"][i0]
         else:
-            ds = np.hypot(run["slip_x"][sl] - run["slip_x"][i0], run["slip_y"][sl] - run["slip_y"][i0])
+            ds = np.hypot(
+                run["slip_x"][sl] - run["slip_x"][i0], run["slip_y"][sl] - run["slip_y"][i0]
+            )
         slip = max(slip, float(np.max(np.abs(ds))) * 1e3)
         rot = max(rot, float(np.degrees(np.max(np.abs(run["rotation"][sl] - run["rotation"][i0])))))
     return slip, rot
@@ -294,7 +309,9 @@ def compute_metrics(
     m: dict[str, Any] = {}
 
     # pivoting manoeuvre (lugrip with a pivot in the schedule)
-    pivot_t = [float(e["time"]) for e in scenario.schedule if str(e.get("action", "")).startswith("pivot")]
+    pivot_t = [
+        float(e["time"]) for e in scenario.schedule if str(e.get("action", "")).startswith("pivot")
+    ]
     pivoting = pivot and bool(pivot_t) and bool(np.any(run["mode"] == 1))
     phases = [(hold, end)]
     if pivoting:
@@ -328,7 +345,9 @@ def compute_metrics(
         max_slip_mm=float(np.max(run["slip"]) * 1e3),
         max_rotation_deg=float(np.degrees(np.max(np.abs(run["rotation"])))),
         lift_slip_mm=float(run["slip"][i_hold] * 1e3),
-        lift_rotation_deg=float(np.degrees(np.max(np.abs(run["rotation"][lift])))) if lift.stop > lift.start else 0.0,
+        lift_rotation_deg=float(np.degrees(np.max(np.abs(run["rotation"][lift]))))
+        if lift.stop > lift.start
+        else 0.0,
         hold_slip_mm=hold_slip,
         hold_rotation_deg=hold_rot,
         hold_phases=[[a, b] for a, b in phases],
@@ -336,7 +355,11 @@ def compute_metrics(
         peak_force=float(np.max(cmd[run.window(scenario.lift_start, end)])),
         peak_normal_force=float(np.max(run["f_n"][run.window(scenario.lift_start, end)])),
         finite=bool(finite and np.all(run["finite"])),
-        command_in_limits=bool(np.all(np.isfinite(cmd)) and np.all(cmd >= f_min - 1e-12) and np.all(cmd <= f_max + 1e-12)),
+        command_in_limits=bool(
+            np.all(np.isfinite(cmd))
+            and np.all(cmd >= f_min - 1e-12)
+            and np.all(cmd <= f_max + 1e-12)
+        ),
     )
     if scenario.steady_window is not None:
         sw = run.window(*scenario.steady_window)
@@ -361,7 +384,9 @@ def compute_metrics(
     return m
 
 
-def _survives(scenario: Scenario, metrics: Mapping[str, Any], reference: Mapping[str, Any] | None = None) -> bool:
+def _survives(
+    scenario: Scenario, metrics: Mapping[str, Any], reference: Mapping[str, Any] | None = None
+) -> bool:
     """The run held the object: no drop, finite, hold slip/rotation within the criteria and,
     given the `reference` run (lugrip without pivoting), a whole-run slip and rotation at most
     the reference's plus the same limits (a baseline must hold the object at least as well as
@@ -377,8 +402,10 @@ def _survives(scenario: Scenario, metrics: Mapping[str, Any], reference: Mapping
         and metrics["hold_rotation_deg"] <= rot_lim
     )
     if ok and reference is not None:
-        ok = (metrics["max_slip_mm"] <= reference["max_slip_mm"] + slip_lim
-              and metrics["max_rotation_deg"] <= reference["max_rotation_deg"] + rot_lim)
+        ok = (
+            metrics["max_slip_mm"] <= reference["max_slip_mm"] + slip_lim
+            and metrics["max_rotation_deg"] <= reference["max_rotation_deg"] + rot_lim
+        )
     return ok
 
 
@@ -405,8 +432,15 @@ def constant_force_search(
 
     def attempt(f: float):
         if f not in cache:
-            run = run_closed_loop(cfg, scenario.controller, scenario.observer, None, scenario.duration,
-                                  kind="constant_force", constant_force=f)
+            run = run_closed_loop(
+                cfg,
+                scenario.controller,
+                scenario.observer,
+                None,
+                scenario.duration,
+                kind="constant_force",
+                constant_force=f,
+            )
             m = compute_metrics(scenario, run, cfg=cfg, pivot=False)
             ok = _survives(scenario, m, reference)
             history.append([f, ok])
@@ -415,7 +449,13 @@ def constant_force_search(
 
     hi = f_max
     if not attempt(hi)[0]:
-        return {"force": None, "run": cache[hi][1], "metrics": cache[hi][2], "history": history, "found": False}
+        return {
+            "force": None,
+            "run": cache[hi][1],
+            "metrics": cache[hi][2],
+            "history": history,
+            "found": False,
+        }
     lo = min(max(start, 1e-3), hi)
     while attempt(lo)[0] and len(history) < max_runs:
         hi, lo = lo, lo / 2.0
@@ -425,7 +465,7 @@ def constant_force_search(
             hi = mid
         else:
             lo = mid
-    ok, run, m = cache[hi]
+    _, run, m = cache[hi]
     return {"force": hi, "run": run, "metrics": m, "history": history, "found": True}
 
 
@@ -495,7 +535,9 @@ def _evaluate(scenario: Scenario, metrics: dict[str, dict[str, Any]], search) ->
         elif name == "max_hold_slip_mm":
             out[name] = _criterion(m["hold_slip_mm"], limit, m["hold_slip_mm"] <= float(limit))
         elif name == "max_hold_rotation_deg":
-            out[name] = _criterion(m["hold_rotation_deg"], limit, m["hold_rotation_deg"] <= float(limit))
+            out[name] = _criterion(
+                m["hold_rotation_deg"], limit, m["hold_rotation_deg"] <= float(limit)
+            )
         elif name == "steady_slippage":
             v = m.get("steady_slippage")
             out[name] = _criterion(v, list(limit), v is not None and limit[0] <= v <= limit[1])
@@ -520,8 +562,11 @@ def _evaluate(scenario: Scenario, metrics: dict[str, dict[str, Any]], search) ->
             ok = None if search is None else (f is None or (steady is not None and f > steady))
             if limit == "group":  # one constant force for the whole group: filled by evaluate_cross
                 ok = None
-            out[name] = _criterion({"constant_force": f, "lugrip_steady_force": steady},
-                                   "group constant > steady" if limit == "group" else "constant > steady", ok)
+            out[name] = _criterion(
+                {"constant_force": f, "lugrip_steady_force": steady},
+                "group constant > steady" if limit == "group" else "constant > steady",
+                ok,
+            )
         elif name == "friction_cone_fails":
             cone = metrics.get("friction_cone")
             hold = metrics.get("lugrip_no_pivot", m)
@@ -531,10 +576,16 @@ def _evaluate(scenario: Scenario, metrics: dict[str, dict[str, Any]], search) ->
                 cone_fails = not _survives(scenario, cone, hold)
                 lugrip_holds = _survives(scenario, hold)
                 out[name] = _criterion(
-                    {"friction_cone_fails": cone_fails, "lugrip_holds": lugrip_holds,
-                     "cone_dropped": cone["dropped"], "cone_hold_slip_mm": cone["hold_slip_mm"],
-                     "cone_max_rotation_deg": cone["max_rotation_deg"]},
-                    "cone fails, lugrip holds", cone_fails and lugrip_holds)
+                    {
+                        "friction_cone_fails": cone_fails,
+                        "lugrip_holds": lugrip_holds,
+                        "cone_dropped": cone["dropped"],
+                        "cone_hold_slip_mm": cone["hold_slip_mm"],
+                        "cone_max_rotation_deg": cone["max_rotation_deg"],
+                    },
+                    "cone fails, lugrip holds",
+                    cone_fails and lugrip_holds,
+                )
     return out
 
 
@@ -567,24 +618,32 @@ def run_scenario(
     runs["lugrip"] = run_closed_loop(cfg, scn.controller, scn.observer, scn.schedule, scn.duration)
     metrics["lugrip"] = compute_metrics(scn, runs["lugrip"], cfg=cfg)
     if scn.has_pivot:
-        runs["lugrip_no_pivot"] = run_closed_loop(cfg, scn.controller, scn.observer, None, scn.duration)
-        metrics["lugrip_no_pivot"] = compute_metrics(scn, runs["lugrip_no_pivot"], cfg=cfg, pivot=False)
+        runs["lugrip_no_pivot"] = run_closed_loop(
+            cfg, scn.controller, scn.observer, None, scn.duration
+        )
+        metrics["lugrip_no_pivot"] = compute_metrics(
+            scn, runs["lugrip_no_pivot"], cfg=cfg, pivot=False
+        )
     search = None
     if baselines and scn.baselines.get("constant_force", True):
         steady = metrics.get("lugrip_no_pivot", metrics["lugrip"]).get("steady_force") or 1.0
         reference = metrics.get("lugrip_no_pivot", metrics["lugrip"])
-        search = constant_force_search(scn, cfg, start=0.5 * steady, reference=reference,
-                                       tolerance=0.05 if short else 0.01)
+        search = constant_force_search(
+            scn, cfg, start=0.5 * steady, reference=reference, tolerance=0.05 if short else 0.01
+        )
         runs["constant_force"] = search["run"]
         metrics["constant_force"] = dict(search["metrics"], constant_force=search["force"])
     if baselines and scn.baselines.get("friction_cone", True):
         cone = scn.baselines.get("friction_cone")
         opts = dict(cone) if isinstance(cone, Mapping) else {}
-        runs["friction_cone"] = run_closed_loop(cfg, scn.controller, scn.observer, None, scn.duration,
-                                                kind="friction_cone", **opts)
+        runs["friction_cone"] = run_closed_loop(
+            cfg, scn.controller, scn.observer, None, scn.duration, kind="friction_cone", **opts
+        )
         metrics["friction_cone"] = compute_metrics(scn, runs["friction_cone"], cfg=cfg, pivot=False)
     criteria = _evaluate(scn, metrics, search)
-    return ScenarioResult(scn, cfg.model, short, runs, metrics, search, criteria, time.perf_counter() - t_start)
+    return ScenarioResult(
+        scn, cfg.model, short, runs, metrics, search, criteria, time.perf_counter() - t_start
+    )
 
 
 def evaluate_cross(results: Mapping[str, ScenarioResult] | Sequence[ScenarioResult]) -> None:
@@ -611,8 +670,9 @@ def evaluate_cross(results: Mapping[str, ScenarioResult] | Sequence[ScenarioResu
         else:
             group_force = max(forces)
             ok = group_force > steady
-        crit["value"] = dict(crit["value"], group_constant_force=group_force,
-                             group=[x.name for x in members])
+        crit["value"] = dict(
+            crit["value"], group_constant_force=group_force, group=[x.name for x in members]
+        )
         crit["pass"] = ok
     for r in by_name.values():
         spec = r.scenario.criteria.get("force_ratio")
