@@ -284,12 +284,15 @@ def machine() -> dict:
     }
 
 
-def timed_eval(prob, params, derivatives, repeat=5):
+def timed_eval(prob, params, derivatives, repeat=7):
+    """Fastest of `repeat` evaluations (the machine is shared: the minimum is the cost)."""
     prob.evaluate(params, derivatives)
-    t0 = time.perf_counter()
+    best = math.inf
     for _ in range(repeat):
+        t0 = time.perf_counter()
         prob.evaluate(params, derivatives)
-    return (time.perf_counter() - t0) / repeat
+        best = min(best, time.perf_counter() - t0)
+    return best
 
 
 def run(quick: bool) -> dict:
@@ -477,6 +480,8 @@ def section(R: dict) -> str:
     w("")
     w("### Speed")
     w("")
+    w("Fastest of 7 evaluations each (the machine is shared with other jobs).")
+    w("")
     w("| quantity | time |")
     w("|---|---|")
     w(
@@ -607,10 +612,15 @@ def section(R: dict) -> str:
         "RMS omega, and the stick parameters absorb its lag and chattering at slip ends."
     )
     af = t2["all_six_fast_maneuvers_b1000"]
+    off_f = [n for n in PARAMETERS if abs(af["ratio"][n] - 1) > 0.05]
     w(
         f"* All six from maneuvers sliding at 0.5-5 rad/s (viscous torque comparable to g), "
         f"bandwidth 1000/s: ratios {_r(af['ratio'])}, validation RMSE "
-        f"{af['rmse_validation']:.3f} rad/s (RMS {af['rms_omega_validation']:.2f})."
+        f"{af['rmse_validation']:.3f} rad/s (RMS {af['rms_omega_validation']:.2f})"
+        + (f"; outside 5 %: {', '.join(off_f)}" if off_f else "")
+        + ". Fast sliding fixes mu, beta_A, delta and gamma; the stick parameters sigma0 and "
+        "sigma_z are not identifiable from such data (they act only in the short pre-sliding "
+        "phase, where the observer's lag dominates)."
     )
     w(
         "* Per-object refit of mu and beta_A (paper's procedure; other parameters fixed at Table 1) "
@@ -624,6 +634,20 @@ def section(R: dict) -> str:
             f"| {r['seed']} | x{r['start'][0]:g}, x{r['start'][1]:g} | {r['observer']} | "
             f"{r['mu']:.3f} | {r['beta_a']:.3f} | {r['fit_time_s']:.2f} s |"
         )
+    w("")
+    for obs_name in ("b1000", "default"):
+        rows = [r for r in t2["object_refit"] if r["observer"] == obs_name]
+        dm = max(abs(r["mu"] - 1) for r in rows)
+        db = max(abs(r["beta_a"] - 1) for r in rows)
+        label = "bandwidth 1000/s" if obs_name == "b1000" else "default observer (100/s)"
+        w(
+            f"* {label}: largest deviation over the {len(rows)} refits mu {100 * dm:.1f} %, "
+            f"beta_A {100 * db:.1f} %."
+        )
+    w(
+        "  With the default observer beta_A absorbs the observer's lag behind the fast speed "
+        "ramps of these maneuvers (lag ~ (d omega/dt) / bandwidth)."
+    )
     w("")
     p = R["patch"]
     w("### A plant that is not the lumped model")

@@ -541,3 +541,36 @@ def test_cli_reports_a_log_without_omega(tmp_path, capsys):
     code = main(["identify", str(csv), "--out", str(tmp_path / "p.yaml")])
     assert code == 2
     assert "no ground-truth 'omega' column" in capsys.readouterr().err
+
+
+@pytest.mark.parametrize("method", ["sandwich", "bootstrap"])
+def test_other_standard_errors(method):
+    """Maneuver-clustered (sandwich) and bootstrap standard errors: finite, positive, and of
+    the order of the spread of refits on other noise realisations (within a factor 20; both
+    are wider than the Gauss-Newton errors, which assume independent residuals)."""
+    start = TABLE1.replace(mu=TABLE1.mu * 1.3, beta_a=TABLE1.beta_a * 0.7)
+    fits = []
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", IdentificationWarning)
+        for seed in (21, 22, 23):
+            log = simulate_sliding(
+                TABLE1, 8, seed=seed, c_range=(0.02, 1.4), omega_range=(0.002, 0.5)
+            )
+            fits.append(
+                lugrip.identify(
+                    log,
+                    start,
+                    free="mu,beta_a",
+                    observer=FAST,
+                    validation=0.0,
+                    uncertainty=method,
+                    n_bootstrap=6,
+                )
+            )
+    for r in fits:
+        assert r.uncertainty == method
+        for name in ("mu", "beta_a"):
+            assert math.isfinite(r[name].stderr) and r[name].stderr > 0
+    spread = np.std([np.log(r.params.mu) for r in fits])
+    se = np.mean([r["mu"].relative_stderr for r in fits])
+    assert 0.5 * spread < se < 20 * spread
