@@ -574,3 +574,39 @@ def test_other_standard_errors(method):
     spread = np.std([np.log(r.params.mu) for r in fits])
     se = np.mean([r["mu"].relative_stderr for r in fits])
     assert 0.5 * spread < se < 20 * spread
+
+
+def test_cli_rubbing(tmp_path, capsys):
+    """lugrip identify --rubbing: a rotation rubbing log (omega = known angular velocity) and
+    the fingertip's file give the object's mu and beta_A in a parameter file."""
+    from lugrip.cli import main
+
+    data = _rub(RESIN, "rotation", (2.0, 4.0, 8.0, 16.0), forces=(3.0, 6.0))
+    log = SlidingLog.from_arrays(
+        data["t"],
+        data["f_n"],
+        data["tau"],
+        f_t=data["f_t"],
+        omega=data["velocity"],
+        check_units=False,
+    )
+    csv = lugrip.write_log(log, tmp_path / "rub.csv")
+    tip = tmp_path / "tip.yaml"
+    TABLE1.to_yaml(tip)
+    code = main(
+        [
+            "identify",
+            str(csv),
+            "--rubbing",
+            "--params0",
+            str(tip),
+            "--out",
+            str(tmp_path / "obj.yaml"),
+        ]
+    )
+    assert code == 0, capsys.readouterr().err
+    obj = ContactParams.from_yaml(tmp_path / "obj.yaml")
+    assert obj.mu == pytest.approx(RESIN.mu, rel=0.05)
+    assert obj.beta_a == pytest.approx(RESIN.beta_a, rel=0.05)
+    assert obj.sigma0 == TABLE1.sigma0
+    assert "rubbing (rotation" in capsys.readouterr().out
