@@ -1,20 +1,92 @@
-"""The ``lugrip`` command line."""
+"""The ``lugrip`` command line: ``lugrip <command> [options]``.
+
+Subcommands live in :mod:`lugrip.commands` (one module each, listed in
+``lugrip.commands.COMMANDS``). User errors exit with code 2 and one line on stderr; set
+``LUGRIP_DEBUG=1`` to get the traceback instead.
+"""
 
 from __future__ import annotations
 
 import argparse
+import importlib
+import os
 import sys
+
+from .commands import COMMANDS, CliError
+
+__all__ = ["main", "build_parser"]
+
+_DESCRIPTION = (
+    "lugrip: model-based slip detection, slip avoidance and pivoting for parallel grippers "
+    "with force/torque fingertips (limit surface + LuGre friction)."
+)
+_EPILOG = "Run 'lugrip <command> --help' for the options of a command."
+
+
+class _UsageError(Exception):
+    def __init__(self, prog: str, message: str):
+        super().__init__(message)
+        self.prog = prog
+        self.message = message
+
+
+class _Parser(argparse.ArgumentParser):
+    """ArgumentParser that raises instead of printing the usage and exiting, so main() can
+    report a bad argument as one line and return 2 (also when called in-process)."""
+
+    def error(self, message: str):  # type: ignore[override]
+        raise _UsageError(self.prog, message)
+
+
+def build_parser() -> argparse.ArgumentParser:
+    """The top-level parser with every subcommand of ``lugrip.commands.COMMANDS``."""
+    from . import __version__
+
+    parser = _Parser(prog="lugrip", description=_DESCRIPTION, epilog=_EPILOG)
+    parser.add_argument("--version", action="version", version=f"lugrip {__version__}")
+    subparsers = parser.add_subparsers(dest="command", metavar="<command>", required=True,
+                                       parser_class=_Parser)
+    for name in COMMANDS:
+        module = importlib.import_module(f"{__package__}.commands.{name}")
+        module.register(subparsers)
+    return parser
+
+
+def _one_line(err: BaseException) -> str:
+    text = str(err) or type(err).__name__
+    if isinstance(err, OSError) and err.filename is not None and err.strerror:
+        text = f"{err.filename}: {err.strerror}"
+    return "; ".join(part.strip() for part in text.splitlines() if part.strip())
 
 
 def main(argv: list[str] | None = None) -> int:
-    parser = argparse.ArgumentParser(prog="lugrip", description=__doc__)
-    parser.add_argument("--version", action="store_true")
-    args = parser.parse_args(argv)
-    if args.version:
-        from . import __version__
+    """Entry point of the ``lugrip`` script; returns the exit code (0 ok, 2 user error)."""
+    parser = build_parser()
+    try:
+        args = parser.parse_args(argv)
+    except _UsageError as err:
+        print(f"{err.prog}: error: {_one_line(err)} (see '{err.prog} --help')", file=sys.stderr)
+        return 2
+    except SystemExit as exit_:  # --help, --version
+        return exit_.code if isinstance(exit_.code, int) else 0
 
-        print(__version__)
-    return 0
+    prog = f"lugrip {args.command}"
+    try:
+        return int(args.run(args) or 0)
+    except BrokenPipeError:  # e.g. `lugrip ls | head`: not an error
+        try:  # silence the second failure when Python flushes stdout at exit
+            os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
+        except (OSError, ValueError):
+            pass
+        return 0
+    except (CliError, ValueError, OSError) as err:
+        if os.environ.get("LUGRIP_DEBUG"):
+            raise
+        print(f"{prog}: error: {_one_line(err)}", file=sys.stderr)
+        return 2
+    except KeyboardInterrupt:
+        print(f"{prog}: interrupted", file=sys.stderr)
+        return 130
 
 
 if __name__ == "__main__":

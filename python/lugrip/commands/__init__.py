@@ -1,0 +1,72 @@
+"""Subcommands of the ``lugrip`` command line.
+
+Each subcommand is a module of this package exposing
+
+* ``register(subparsers)``: adds its parser with ``subparsers.add_parser(...)`` and sets
+  ``parser.set_defaults(run=run)``;
+* ``run(args) -> int``: does the work and returns the exit code.
+
+Adding a subcommand is one line: append its module name to ``COMMANDS`` (the order is the
+order of ``lugrip --help``). Modules import heavy dependencies (matplotlib, scipy) inside
+``run`` so that ``lugrip --help`` stays fast.
+
+Errors the user can fix (bad argument value, unreadable or invalid file) are raised as
+:class:`CliError` (or ``ValueError``/``OSError``); the entry point prints them as one line and
+exits with code 2, without a traceback.
+"""
+
+from __future__ import annotations
+
+import argparse
+import math
+
+__all__ = ["COMMANDS", "CliError", "parse_k", "k_label", "positive_float"]
+
+COMMANDS: list[str] = [
+    "ls",
+    "params",
+    "simulate_sliding",
+    "observe",
+    "identify",
+    "simulate",
+    "demo",
+]
+"""Module names (in this package) of the subcommands, in --help order."""
+
+
+class CliError(Exception):
+    """A user error: printed as ``lugrip <command>: error: <message>``, exit code 2."""
+
+
+def parse_k(text: str) -> float:
+    """argparse type for a pressure exponent k: a positive number or 'inf'."""
+    t = text.strip().lower()
+    if t in ("inf", "infinity", "+inf", "oo"):
+        return math.inf
+    try:
+        value = float(t)
+    except ValueError:
+        raise argparse.ArgumentTypeError(
+            f"invalid value {text!r}: expected a positive number or 'inf'") from None
+    if math.isnan(value) or value <= 0.0:
+        raise argparse.ArgumentTypeError(
+            f"invalid value {text!r}: the pressure exponent k must be > 0 (or 'inf')")
+    return value
+
+
+def positive_float(text: str) -> float:
+    """argparse type for a finite number > 0."""
+    try:
+        value = float(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"invalid value {text!r}: expected a number") from None
+    if not (math.isfinite(value) and value > 0.0):
+        raise argparse.ArgumentTypeError(f"invalid value {text!r}: must be finite and > 0")
+    return value
+
+
+def k_label(k: float) -> str:
+    """'2', '4', '3.5', 'inf' — for file names, CSV cells and legends."""
+    if math.isinf(k):
+        return "inf"
+    return f"{k:g}"
