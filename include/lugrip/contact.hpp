@@ -45,8 +45,9 @@ class ContactModel {
   //! Root of h(a) = f - F(a) - 2 xi a (t - T(a)) on [0, c_max] (eq. 13, second line,
   //! MODEL.md 5.4); returns c_max when h(c_max) > 0.
   //! `guess` (optional, e.g. the inside-LS estimate) starts the iteration.
+  //! `point` (optional) receives the LS point (F, T, dF, dT) at the returned a.
   double solve_outside(double ft_abs, double tau_abs, int* iterations = nullptr,
-                       double guess = -1.0) const noexcept;
+                       double guess = -1.0, LsPoint* point = nullptr) const noexcept;
 
  private:
   ContactParams p_;
