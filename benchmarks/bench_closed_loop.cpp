@@ -274,8 +274,8 @@ int main(int argc, char** argv) {
                   parts[i].controller_ns, rs[i].allocations);
     std::printf("\nWhere the time goes (lumped plant, 1 kHz): per sample the plant takes two steps (%.0f ns together, "
                 "each with a CoR estimate of the quasi-static load and an implicit rotor step), each of the two "
-                "observers one CoR estimate and one Rosenbrock step (%.0f ns each), the controller %.0f ns. Four CoR "
-                "estimates per sample at ~250 ns each (issue-2 table above) alone bound this loop to ~1e6 samples/s; "
+                "observers one CoR estimate and one Rosenbrock step (%.0f ns each), the controller %.0f ns. The four CoR "
+                "estimates per sample (per-call time in the issue-2 table) take most of a microsecond on their own; "
                 "reaching the target would need the lumped plant to reuse its CoR while the load is unchanged "
                 "(plant code, not changed here). The component times come from separate replays and vary by "
                 "+-30 %% with the load of this shared machine.\n\n",
