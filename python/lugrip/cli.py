@@ -14,7 +14,7 @@ import sys
 
 from .commands import COMMANDS, CliError
 
-__all__ = ["main", "build_parser"]
+__all__ = ["build_parser", "main"]
 
 _DESCRIPTION = (
     "lugrip: model-based slip detection, slip avoidance and pivoting for parallel grippers "

@@ -31,16 +31,16 @@ from matplotlib.figure import Figure
 from matplotlib.lines import Line2D
 
 __all__ = [
+    "DPI",
     "PALETTE",
     "RC",
-    "DPI",
-    "color",
-    "style",
-    "new_figure",
-    "save",
     "axis_label",
-    "panel_labels",
+    "color",
     "inset_zoom",
+    "new_figure",
+    "panel_labels",
+    "save",
+    "style",
 ]
 
 PALETTE: tuple[str, ...] = (

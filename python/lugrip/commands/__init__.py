@@ -20,7 +20,7 @@ from __future__ import annotations
 import argparse
 import math
 
-__all__ = ["COMMANDS", "CliError", "parse_k", "k_label", "positive_float"]
+__all__ = ["COMMANDS", "CliError", "k_label", "parse_k", "positive_float"]
 
 COMMANDS: list[str] = [
     "ls",

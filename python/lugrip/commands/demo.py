@@ -18,11 +18,11 @@ import time
 import traceback
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Callable, Union
+from typing import Callable
 
 from . import CliError
 
-__all__ = ["DemoStep", "STEPS", "register", "run", "run_demo", "REPORT_NAME"]
+__all__ = ["REPORT_NAME", "STEPS", "DemoStep", "register", "run", "run_demo"]
 
 REPORT_NAME = "report.md"
 
@@ -41,7 +41,7 @@ class DemoStep:
 
     name: str
     title: str
-    function: Union[StepFunction, str]
+    function: StepFunction | str
 
     def resolve(self) -> StepFunction:
         if callable(self.function):
@@ -112,7 +112,7 @@ def run_demo(out_dir: str | Path, steps: list[DemoStep] | None = None,
         try:
             body = step.resolve()(out_dir)
             status = "ok"
-        except Exception:  # a failing step must not hide the others; reported below
+        except Exception:  # noqa: BLE001  (a failing step must not hide the others)
             body = ("**This step failed:**\n\n```\n" + traceback.format_exc().rstrip() +
                     "\n```\n")
             status = "FAILED"
@@ -132,11 +132,11 @@ def run_demo(out_dir: str | Path, steps: list[DemoStep] | None = None,
         f"- Python {platform.python_version()} on {platform.system()} {platform.machine()}",
         f"- command: `lugrip demo --out {out_dir.as_posix()}`",
         "",
-        "lugrip implements a model-based approach to slip detection, slip avoidance and "
+        ("lugrip implements a model-based approach to slip detection, slip avoidance and "
         "controlled pivoting for a parallel gripper whose fingertips measure the normal force, "
         "the tangential force and the torsional moment (limit surface + LuGre friction). Each "
         "section below was produced by one demo step; figures are in the same directory as "
-        "this report.",
+        "this report."),
         "",
         *summary,
         "",

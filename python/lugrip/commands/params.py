@@ -9,7 +9,7 @@ from pathlib import Path
 
 from . import CliError
 
-__all__ = ["register", "run", "preset_yaml", "describe", "PRESET_SOURCES"]
+__all__ = ["PRESET_SOURCES", "describe", "preset_yaml", "register", "run"]
 
 PRESET_SOURCES = {
     "table1": "paper Table 1: parameters identified on a rigid cardboard slider",
@@ -66,7 +66,7 @@ def register(subparsers) -> None:
 
 def preset_yaml(name: str) -> str:
     """YAML text of a preset, with comments giving its source and the beta_A unit note."""
-    from .. import ContactParams, PRESETS
+    from .. import PRESETS, ContactParams
 
     key = name.lower().replace("-", "_")
     if key == "aluminum_can":
@@ -119,7 +119,7 @@ def describe(params, source: str = "") -> str:
 
 
 def run(args: argparse.Namespace) -> int:
-    from .. import ContactParams, PRESETS
+    from .. import PRESETS, ContactParams
 
     if args.list:
         width = max(len(n) for n in PRESETS)
