@@ -94,11 +94,12 @@ def _select(only) -> list[DemoStep]:
 
 
 def run_demo(out_dir: str | Path, steps: list[DemoStep] | None = None,
-             log=sys.stderr) -> tuple[Path, list[str]]:
+             log=None) -> tuple[Path, list[str]]:
     """Run the steps, write out_dir/report.md. Returns (report path, names of failed steps).
     A failing step is recorded in the report (with its traceback) and the others still run."""
     from .. import __version__
 
+    log = sys.stderr if log is None else log  # looked up per call (tests swap sys.stderr)
     out_dir = Path(out_dir)
     if out_dir.exists() and not out_dir.is_dir():
         raise CliError(f"argument --out: {out_dir} exists and is not a directory")
