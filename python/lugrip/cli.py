@@ -12,7 +12,7 @@ import importlib
 import os
 import sys
 
-from .commands import COMMANDS, CliError
+from .commands import COMMANDS, CliError, HelpFormatter
 
 __all__ = ["build_parser", "main"]
 
@@ -32,7 +32,14 @@ class _UsageError(Exception):
 
 class _Parser(argparse.ArgumentParser):
     """ArgumentParser that raises instead of printing the usage and exiting, so main() can
-    report a bad argument as one line and return 2 (also when called in-process)."""
+    report a bad argument as one line and return 2 (also when called in-process). Help text
+    is wrapped by HelpFormatter unless a command chooses another formatter."""
+
+    def __init__(self, *args, **kwargs):
+        if kwargs.get("formatter_class") in (None, argparse.HelpFormatter,
+                                             argparse.RawDescriptionHelpFormatter):
+            kwargs["formatter_class"] = HelpFormatter
+        super().__init__(*args, **kwargs)
 
     def error(self, message: str):  # type: ignore[override]
         raise _UsageError(self.prog, message)

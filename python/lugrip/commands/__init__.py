@@ -20,7 +20,7 @@ from __future__ import annotations
 import argparse
 import math
 
-__all__ = ["COMMANDS", "CliError", "k_label", "parse_k", "positive_float"]
+__all__ = ["COMMANDS", "CliError", "HelpFormatter", "k_label", "parse_k", "positive_float"]
 
 COMMANDS: list[str] = [
     "ls",
@@ -32,6 +32,24 @@ COMMANDS: list[str] = [
     "demo",
 ]
 """Module names (in this package) of the subcommands, in --help order."""
+
+
+class HelpFormatter(argparse.RawDescriptionHelpFormatter):
+    """Wraps one-line paragraphs of the description/epilog to the terminal width and keeps
+    paragraphs that contain line breaks (example blocks) as written. The ``lugrip`` parser
+    uses it for every subcommand that asks for the default or the raw-description formatter."""
+
+    def _fill_text(self, text, width, indent):
+        import textwrap
+
+        out = []
+        for para in text.split("\n\n"):
+            if "\n" in para.strip("\n"):
+                out.append("\n".join(indent + line for line in para.splitlines()))
+            else:
+                out.append(textwrap.fill(" ".join(para.split()), width,
+                                         initial_indent=indent, subsequent_indent=indent))
+        return "\n\n".join(out)
 
 
 class CliError(Exception):
