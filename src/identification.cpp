@@ -369,8 +369,12 @@ void run_segment(Observer& obs, const SegmentWork& w, int64_t begin, int64_t end
           z.v = o.z_hat;
         } else {
           Dual zz = z, ww = omega;
-          zz.v = z_before;
-          ww.v = w_before;
+          if (o.cor_side_flipped) {  // the observer mirrored its state before the update
+            zz = Dual(0.0) - zz;
+            ww = Dual(0.0) - ww;
+          }
+          zz.v = o.cor_side_flipped ? -z_before : z_before;
+          ww.v = o.cor_side_flipped ? -w_before : w_before;
           advance(zz, ww, h, c, os.integrator, o.substeps);
           const double bound = o.g / p.sigma0;
           out.replica_error = std::max(out.replica_error, std::fabs(ww.v - o.omega_hat));

@@ -163,6 +163,7 @@ Status Observer::step(const ObserverInput& in, ObserverOutput& out) noexcept {
 
   // (1) CoR from the low-pass filtered torque with sign hysteresis; raw torque for y.
   const bool init = need_init_;
+  bool flipped = false;
   if (init) {
     cor_.reset();
     tau_f_ = in.tau;
@@ -172,7 +173,18 @@ Status Observer::step(const ObserverInput& in, ObserverOutput& out) noexcept {
     const double alpha = s_.torque_cutoff > 0.0 ? -std::expm1(-kTwoPi * s_.torque_cutoff * h) : 1.0;
     tau_f_ += alpha * (in.tau - tau_f_);
     ft_f_ += alpha * (in.f_t - ft_f_);
-    if (std::fabs(tau_f_) > sign_band_) cor_sign_ = tau_f_ < 0.0 ? -1.0 : 1.0;
+    if (std::fabs(tau_f_) > sign_band_) {
+      const double side = tau_f_ < 0.0 ? -1.0 : 1.0;
+      // The CoR changes side: the torque about it, y = tau - c f_t, changes sign with c (for a
+      // translation-dominated load almost entirely). The state is the friction about the CoR, so
+      // mirror it: S stays continuous instead of dropping to 0 while z_hat crosses zero.
+      if (side != cor_sign_) {
+        z_ = -z_;
+        omega_ = -omega_;
+        flipped = true;
+      }
+      cor_sign_ = side;
+    }
   }
   const double tau_cor = std::copysign(std::fabs(tau_f_), cor_sign_);
   CorOutput co;
@@ -197,6 +209,7 @@ Status Observer::step(const ObserverInput& in, ObserverOutput& out) noexcept {
 
   // (3)-(4) update and projection, or (re)initialisation.
   ObserverOutput r;
+  r.cor_side_flipped = flipped;
   Status status = cor_status;
   if (init) {
     z_ = clip(rc.drive / rc.sigma0, bound);

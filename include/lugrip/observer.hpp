@@ -112,6 +112,7 @@ struct ObserverOutput {
   bool inside = true;       //!< CoR wrench strictly inside the limit surface (eq. 15)
   bool saturated = false;   //!< |c~| clipped at c_max
   bool projected = false;   //!< z_hat was clipped to +-g/sigma0 after the update
+  bool cor_side_flipped = false;  //!< the CoR changed side this sample: the state was mirrored (z, omega -> -z, -omega)
   bool diverged = false;    //!< the update left the valid range (|omega_hat| > omega_limit or non-finite): re-initialised
   bool substeps_capped = false;  //!< Rk4Adaptive needed more than max_substeps
   int substeps = 0;         //!< integrator (sub)steps on this sample (0 when not integrated)

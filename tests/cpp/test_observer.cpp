@@ -358,8 +358,8 @@ TEST(Observer, TorqueFilterAndSignHysteresisStopCorChatterOnTranslationalLoads) 
   // Pure translational stick load (tau = 0) at half the translational capacity, with the
   // spec's default noise (0.01 N mm torque, 5 mN forces). The CoR side follows sign(tau): raw it
   // flips on most samples, flipping y = tau - c f_t and with it z_hat. Measured (10 s):
-  //   no filter:                      > 100 side flips/s, S std ~ 0.02
-  //   2 Hz filter, no hysteresis:     ~ 10-30 flips/s,     S std ~ 0.1 (each flip drags z_hat)
+  //   no filter:                      > 100 side flips/s, S std ~ 0.008 (state mirrored per flip)
+  //   2 Hz filter, no hysteresis:     ~ 10-30 flips/s,     S std ~ 0.02-0.05
   //   2 Hz + 5-sigma hysteresis (default): no flip,        S std < 0.005, |omega_hat| ~ 1e-6
   // The filter's cost on a proportional rotational ramp is checked below (filter_force keeps
   // f_t and tau in phase).
@@ -396,17 +396,19 @@ TEST(Observer, TorqueFilterAndSignHysteresisStopCorChatterOnTranslationalLoads) 
     ObserverSettings raw;
     raw.torque_cutoff = 0.0;
     raw.cor_sign_sigmas = 0.0;
-    stats(raw, flips, s_std, w_rms);
+    // Each side change mirrors the state (z, omega -> -z, -omega), which keeps S continuous;
+    // the chatter still shows in c~ and, through the filter lag, in S.
+    double s_std_raw, s_std_filtered;
+    stats(raw, flips, s_std_raw, w_rms);
     EXPECT_GT(flips, 100.0);
-    EXPECT_GT(s_std, 0.01);
     ObserverSettings filtered;
     filtered.cor_sign_sigmas = 0.0;
-    stats(filtered, flips, s_std, w_rms);
+    stats(filtered, flips, s_std_filtered, w_rms);
     EXPECT_GT(flips, 1.0);
-    EXPECT_GT(s_std, 0.05);
     stats(ObserverSettings(), flips, s_std, w_rms);
     EXPECT_EQ(flips, 0.0);
     EXPECT_LT(s_std, 0.005);
+    EXPECT_LT(s_std, 0.5 * std::min(s_std_raw, s_std_filtered));
     EXPECT_LT(w_rms, 1e-5);
   }
   // Cost on a rotation-dominated proportional ramp: the filtered CoR stays at the true |c~|.

@@ -137,11 +137,16 @@ def reference_observer(p, f_n, f_t, tau, s):
     tau_f, ft_f = tau[0], f_t[0]
     side = -1.0 if tau[0] < 0 else 1.0
     ft_cor, tau_cor = [ft_f], [math.copysign(abs(tau_f), side)]
+    flipped = [False]  # the CoR changes side: the state is mirrored before the update
     for i in range(1, len(tau)):
         tau_f += alpha * (tau[i] - tau_f)
         ft_f += alpha * (f_t[i] - ft_f)
+        flip = False
         if abs(tau_f) > band:
-            side = -1.0 if tau_f < 0 else 1.0
+            new_side = -1.0 if tau_f < 0 else 1.0
+            flip = new_side != side
+            side = new_side
+        flipped.append(flip)
         ft_cor.append(ft_f)
         tau_cor.append(math.copysign(abs(tau_f), side))
     cor = lugrip.estimate_cor(p, f_n, np.array(ft_cor), np.array(tau_cor))
@@ -153,6 +158,8 @@ def reference_observer(p, f_n, f_t, tau, s):
     zs, ws = [z], [w]
     cap = s["max_substeps"]
     for i in range(1, len(tau)):
+        if flipped[i]:
+            z, w = -z, -w
         bound = g[i] / s0
         z = min(max(z, -bound), bound)
         g_i = g[i]
@@ -195,6 +202,7 @@ def test_cpp_matches_independent_numpy_model():
     np.testing.assert_allclose(run.z_hat, z, rtol=1e-9, atol=1e-15)
     np.testing.assert_allclose(run.omega_hat, w, rtol=1e-8, atol=1e-10 * np.abs(w).max())
     assert np.abs(w).max() > 0.05  # the comparison covered sliding
+    assert (np.diff(np.sign(ct)) != 0).any()  # and at least one change of the CoR side
 
 
 def test_run_equals_step_by_step():
