@@ -64,25 +64,7 @@ void tridiagonal_eigen(std::vector<double>& d, std::vector<double> e, std::vecto
 }  // namespace
 
 void gauss_gegenbauer(int n, double alpha, std::vector<double>& x, std::vector<double>& w) {
-  if (n < 1 || !(alpha > -1.0)) throw std::invalid_argument("gauss_gegenbauer: bad arguments");
-  std::vector<double> d(n, 0.0), e(n > 1 ? n - 1 : 0), first;
-  for (int j = 1; j < n; ++j) {
-    const double jj = j;
-    e[j - 1] = std::sqrt(jj * (jj + 2.0 * alpha) / (4.0 * (jj + alpha) * (jj + alpha) - 1.0));
-  }
-  tridiagonal_eigen(d, e, first);
-  // mu0 = int (1-x^2)^alpha dx = 2^(2 alpha + 1) B(alpha + 1, alpha + 1)
-  const double mu0 = std::exp((2.0 * alpha + 1.0) * std::log(2.0) + 2.0 * std::lgamma(alpha + 1.0) -
-                              std::lgamma(2.0 * alpha + 2.0));
-  std::vector<int> order(n);
-  std::iota(order.begin(), order.end(), 0);
-  std::sort(order.begin(), order.end(), [&](int a, int b) { return d[a] < d[b]; });
-  x.resize(n);
-  w.resize(n);
-  for (int i = 0; i < n; ++i) {
-    x[i] = d[order[i]];
-    w[i] = mu0 * first[order[i]] * first[order[i]];
-  }
+  gauss_jacobi(n, alpha, alpha, x, w);
   // Exact symmetry of the rule.
   for (int i = 0; i < n / 2; ++i) {
     const double xs = 0.5 * (x[n - 1 - i] - x[i]);
