@@ -38,6 +38,8 @@ test-cpp:
 test-python: install
 	$(VPY) -m pytest -q tests/python
 
+# `make bench`: every section of BENCHMARKS.md (issues 2-5), ~5 minutes; ratios come from one run.
+
 # Debug build of the C++ tests with AddressSanitizer and UBSan.
 sanitize:
 	cmake -S . -B build/asan -DCMAKE_BUILD_TYPE=Debug -DLUGRIP_BUILD_TESTS=ON -DLUGRIP_SANITIZE=ON > /dev/null
@@ -48,6 +50,11 @@ bench: install
 	cmake -S . -B $(CPP_BUILD) -DCMAKE_BUILD_TYPE=Release -DLUGRIP_BUILD_TESTS=ON -DLUGRIP_BUILD_BENCHMARKS=ON > /dev/null
 	cmake --build $(CPP_BUILD) -j $(JOBS)
 	$(VPY) benchmarks/run_benchmarks.py --cpp-dir $(CPP_BUILD)/benchmarks --out BENCHMARKS.md
+	$(VPY) benchmarks/observer_report.py --cpp-dir $(CPP_BUILD)/benchmarks --out BENCHMARKS.md
+	$(VPY) benchmarks/bench_identify.py --out BENCHMARKS.md
+	$(CPP_BUILD)/benchmarks/bench_closed_loop --markdown > build/issue5.md
+	$(VPY) -c "import re,pathlib; b=pathlib.Path('BENCHMARKS.md'); n=pathlib.Path('build/issue5.md').read_text().strip(); \
+	  b.write_text(re.sub(r'<!-- issue5:begin -->.*?<!-- issue5:end -->', lambda m: n, b.read_text(), flags=re.S))"
 
 clean:
 	rm -rf build $(OUT)
