@@ -35,19 +35,7 @@
 #define LUGRIP_BENCH_BUILD_TYPE "unknown"
 #endif
 
-namespace {
-std::atomic<long> g_allocations{0};
-}
-void* operator new(std::size_t n) {
-  g_allocations.fetch_add(1, std::memory_order_relaxed);
-  if (void* p = std::malloc(n ? n : 1)) return p;
-  throw std::bad_alloc();
-}
-void* operator new[](std::size_t n) { return operator new(n); }
-void operator delete(void* p) noexcept { std::free(p); }
-void operator delete[](void* p) noexcept { std::free(p); }
-void operator delete(void* p, std::size_t) noexcept { std::free(p); }
-void operator delete[](void* p, std::size_t) noexcept { std::free(p); }
+#include "counting_new.hpp"
 
 using namespace lugrip;
 
@@ -105,11 +93,11 @@ Result bench_loop(const char* name, const ClosedLoopConfig& cfg, long samples, i
   long allocations = 0;
   for (int k = 0; k < reps; ++k) {
     loop.reset();
-    const long a0 = g_allocations.load();
+    const long a0 = lugrip_support::g_allocations.load();
     const auto t0 = Clock::now();
     for (long n = 0; n < samples; ++n) loop.step(s);
     const auto t1 = Clock::now();
-    allocations += g_allocations.load() - a0;
+    allocations += lugrip_support::g_allocations.load() - a0;
     g_sink = g_sink + s.command;
     rates.push_back(samples / seconds_between(t0, t1));
     r.steps += samples;

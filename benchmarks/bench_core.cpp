@@ -46,19 +46,7 @@
 #endif
 
 // ---- allocation counter: the timed loops must not allocate ---------------------------------
-namespace {
-std::atomic<long> g_allocations{0};
-}
-void* operator new(std::size_t n) {
-  g_allocations.fetch_add(1, std::memory_order_relaxed);
-  if (void* p = std::malloc(n ? n : 1)) return p;
-  throw std::bad_alloc();
-}
-void* operator new[](std::size_t n) { return operator new(n); }
-void operator delete(void* p) noexcept { std::free(p); }
-void operator delete[](void* p) noexcept { std::free(p); }
-void operator delete(void* p, std::size_t) noexcept { std::free(p); }
-void operator delete[](void* p, std::size_t) noexcept { std::free(p); }
+#include "counting_new.hpp"
 
 namespace {
 
@@ -119,7 +107,7 @@ Stats time_batched(Fn&& fn, int n_inputs, int rounds) {
   std::vector<double> per_call;
   per_call.reserve(static_cast<size_t>(batches) * rounds);
   for (int i = 0; i < n_inputs; ++i) fn(i);  // warm-up: caches, branch predictors
-  const long alloc0 = g_allocations.load();
+  const long alloc0 = lugrip_support::g_allocations.load();
   for (int r = 0; r < rounds; ++r) {
     for (int b = 0; b < batches; ++b) {
       const int i0 = b * kBatch;
@@ -129,7 +117,7 @@ Stats time_batched(Fn&& fn, int n_inputs, int rounds) {
       per_call.push_back(std::max(0.0, ns_between(t0, t1) - g_overhead) / kBatch);
     }
   }
-  const long alloc1 = g_allocations.load();
+  const long alloc1 = lugrip_support::g_allocations.load();
   Stats s = summarize(std::move(per_call), static_cast<long>(batches) * kBatch * rounds);
   // the vector push_back above reserved its storage first, so any count is the callee's
   s.allocations = alloc1 - alloc0;
@@ -410,14 +398,14 @@ Row time_construction(const std::string& name, const std::string& detail, int re
   std::vector<double> ms;
   ms.reserve(reps);
   make();  // warm-up
-  const long alloc0 = g_allocations.load();
+  const long alloc0 = lugrip_support::g_allocations.load();
   for (int r = 0; r < reps; ++r) {
     const auto t0 = Clock::now();
     make();
     const auto t1 = Clock::now();
     ms.push_back(ns_between(t0, t1) * 1e-6);
   }
-  const long alloc1 = g_allocations.load();
+  const long alloc1 = lugrip_support::g_allocations.load();
   Row row{"construct", name, detail, summarize(std::move(ms), reps)};
   row.batched.allocations = (alloc1 - alloc0) / reps;  // per construction (allowed there)
   row.ms = true;

@@ -49,19 +49,7 @@
 #define LUGRIP_BENCH_BUILD_TYPE "unknown"
 #endif
 
-namespace {
-std::atomic<long> g_new_calls{0};
-}
-void* operator new(std::size_t n) {
-  g_new_calls.fetch_add(1, std::memory_order_relaxed);
-  if (void* p = std::malloc(n ? n : 1)) return p;
-  throw std::bad_alloc();
-}
-void* operator new[](std::size_t n) { return operator new(n); }
-void operator delete(void* p) noexcept { std::free(p); }
-void operator delete[](void* p) noexcept { std::free(p); }
-void operator delete(void* p, std::size_t) noexcept { std::free(p); }
-void operator delete[](void* p, std::size_t) noexcept { std::free(p); }
+#include "counting_new.hpp"
 
 namespace {
 
@@ -121,7 +109,7 @@ Summary time_stream(int n, int passes, Prepare&& prepare, Step&& step) {
   per_step.reserve(static_cast<size_t>(batches) * passes);
   prepare();
   for (int i = 0; i < n; ++i) step(i);  // warm-up
-  const long a0 = g_new_calls.load();
+  const long a0 = lugrip_support::g_allocations.load();
   for (int p = 0; p < passes; ++p) {
     prepare();
     for (int b = 0; b < batches; ++b) {
@@ -133,7 +121,7 @@ Summary time_stream(int n, int passes, Prepare&& prepare, Step&& step) {
     }
   }
   Summary s = summarise(std::move(per_step), static_cast<long>(batches) * kBatch * passes);
-  s.allocations = g_new_calls.load() - a0;
+  s.allocations = lugrip_support::g_allocations.load() - a0;
   return s;
 }
 

@@ -9,24 +9,7 @@
 
 #include "lugrip/closed_loop.hpp"
 
-namespace {
-std::atomic<long> g_allocations{0};
-}  // namespace
-
-void* operator new(std::size_t n) {
-  ++g_allocations;
-  if (void* p = std::malloc(n ? n : 1)) return p;
-  throw std::bad_alloc();
-}
-void* operator new[](std::size_t n) {
-  ++g_allocations;
-  if (void* p = std::malloc(n ? n : 1)) return p;
-  throw std::bad_alloc();
-}
-void operator delete(void* p) noexcept { std::free(p); }
-void operator delete[](void* p) noexcept { std::free(p); }
-void operator delete(void* p, std::size_t) noexcept { std::free(p); }
-void operator delete[](void* p, std::size_t) noexcept { std::free(p); }
+#include "counting_new.hpp"
 
 using namespace lugrip;
 
@@ -53,11 +36,11 @@ TEST(NoAllocation, ClosedLoopStep) {
       c.schedule.push_back(ModeEvent{3.0, ModeAction::SlippingAvoidance});
       ClosedLoop loop(c);  // allocates (construction)
       ClosedLoopSample s;
-      const long before = g_allocations.load();
+      const long before = lugrip_support::g_allocations.load();
       for (int n = 0; n < 2000; ++n) loop.step(s);  // 4 s: lift, push, pivot, back
       loop.reset();
       for (int n = 0; n < 500; ++n) loop.step(s);
-      const long used = g_allocations.load() - before;
+      const long used = lugrip_support::g_allocations.load() - before;
       EXPECT_EQ(used, 0) << to_string(model) << " " << to_string(kind);
       EXPECT_TRUE(s.finite);
     }

@@ -11,24 +11,7 @@
 
 #include "lugrip/grasp_controller.hpp"
 
-namespace {
-std::atomic<long> g_allocations{0};
-}  // namespace
-
-void* operator new(std::size_t n) {
-  ++g_allocations;
-  if (void* p = std::malloc(n ? n : 1)) return p;
-  throw std::bad_alloc();
-}
-void* operator new[](std::size_t n) {
-  ++g_allocations;
-  if (void* p = std::malloc(n ? n : 1)) return p;
-  throw std::bad_alloc();
-}
-void operator delete(void* p) noexcept { std::free(p); }
-void operator delete[](void* p) noexcept { std::free(p); }
-void operator delete(void* p, std::size_t) noexcept { std::free(p); }
-void operator delete[](void* p, std::size_t) noexcept { std::free(p); }
+#include "counting_new.hpp"
 
 using namespace lugrip;
 
@@ -40,7 +23,7 @@ TEST(NoAllocation, GraspControllerStep) {
   GraspControllerInput in;
   GraspControllerOutput out;
   const double nan = std::numeric_limits<double>::quiet_NaN();
-  const long before = g_allocations.load();
+  const long before = lugrip_support::g_allocations.load();
   for (int n = 0; n < 100000; ++n) {
     for (auto& f : in.fingers) {
       f.omega_hat = u(rng) < 0.01 ? nan : 0.1 * (u(rng) - 0.5);
@@ -56,7 +39,7 @@ TEST(NoAllocation, GraspControllerStep) {
   }
   StaticForceResult r;
   for (int n = 0; n < 200; ++n) r = plant.solve(0.1 + 0.02 * n, 1e-4 * n);
-  const long used = g_allocations.load() - before;
+  const long used = lugrip_support::g_allocations.load() - before;
   EXPECT_EQ(used, 0);
   EXPECT_TRUE(std::isfinite(out.force));
   EXPECT_TRUE(r.converged);
