@@ -206,6 +206,19 @@ void GraspPlant::reset() noexcept {
   cor_.reset();
   for (int i = 0; i < 2; ++i) rng_[i].seed_with(cfg_.seed * 0x9E3779B97F4A7C15ULL + static_cast<uint64_t>(i + 1));
   st_ = PlantState();
+  report_state();
+  for (int i = 0; i < 2; ++i) {
+    double w[4];
+    true_wrench(i, w);
+    for (int j = 0; j < 4; ++j) filt_[i][j] = w[j];
+  }
+  update_drop();
+  take_sample();
+}
+
+void GraspPlant::report_state() noexcept {
+  double gx, gy, gvx, gvy;
+  gripper_at(st_.t, gx, gy, gvx, gvy);
   st_.f_cmd = f_cmd_;
   st_.f_held = f_held_;
   st_.f_n = f_act_;
@@ -215,15 +228,14 @@ void GraspPlant::reset() noexcept {
   st_.gripper_vy = gvy;
   st_.x = rx_;
   st_.y = ry_;
+  st_.vx = vx_;
+  st_.vy = vy_;
   st_.theta = th_;
+  st_.omega = om_;
+  st_.contact_fx = 2.0 * pad_.fx;
+  st_.contact_fy = 2.0 * pad_.fy;
+  st_.contact_tau = 2.0 * pad_.tau;  // pad wrench about the pad centre = grasp point
   st_.supported = supported_;
-  for (int i = 0; i < 2; ++i) {
-    double w[4];
-    true_wrench(i, w);
-    for (int j = 0; j < 4; ++j) filt_[i][j] = w[j];
-  }
-  update_drop();
-  take_sample();
 }
 
 void GraspPlant::set_command(double f_cmd) noexcept {
@@ -268,27 +280,7 @@ bool GraspPlant::step() noexcept {
     true_wrench(i, w);
     for (int j = 0; j < 4; ++j) filt_[i][j] += alpha * (w[j] - filt_[i][j]);
   }
-  // State report.
-  double gx, gy, gvx, gvy;
-  gripper_at(st_.t, gx, gy, gvx, gvy);
-  st_.f_cmd = f_cmd_;
-  st_.f_held = f_held_;
-  st_.f_n = f_act_;
-  st_.gripper_x = gx;
-  st_.gripper_y = gy;
-  st_.gripper_vx = gvx;
-  st_.gripper_vy = gvy;
-  st_.x = rx_;
-  st_.y = ry_;
-  st_.vx = vx_;
-  st_.vy = vy_;
-  st_.theta = th_;
-  st_.omega = om_;
-  st_.contact_fx = 2.0 * pad_.fx;
-  st_.contact_fy = 2.0 * pad_.fy;
-  // pad wrench is about the pad centre = grasp point
-  st_.contact_tau = 2.0 * pad_.tau;
-  st_.supported = supported_;
+  report_state();
   update_drop();
   if ((n + 1) % steps_per_sample_ == 0) {
     take_sample();

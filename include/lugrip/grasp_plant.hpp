@@ -355,6 +355,7 @@ class GraspPlant {
   void take_sample() noexcept;
   void true_wrench(int finger, double out[4]) const noexcept;
   void update_drop() noexcept;
+  void report_state() noexcept;  // fill st_ from the integration state at st_.t
 };
 
 }  // namespace lugrip
