@@ -12,10 +12,13 @@ Measured in one run on this machine:
   (~150k samples), against scipy SLSQP with finite-difference gradients over a Python loop of
   ``lugrip.Observer.step`` on a subset of the maneuvers (same cost, same start), and against
   SLSQP + finite differences over the C++ batch ``Observer.run`` (no gradient in C++);
-* recovery: Table 1 round trip from a start with every parameter off by 2-3x (default observer
-  and a fast one), the data-computed start, a Table 2 object (all six, and the per-object
-  refit of mu and beta_A from 10 maneuvers), logs from the discretised-patch contact plant
-  (not the lumped model, Stribeck of its own), and the rubbing estimate on that plant.
+* recovery: Table 1 round trip from a start with every parameter off by 2-3x (default
+  observer), the data-computed start, a Table 2 object (all six, and the per-object refit of
+  mu and beta_A from 10 maneuvers), logs from the discretised-patch contact plant (not the
+  lumped model, Stribeck of its own), and the rubbing estimate on that plant;
+* the observer bandwidth (MODEL.md 7.4, 8.1): the round trip, the object refit and the issue-3
+  observer figures (Table 1 / Table 2 RMSE, slip detection, false alarms, noise) for B = 100,
+  300, 1000 and the default, which is why the default is what it is.
 """
 
 from __future__ import annotations
@@ -36,13 +39,14 @@ from lugrip import ContactParams
 from lugrip.identify import PARAMETERS, IdentificationWarning, initial_guess
 from lugrip.io import SlidingLog
 from lugrip.sim import PatchContact, PatchSettings
-from lugrip.sliding import simulate_sliding
+from lugrip.sliding import PAPER_NOISE, evaluate, simulate_maneuvers, simulate_sliding
 
 BEGIN, END = "<!-- issue4:begin -->", "<!-- issue4:end -->"
 TABLE1 = ContactParams.table1()
 RESIN = ContactParams.preset("big_resin_block")
 OFF = {"mu": 2.0, "beta_a": 0.4, "sigma0": 2.5, "sigma_z": 0.4, "delta": 2.0, "gamma": 0.5}
-FAST = {"bandwidth": 3000.0}
+DEFAULT_B = lugrip.Observer(TABLE1).settings["bandwidth"]  # ObserverSettings::bandwidth
+SWEEP = (100.0, 300.0, 1000.0)  # other bandwidths measured against the default
 # Section-4 maneuvers, shortened so that 240 of them hold ~150k samples at 500 Hz
 DESIGN = {
     "c_range": (0.02, 1.4),
@@ -332,9 +336,9 @@ def run(quick: bool) -> dict:
     fits = {}
     fits["gn_default"] = fit_summary(quiet_identify(log, p0), TABLE1)
     fits["slsqp_default"] = fit_summary(quiet_identify(log, p0, method="slsqp"), TABLE1)
-    fits["gn_fast"] = fit_summary(quiet_identify(log, p0, observer=FAST), TABLE1)
-    fits["gn_fast_data_start"] = fit_summary(quiet_identify(log, observer=FAST), TABLE1)
     fits["gn_default_data_start"] = fit_summary(quiet_identify(log), TABLE1)
+    for b in SWEEP:
+        fits[f"gn_b{b:g}"] = fit_summary(quiet_identify(log, p0, observer={"bandwidth": b}), TABLE1)
     g = initial_guess(log)
     fits["data_start"] = {"ratio": ratios(g.params, TABLE1), "notes": g.notes}
     R["table1_fits"] = fits
@@ -389,9 +393,8 @@ def run(quick: bool) -> dict:
         omega_range=(0.5, 5.0),
         stick_fraction=0.0,
     )
-    t2["all_six_fast_maneuvers_b1000"] = fit_summary(
-        quiet_identify(fast_log, perturbed(RESIN), observer={"bandwidth": 1000.0}), RESIN
-    )
+    t2["all_six_fast_maneuvers"] = fit_summary(quiet_identify(fast_log, perturbed(RESIN)), RESIN)
+    t2["fast_rms_omega"] = float(np.sqrt(np.mean(fast_log.omega**2)))
     refits = []
     for seed in (1, 2, 3):
         obj_log = simulate_sliding(
@@ -399,7 +402,8 @@ def run(quick: bool) -> dict:
         )
         for fac in ((2.5, 0.4), (0.4, 3.0)):
             start = RESIN.replace(mu=RESIN.mu * fac[0], beta_a=RESIN.beta_a * fac[1])
-            for obs_name, obs in (("default", None), ("b1000", {"bandwidth": 1000.0})):
+            observers = [("default", None)] + [(f"b{b:g}", {"bandwidth": b}) for b in SWEEP]
+            for obs_name, obs in observers:
                 r = quiet_identify(obj_log, start, free="mu,beta_a", observer=obs, validation=0.0)
                 refits.append(
                     {
@@ -424,7 +428,9 @@ def run(quick: bool) -> dict:
         "truth_rmse_default": lugrip.Observer(TABLE1).run(plog).rmse(plog.omega),
     }
     patch["default"] = fit_summary(quiet_identify(plog, perturbed(TABLE1)), TABLE1)
-    patch["fast"] = fit_summary(quiet_identify(plog, perturbed(TABLE1), observer=FAST), TABLE1)
+    patch["slow"] = fit_summary(
+        quiet_identify(plog, perturbed(TABLE1), observer={"bandwidth": 100.0}), TABLE1
+    )
     R["patch"] = patch
 
     # rubbing on the patch plant
@@ -444,7 +450,43 @@ def run(quick: bool) -> dict:
                 "samples": e.samples,
             }
     R["rubbing"] = rub
+    R["observer_sweep"] = observer_sweep(quick)
     return R
+
+
+def observer_sweep(quick: bool) -> dict:
+    """The issue-3 observer figures (benchmarks/observer_report.py's data: Table 1 and two
+    Table 2 objects, 240 maneuvers, seed 0, true parameters) per bandwidth."""
+    n = 60 if quick else 240
+    sets = {
+        "table1": simulate_maneuvers("table1", n, seed=0),
+        "big_resin_block": simulate_maneuvers("big_resin_block", n, seed=0),
+        "aluminium_can": simulate_maneuvers("aluminium_can", n, seed=0),
+        "aluminium_can_paper_noise": simulate_maneuvers(
+            "aluminium_can", n, seed=0, noise=PAPER_NOISE
+        ),
+        "table1_paper_noise": simulate_maneuvers("table1", n, seed=0, noise=PAPER_NOISE),
+    }
+    out = {}
+    for b in SWEEP + (DEFAULT_B,):
+        row = {}
+        for name, data in sets.items():
+            run, sc = evaluate(data, bandwidth=b)
+            sm = sc.summary()
+            row[name] = {
+                "rmse": sm["rmse"],
+                "rms_omega": sm["rms_omega"],
+                "detected": sm["n_detected"],
+                "slides": sm["n_slide"],
+                "false_alarms": sm["n_false_alarm"],
+                "sticks": sm["n_stick"],
+                "delay_median_ms": 1e3 * sm["delay_median"],
+                "max_substeps": int(run.substeps.max()),
+                "mean_substeps": float(run.substeps.mean()),
+            }
+        out[f"{b:g}"] = row
+        print(f"  observer B={b:g}: Table 1 RMSE {row['table1']['rmse']:.4f}", file=sys.stderr)
+    return out
 
 
 # ---------------------------------------------------------------------------------------------
@@ -507,8 +549,6 @@ def section(R: dict) -> str:
     names = {
         "gn_default": "`lugrip.identify` (Gauss-Newton SQP, default), default observer",
         "slsqp_default": "`method='slsqp'` (scipy SLSQP, exact gradient from C++), default observer",
-        "gn_fast": "Gauss-Newton SQP, observer bandwidth 3000/s",
-        "gn_fast_data_start": "Gauss-Newton SQP, bandwidth 3000/s, start computed from the data",
         "gn_default_data_start": "Gauss-Newton SQP, default observer, start from the data",
     }
     for k, label in names.items():
@@ -556,32 +596,52 @@ def section(R: dict) -> str:
     w("")
     w("### Recovery (Table 1 round trip)")
     w("")
-    w("Identified / true value per parameter (all six free):")
+    w(
+        f"Identified / true value per parameter (all six free). Default observer: "
+        f"`lugrip.Observer` defaults, bandwidth B = l sigma_1 = {DEFAULT_B:g}/s "
+        "(`ObserverSettings::bandwidth`), the same online and in the cost; the result records it "
+        "(`observer:` block of the YAML, used by `lugrip observe --params`)."
+    )
     w("")
-    w("| run | mu | beta_A | sigma0 | sigma_z | delta | gamma | val. RMSE [rad/s] |")
-    w("|---|---|---|---|---|---|---|---|")
-    for k, label in names.items():
-        if k == "slsqp_default":
-            label = "SLSQP, default observer"
+    w("| run | mu | beta_A | sigma0 | sigma_z | delta | gamma | beta_A delta^4 | val. RMSE [rad/s] |")
+    w("|---|---|---|---|---|---|---|---|---|")
+    rec = dict(names)
+    rec["slsqp_default"] = "SLSQP, default observer"
+    for b in SWEEP:
+        rec[f"gn_b{b:g}"] = f"Gauss-Newton SQP, observer bandwidth {b:g}/s (fit and online)"
+    for k, label in rec.items():
         f = fits[k]
+        q = f["ratio"]
         w(
             f"| {label} | "
-            + " | ".join(f"{f['ratio'][n]:.3f}" for n in PARAMETERS)
-            + f" | {f['rmse_validation']:.2e} |"
+            + " | ".join(f"{q[n]:.3f}" for n in PARAMETERS)
+            + f" | {q['beta_a'] * q['delta'] ** 4:.3f} | {f['rmse_validation']:.2e} |"
         )
     ds = fits["data_start"]["ratio"]
     w(
         "| (start computed from the data, before fitting) | "
         + " | ".join(f"{ds[n]:.2f}" for n in PARAMETERS)
-        + " | |"
+        + " | | |"
     )
     w("")
+    gd = fits["gn_default"]["ratio"]
+    ident = ("mu", "sigma0", "sigma_z", "gamma")
+    worst = max(
+        [abs(gd[n] - 1) for n in ident] + [abs(gd["beta_a"] * gd["delta"] ** 4 - 1)]
+    )
     w(
-        "* With a fast observer (bandwidth 3000/s in the fit and online) every parameter comes back "
-        "within a few per cent. With the default observer (bandwidth 100/s) the stick parameters "
-        "sigma0 and sigma_z absorb the observer's lag while slips start and stop (MODEL.md 8.2): "
-        "eq. 32 identifies the parameters that make *that* observer best, which are not the "
-        "plant's (the fitted set has a lower RMSE than the true one for that observer)."
+        f"* Default settings: mu, sigma0, sigma_z, gamma and beta_A delta^4 within "
+        f"{100 * worst:.1f} % (target 5 %: {'met' if worst <= 0.05 else 'NOT met'}); beta_A "
+        f"{gd['beta_a']:.3f}, delta {gd['delta']:.3f} (see below)."
+    )
+    w(
+        "* The observer's bandwidth matters (MODEL.md 7.4, 8.1): eq. 32 identifies the parameters "
+        "that make *that* observer best. A slow observer lags the slip ramps (lag ~ "
+        "(d omega/dt)/B), and sigma0, sigma_z and beta_A absorb the lag: at 100/s (the default "
+        "before this change) sigma0 comes back about 2x too large, and the fitted set tracks "
+        "better than the true one for that observer. The fit bandwidth and the online one must "
+        "therefore be the same: `lugrip.identify` uses the online default unless told otherwise "
+        "and writes what it used to the YAML."
     )
     w(
         "* Not separately identifiable: beta_A and delta enter sigma_1 = pi beta_A rho^4 (c~^2+1/2) "
@@ -595,58 +655,147 @@ def section(R: dict) -> str:
     for s in fits["gn_default"]["identifiability"]:
         w(f"  * {s}")
     w("")
+
+    # ---- bandwidth
+    sw = R["observer_sweep"]
     t2 = R["table2"]
+    w("### Observer bandwidth: identification and the issue-3 observer figures")
+    w("")
+    w(
+        "Same data as the issue-3 report (`benchmarks/observer_report.py`: 240 maneuvers per set, "
+        "seed 0, true parameters; detected = slips with S >= 0.9, false alarms = stick maneuvers "
+        "with S >= 0.9), the Table 1 round trip above and the object refit below, per bandwidth "
+        "B (all other settings default):"
+    )
+    w("")
+    w(
+        "| B [1/s] | Table 1 RMSE | T1 detected / false alarms | resin RMSE | can RMSE | T2 detected "
+        "/ false alarms | can, paper noise | T1, paper noise | max substeps (resin) | T1 round "
+        "trip: sigma0 / sigma_z / beta_A delta^4 | refit: worst mu / beta_A |"
+    )
+    w("|---|---|---|---|---|---|---|---|---|---|---|")
+    for b in SWEEP + (DEFAULT_B,):
+        r = sw[f"{b:g}"]
+        key = "gn_default" if b == DEFAULT_B else f"gn_b{b:g}"
+        q = fits[key]["ratio"]
+        name = "default" if b == DEFAULT_B else f"b{b:g}"
+        rows = [x for x in t2["object_refit"] if x["observer"] == name]
+        dm = max(abs(x["mu"] - 1) for x in rows)
+        db = max(abs(x["beta_a"] - 1) for x in rows)
+        t1, rs, ca = r["table1"], r["big_resin_block"], r["aluminium_can"]
+        w(
+            f"| {b:g}{' (default)' if b == DEFAULT_B else ''} | {t1['rmse']:.4f} | "
+            f"{t1['detected']}/{t1['slides']} / {t1['false_alarms']}/{t1['sticks']} | "
+            f"{rs['rmse']:.4f} | {ca['rmse']:.4f} | "
+            f"{rs['detected'] + ca['detected']}/{rs['slides'] + ca['slides']} / "
+            f"{rs['false_alarms'] + ca['false_alarms']}/{rs['sticks'] + ca['sticks']} | "
+            f"{r['aluminium_can_paper_noise']['rmse']:.3f} | "
+            f"{r['table1_paper_noise']['rmse']:.4f} | {rs['max_substeps']} | "
+            f"{q['sigma0']:.3f} / {q['sigma_z']:.3f} / {q['beta_a'] * q['delta'] ** 4:.3f} | "
+            f"{100 * dm:.1f} % / {100 * db:.1f} % |"
+        )
+    w("")
+    w(
+        f"Why B = {DEFAULT_B:g}/s is the default (online and in identification): it is the "
+        "bandwidth in this sweep at which the Table 1 round trip and the object refit both "
+        "recover every identifiable parameter within 5 %; at 1000/s sigma0 is still biased by the "
+        "lag (the 2-parameter refit is fine there), at 100/s sigma0 and beta_A are far off. The "
+        "issue-3 figures stay within their targets: the Table 1 RMSE is lower than at 100/s "
+        "(target 0.0222), every slip is detected with no false alarm, the Table 2 RMSEs change by "
+        "a few per cent, and the median step cost is unchanged (about one Rosenbrock step per "
+        "sample; the rare worst-case sample needs more substeps, capped at max_substeps = 500). "
+        "The price is noise: a faster observer trusts the torque more, so with the paper's stated "
+        "sensor accuracy taken as white noise (2 N mm) the Table 2 RMSE grows (the speed of those "
+        "objects is not observable at that noise with any bandwidth: the RMSE exceeds the RMS "
+        f"speed, {sw[f'{DEFAULT_B:g}']['aluminium_can_paper_noise']['rms_omega']:.3f} rad/s). With "
+        "such a sensor, identify and run online with a lower bandwidth (`lugrip identify "
+        "--bandwidth B`; the YAML carries it to `lugrip observe --params`)."
+    )
+    w("")
+
+    # ---- Table 2
     w("### Table 2 object (big resin block)")
     w("")
     a6 = t2["all_six_default"]
+    af = t2["all_six_fast_maneuvers"]
+    w(
+        "All six parameters from a Table 2 object's logs, start off by 2-3x as above, default "
+        "observer:"
+    )
+    w("")
+    w("| maneuvers | mu | beta_A | sigma0 | sigma_z | delta | gamma | beta_A delta^4 | val. RMSE [rad/s] | RMS omega |")
+    w("|---|---|---|---|---|---|---|---|---|---|")
+    for label, f, rms in (
+        (f"{t2['maneuvers']} Section-4 maneuvers, peak 0.05-0.5 rad/s", a6, a6["rms_omega_validation"]),
+        (f"{t2['maneuvers']} maneuvers sliding at 0.5-5 rad/s", af, af["rms_omega_validation"]),
+    ):
+        q = f["ratio"]
+        w(
+            f"| {label} | "
+            + " | ".join(f"{q[n]:.3f}" for n in PARAMETERS)
+            + f" | {q['beta_a'] * q['delta'] ** 4:.3f} | {f['rmse_validation']:.3f} | {rms:.3f} |"
+        )
+    w("")
+    ok_f = [n for n in PARAMETERS if abs(af["ratio"][n] - 1) <= 0.05]
+    bad_f = [n for n in PARAMETERS if abs(af["ratio"][n] - 1) > 0.05]
+    w(
+        f"* Identifiable within 5 % from the fast maneuvers: {', '.join(ok_f) or 'none'}"
+        + (f"; not: {', '.join(bad_f)}." if bad_f else ".")
+        + " Sliding at 0.5-5 rad/s makes the viscous torque sigma_1 omega comparable to the dry "
+        "capacity g, so mu (capacity), beta_A delta^4 (viscous part) and gamma (force "
+        "dependence) are fixed; beta_A and delta separate only weakly (as for Table 1)."
+    )
+    w(
+        "* **sigma0 and sigma_z are not identifiable from a Table 2 object's logs.** They act only "
+        "in pre-sliding (stick and slip onset), and there the slip speed is not observable: the "
+        "speed enters the wrench only through sigma_1 omega, and Table 2's beta_A makes sigma_1 "
+        "~1e-3 N m s/rad (MODEL.md 6, 7.3), so the observer's error at slip onsets is set by the "
+        "torque noise / sigma_1, not by sigma0 and sigma_z; they wander to wherever the cost is "
+        "flat (even to their bounds). This is why the paper identifies them once per fingertip "
+        "(Table 1 data, large sigma_1) and refits only mu and beta_A per object."
+    )
     off = [n for n in PARAMETERS if abs(a6["ratio"][n] - 1) > 0.05]
     w(
-        f"* All six from {t2['maneuvers']} Section-4 maneuvers (peak speeds 0.05-0.5 rad/s), "
-        f"default observer: validation RMSE {a6['rmse_validation']:.3f} rad/s against RMS omega "
-        f"{a6['rms_omega_validation']:.3f} (the true parameters give {t2['truth_rmse_default']:.3f} "
-        f"over all data). Ratios: {_r(a6['ratio'])}"
-        + (f"; outside 5 %: {', '.join(off)}." if off else "; all within 5 %.")
-        + " At these speeds the viscous torque sigma_1 omega is only a few per cent of the dry "
-        "capacity g, comparable to the error of g from the CoR estimate under sensor noise: the "
-        "speed is weakly observable (MODEL.md 6, 7.3), the observer's RMSE is a large fraction of "
-        "RMS omega, and the stick parameters absorb its lag and chattering at slip ends."
-    )
-    af = t2["all_six_fast_maneuvers_b1000"]
-    off_f = [n for n in PARAMETERS if abs(af["ratio"][n] - 1) > 0.05]
-    w(
-        f"* All six from maneuvers sliding at 0.5-5 rad/s (viscous torque comparable to g), "
-        f"bandwidth 1000/s: ratios {_r(af['ratio'])}, validation RMSE "
-        f"{af['rmse_validation']:.3f} rad/s (RMS {af['rms_omega_validation']:.2f})"
-        + (f"; outside 5 %: {', '.join(off_f)}" if off_f else "")
-        + ". Fast sliding fixes mu, beta_A, delta and gamma; the stick parameters sigma0 and "
-        "sigma_z are not identifiable from such data (they act only in the short pre-sliding "
-        "phase, where the observer's lag dominates)."
+        f"* From the Section-4 maneuvers (slow for this object) the validation RMSE "
+        f"{a6['rmse_validation']:.3f} rad/s is a large fraction of RMS omega "
+        f"{a6['rms_omega_validation']:.3f} (the true parameters give "
+        f"{t2['truth_rmse_default']:.3f} over all data): outside 5 %: {', '.join(off) or 'none'}. "
+        "At these speeds sigma_1 omega is a few per cent of g, comparable to the error of g from "
+        "the CoR estimate under noise; only mu is fixed. Record fast sliding for Table 2 objects."
     )
     w(
-        "* Per-object refit of mu and beta_A (paper's procedure; other parameters fixed at Table 1) "
-        "from **10 maneuvers** at 0.5-5 rad/s, start off by 2.5x/0.4x or 0.4x/3x:"
+        "* Per-object refit of mu and beta_A (the paper's procedure; sigma0, sigma_z, delta, gamma "
+        "fixed at the fingertip's Table 1 values) from **10 maneuvers** at 0.5-5 rad/s, start off "
+        "by 2.5x/0.4x or 0.4x/3x, per observer bandwidth:"
     )
     w("")
     w("| seed | start (mu, beta_A) | observer | mu | beta_A | fit time |")
     w("|---|---|---|---|---|---|")
     for r in t2["object_refit"]:
+        obs_label = f"default ({DEFAULT_B:g}/s)" if r["observer"] == "default" else r["observer"]
         w(
-            f"| {r['seed']} | x{r['start'][0]:g}, x{r['start'][1]:g} | {r['observer']} | "
+            f"| {r['seed']} | x{r['start'][0]:g}, x{r['start'][1]:g} | {obs_label} | "
             f"{r['mu']:.3f} | {r['beta_a']:.3f} | {r['fit_time_s']:.2f} s |"
         )
     w("")
-    for obs_name in ("b1000", "default"):
+    for obs_name in ["default"] + [f"b{b:g}" for b in SWEEP]:
         rows = [r for r in t2["object_refit"] if r["observer"] == obs_name]
         dm = max(abs(r["mu"] - 1) for r in rows)
         db = max(abs(r["beta_a"] - 1) for r in rows)
-        label = "bandwidth 1000/s" if obs_name == "b1000" else "default observer (100/s)"
+        label = (
+            f"default observer ({DEFAULT_B:g}/s)"
+            if obs_name == "default"
+            else f"bandwidth {obs_name[1:]}/s"
+        )
         w(
             f"* {label}: largest deviation over the {len(rows)} refits mu {100 * dm:.1f} %, "
             f"beta_A {100 * db:.1f} %."
         )
     w(
-        "  With the default observer beta_A absorbs the observer's lag behind the fast speed "
-        "ramps of these maneuvers (lag ~ (d omega/dt) / bandwidth)."
+        "  A slow observer lets beta_A absorb its lag behind the fast speed ramps of these "
+        "maneuvers (lag ~ (d omega/dt) / bandwidth). The remaining spread between the two starts "
+        "on the same data is the optimiser stopping in shallow local minima of the (non-smooth) "
+        "cost, not noise in beta_A's estimate (standard error ~0.3 %)."
     )
     w("")
     p = R["patch"]
@@ -655,7 +804,7 @@ def section(R: dict) -> str:
     w(
         f"Logs from `lugrip.sim.PatchContact` (discretised pressure patch, per-cell LuGre bristles, "
         f"Stribeck mu_s = 1.3 mu below 1 mm/s, viscous stress of its own), prescribed sliding "
-        f"maneuvers as above, {p['samples']} samples, noise as above. The observer with the "
+        f"maneuvers as above, {p['samples']} samples, noise as above. The default observer with the "
         f"patch's own (lumped) parameters has RMSE {p['truth_rmse_default']:.4f} rad/s."
     )
     w("")
@@ -663,7 +812,7 @@ def section(R: dict) -> str:
         "| fit | validation RMSE [rad/s] | RMS omega | mu | beta_A | sigma0 | sigma_z | delta | gamma |"
     )
     w("|---|---|---|---|---|---|---|---|---|")
-    for k, label in (("default", "default observer"), ("fast", "bandwidth 3000/s")):
+    for k, label in (("default", "default observer"), ("slow", "bandwidth 100/s")):
         f = p[k]
         w(
             f"| {label} | {f['rmse_validation']:.4f} | {f['rms_omega_validation']:.3f} | "

@@ -221,7 +221,8 @@ class Observer:
         gain_mode: "fixed" (l = gain) or "bandwidth" (l = bandwidth / sigma_1 clipped to
             [gain_min, gain_max]). Default: "fixed" when only `gain` is given, else "bandwidth".
         gain: fixed observer gain l [1/(kg m^2)] (default 200).
-        bandwidth: B = l sigma_1 [1/s] (default 100).
+        bandwidth: B = l sigma_1 [1/s] (default 3000; the rate at which omega_hat converges
+            in sliding: higher tracks slip ramps with less lag, lower filters torque noise).
         Other keywords: the fields of the C++ ObserverSettings (gain_min, gain_max, g_floor,
         torque_cutoff [Hz], filter_force, cor_sign_sigmas, max_invalid, max_dt_gap [s],
         torque_noise [N m], resolution_max [rad/s], omega_limit [rad/s], substeps,

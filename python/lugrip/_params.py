@@ -9,7 +9,7 @@ from typing import Any
 
 from . import _core
 
-__all__ = ["ContactParams", "PRESETS"]
+__all__ = ["ContactParams", "PRESETS", "read_observer_settings"]
 
 _FIELDS = ("mu", "beta_a", "sigma0", "sigma_z", "delta", "gamma", "k", "c_max")
 _UNITS = {
@@ -111,6 +111,8 @@ class ContactParams:
         """From a mapping; accepts either flat fields or the YAML layout of to_yaml()."""
         if "contact" in data:
             data = data["contact"]
+        else:  # flat layout: the observer block of an identification result is not a field
+            data = {k: v for k, v in data.items() if k != "observer"}
         values = {}
         for name, value in data.items():
             if name not in _FIELDS:
@@ -141,21 +143,72 @@ class ContactParams:
         except ValueError as err:
             raise ValueError(f"{path}: {err}") from None
 
-    def to_yaml(self, path: str | Path | None = None, comment: str = "") -> str:
-        """YAML text (value and unit per field); written to `path` when given."""
+    def to_yaml(
+        self,
+        path: str | Path | None = None,
+        comment: str = "",
+        observer: dict[str, Any] | None = None,
+    ) -> str:
+        """YAML text (value and unit per field); written to `path` when given. ``observer``:
+        the observer settings these parameters belong to (keywords of
+        :class:`lugrip.Observer`), written as the ``observer:`` block that
+        :func:`read_observer_settings` and ``lugrip observe --params`` use."""
         import yaml
 
-        body = {
+        body: dict[str, Any] = {
             "contact": {
                 name: {"value": getattr(self, name) if math.isfinite(getattr(self, name)) else ".inf",
                        "unit": _UNITS[name]}
                 for name in _FIELDS
             }
         }
+        if observer is not None:
+            body["observer"] = _check_observer_block(dict(observer), "observer")
         text = (f"# {comment}\n" if comment else "") + yaml.safe_dump(body, sort_keys=False)
         if path is not None:
             Path(path).write_text(text)
         return text
+
+
+def _check_observer_block(block: Any, where: str) -> dict[str, Any]:
+    """Validates an observer block (keywords of lugrip.Observer) by building the settings;
+    returns it with plain Python values."""
+    from ._observer import Observer
+
+    if not isinstance(block, dict):
+        raise ValueError(f"{where}: expected a mapping of observer settings")
+    plain = {}
+    for k, v in block.items():
+        if hasattr(v, "item"):  # numpy scalars
+            v = v.item()
+        plain[str(k)] = v
+    try:
+        Observer(ContactParams.table1(), **plain)
+    except (TypeError, ValueError) as err:
+        raise ValueError(f"{where}: {str(err).replace(chr(10), '; ')}") from None
+    return plain
+
+
+def read_observer_settings(path: str | Path) -> dict[str, Any] | None:
+    """The ``observer:`` block of a parameter YAML (written by ``lugrip identify`` /
+    :meth:`lugrip.identify.IdentificationResult.save_yaml`): the settings of the observer the
+    parameters were identified with, as keywords of :class:`lugrip.Observer`, so that the
+    observer used online is the one inside the identification cost (MODEL.md 8.1). None when
+    the file has no such block (e.g. ``objects/*.yaml``, ``lugrip params`` output).
+
+    Raises:
+        ValueError: the block is not a mapping or holds an unknown or invalid setting.
+    """
+    import yaml
+
+    path = Path(path)
+    try:
+        data = yaml.safe_load(path.read_text())
+    except yaml.YAMLError as err:
+        raise ValueError(f"{path}: not valid YAML: {err}") from None
+    if not isinstance(data, dict) or data.get("observer") is None:
+        return None
+    return _check_observer_block(data["observer"], f"{path}: observer")
 
 
 PRESETS = ("table1", "big_resin_block", "small_resin_block", "plastic_bottle", "aluminium_can")

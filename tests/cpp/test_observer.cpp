@@ -164,7 +164,7 @@ TEST(Observer, ImplicitSchemeIsSecondsLateWithWeakViscousFriction) {
   // bristle rate at the previous sample, so in sliding the micro-damping sigma_z acts like extra
   // viscous damping: per sample omega_hat approaches its steady value by only
   // h l sigma_1 / (1 + h l (sigma_1 + sigma_z)) ~ sigma_1 / sigma_z ~ 1e-3. Rosenbrock (exact
-  // Jacobian) converges at the bandwidth B = 100/s.
+  // Jacobian) converges at the bandwidth B (default 3000/s).
   const ContactParams p = object_params("aluminium_can");
   const ContactModel m(p);
   const double f_n = 3.0, ct = 0.6, w0 = 0.01;

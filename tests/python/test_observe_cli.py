@@ -178,9 +178,11 @@ def test_observe_options_reach_the_observer(tmp_path, capsys):
         "200",
     )
     assert rc == 0, err
-    assert "divergence guard" in out and "(rk4, gain fixed)" in out
+    assert "divergence guard" in out and "(rk4, fixed l = 200)" in out
     rc, out, err = _observe(capsys, log_path, "--preset", "table1", "--out", tmp_path / "ros.csv")
     assert rc == 0 and "divergence" not in out
+    default_b = lugrip.Observer(TABLE1).settings["bandwidth"]
+    assert f"(rosenbrock, l = {default_b:g}/sigma_1)" in out
     rc, out, err = _observe(
         capsys,
         log_path,

@@ -484,7 +484,7 @@ def test_settings_validation_and_modes():
     assert (s["integrator"], s["gain_mode"], s["bandwidth"], s["torque_cutoff"]) == (
         "rosenbrock",
         "bandwidth",
-        100.0,
+        3000.0,
         2.0,
     )
     assert Observer(TABLE1, gain=300.0).settings["gain_mode"] == "fixed"

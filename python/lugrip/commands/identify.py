@@ -19,9 +19,11 @@ examples:
   lugrip identify obj/*.parquet --free mu,beta_a --params0 fingertip.yaml --out object.yaml
   lugrip identify rub.csv --rubbing --params0 fingertip.yaml --out object.yaml
 
-The cost runs the online observer (same settings as 'lugrip observe': give the same
---bandwidth/--gain/--integrator you run online). Every log needs an 'omega' column (ground
-truth, rad/s); maneuvers come from the 'maneuver' column and are never integrated across a gap.
+The cost runs the online observer, and the parameters are identified FOR that observer
+(MODEL.md 8.1): the output YAML records its settings in an 'observer' block, and 'lugrip
+observe --params' and 'lugrip identify --params0' use that block (options override it).
+Every log needs an 'omega' column (ground truth, rad/s); maneuvers come from the 'maneuver'
+column and are never integrated across a gap.
 """
 
 
@@ -116,23 +118,29 @@ def register(subparsers) -> None:
     p.add_argument(
         "--bootstrap", type=int, default=20, metavar="N", help="refits for --uncertainty bootstrap"
     )
-    p.add_argument(
+    o = p.add_argument_group(
+        "observer inside the cost (default: the observer block of --params0 when it has one, "
+        "else the library defaults; written to the output YAML, which 'lugrip observe "
+        "--params' then uses)"
+    )
+    gain = o.add_mutually_exclusive_group()
+    gain.add_argument(
         "--bandwidth",
         type=positive_float,
         metavar="B",
-        help="observer bandwidth l sigma_1 [1/s] (as online)",
+        help="observer bandwidth l sigma_1 [1/s]",
     )
-    p.add_argument(
+    gain.add_argument(
         "--gain",
         type=positive_float,
         metavar="L",
-        help="fixed observer gain l [1/(kg m^2)] (as online)",
+        help="fixed observer gain l [1/(kg m^2)]",
     )
-    p.add_argument(
+    o.add_argument(
         "--integrator",
         choices=("rosenbrock", "implicit", "rk4", "rk4_adaptive"),
-        default="rosenbrock",
-        help="observer integrator (as online)",
+        default=None,
+        help="observer integrator (default rosenbrock)",
     )
     p.add_argument("--threads", type=int, default=0, help="C++ worker threads (0: all cores)")
     p.add_argument(
@@ -272,9 +280,13 @@ def run(args) -> int:
     if args.rubbing:
         if args.params0 is None:
             raise CliError("--rubbing needs --params0 (the fingertip's delta and gamma)")
-        from .._params import ContactParams
+        from .._params import ContactParams, read_observer_settings
 
-        base = ContactParams.from_yaml(args.params0)
+        try:
+            base = ContactParams.from_yaml(args.params0)
+            block = read_observer_settings(args.params0)
+        except ValueError as err:
+            raise CliError(f"argument --params0: {err}") from None
         results = []
         for path in args.logs:
             est = estimate_rubbing(read_log(path, allow_gaps=True), base, mode="rotation")
@@ -296,15 +308,30 @@ def run(args) -> int:
             args.out,
             comment=f"lugrip identify --rubbing: mu and beta_A from "
             f"{', '.join(str(p) for p in args.logs)}",
+            observer=block,  # the fingertip's observer goes with its parameters
         )
         print(f"wrote {args.out}")
         return 0
 
-    observer = {"integrator": args.integrator}
+    observer = {}
+    if args.params0 is not None and args.params0.suffix in (".yaml", ".yml"):
+        from .._params import read_observer_settings
+
+        if not args.params0.exists():
+            raise CliError(f"argument --params0: {args.params0}: no such file")
+        try:
+            observer = dict(read_observer_settings(args.params0) or {})
+        except ValueError as err:
+            raise CliError(f"argument --params0: {err}") from None
+        observer.pop("dt", None)  # the nominal sample period is the logs'
+    if args.integrator is not None:
+        observer["integrator"] = args.integrator
     if args.bandwidth is not None:
         observer["bandwidth"] = args.bandwidth
+        observer["gain_mode"] = "bandwidth"
     if args.gain is not None:
         observer["gain"] = args.gain
+        observer["gain_mode"] = "fixed"
     if args.free is not None and args.params0 is None:
         raise CliError("--free needs --params0 for the values of the fixed parameters")
     bar = None if args.quiet else ProgressBar(args.max_iterations)

@@ -37,6 +37,7 @@ _EPILOG = """\
 examples:
   lugrip simulate-sliding --out data.csv
   lugrip observe data.csv --preset table1 --out est.csv --plot out/
+  lugrip observe run.parquet --params fingertip.yaml --out est.parquet
   lugrip observe run.parquet --params p.yaml --out est.parquet --integrator rk4 --gain 200
   lugrip observe run.bag --preset aluminium_can --out est.csv --wrench-topic /ft --flip-normal
 
@@ -45,6 +46,8 @@ docs/sliding_log.md): the wrench the object exerts on the fingertip. The observe
 where the maneuver id changes. With an `omega` column (ground truth) the RMSE of omega_hat
 (overall and per CoR regime) and the slip detection (delay from |omega| > --omega-threshold to
 S >= --s-threshold, false alarms) are printed. Nothing is overwritten without --force.
+A --params file written by 'lugrip identify' carries an 'observer' block (the observer the
+parameters were identified with); it is used unless an option below overrides a setting.
 """
 
 _INTEGRATORS = ("rosenbrock", "implicit", "rk4", "rk4_adaptive")
@@ -82,11 +85,14 @@ def register(subparsers) -> None:
     p.add_argument(
         "--format", choices=("png", "pdf", "svg"), default="png", help="figure format (default png)"
     )
-    o = p.add_argument_group("observer settings (default: the library defaults)")
+    o = p.add_argument_group(
+        "observer settings (default: the observer block of the --params file, written by "
+        "'lugrip identify', else the library defaults; these options override single settings)"
+    )
     o.add_argument(
         "--integrator",
         choices=_INTEGRATORS,
-        default="rosenbrock",
+        default=None,
         help="discretisation (default rosenbrock; rk4 = the paper's one step per sample)",
     )
     gain = o.add_mutually_exclusive_group()
@@ -234,14 +240,32 @@ def write_estimates(path: Path, log, run, *, force: bool = False) -> Path:
     return path
 
 
-def _observer(params, args, dt: float):
+def observer_block(args) -> dict | None:
+    """The ``observer:`` block of the --params file (settings the parameters were identified
+    with), or None (no --params, or a file without the block such as objects/*.yaml)."""
+    from .._params import read_observer_settings
+
+    if getattr(args, "params", None) is None:
+        return None
+    try:
+        return read_observer_settings(args.params)
+    except ValueError as err:
+        raise CliError(f"argument --params: {err}") from None
+
+
+def _observer(params, args, dt: float, block: dict | None = None):
     from .. import Observer
 
-    kwargs = {"integrator": args.integrator}
+    kwargs = dict(block or {})
+    kwargs.pop("dt", None)  # the nominal sample period is the log's
+    if args.integrator is not None:
+        kwargs["integrator"] = args.integrator
     if args.gain is not None:
         kwargs["gain"] = args.gain
+        kwargs["gain_mode"] = "fixed"
     if args.bandwidth is not None:
         kwargs["bandwidth"] = args.bandwidth
+        kwargs["gain_mode"] = "bandwidth"
     if args.torque_noise is not None:
         kwargs["torque_noise"] = args.torque_noise
     if args.torque_cutoff is not None:
@@ -276,6 +300,7 @@ def run(args) -> int:
     if Path(args.log).resolve() == out.resolve():
         raise CliError("argument --out: the output would replace the input log")
     params = load_params(args, default=None)
+    block = observer_block(args)
     if not Path(args.log).exists():
         raise CliError(f"{args.log}: no such file or directory")
     log = read_log(
@@ -288,15 +313,22 @@ def run(args) -> int:
     if len(log) == 0:
         raise CliError(f"{args.log}: the log holds no samples")
     dt = log.sample_period if len(log) > 1 else 0.002
-    observer = _observer(params, args, dt)
+    observer = _observer(params, args, dt, block)
     t0 = time.perf_counter()
     est = observer.run(log)
     elapsed = time.perf_counter() - t0
     write_estimates(out, log, est, force=args.force)
     n_man = len(set(log.maneuver.tolist()))
+    st = observer.settings
+    gain = (
+        f"l = {st['bandwidth']:g}/sigma_1"
+        if st["gain_mode"] == "bandwidth"
+        else f"fixed l = {st['gain']:g}"
+    )
+    origin = f", settings from {args.params}" if block is not None else ""
     print(
         f"{args.log}: {len(log)} samples, {n_man} maneuver(s), observer "
-        f"({observer.settings['integrator']}, gain {observer.settings['gain_mode']}) "
+        f"({st['integrator']}, {gain}{origin}) "
         f"{1e9 * elapsed / max(len(log), 1):.0f} ns/sample; wrote {out}"
     )
     n_valid = int(est.valid.sum())

@@ -7,7 +7,10 @@ per-object "rubbing" estimate of mu and beta_A (paper Section 6).
     >>> obj = lugrip.identify(object_logs, "fingertip.yaml", free=("mu", "beta_a"))
 
 The cost and its exact gradient run in C++ over all maneuvers in parallel; the observer inside
-the cost is the online one (:class:`lugrip.Observer`).
+the cost is the online one (:class:`lugrip.Observer`, default settings unless ``observer=`` is
+given). The parameters are identified FOR that observer: the result records its settings
+(``result.observer``, the ``observer:`` block of the YAML, :func:`read_observer_settings`) and
+``lugrip observe --params`` runs with them.
 """
 
 from ._fit import (
@@ -23,6 +26,7 @@ from ._fit import (
     initial_guess,
     load_maneuvers,
 )
+from .._params import read_observer_settings
 from ._rubbing import RubbingEstimate, estimate_rubbing
 
 __all__ = [
@@ -39,4 +43,5 @@ __all__ = [
     "identify",
     "initial_guess",
     "load_maneuvers",
+    "read_observer_settings",
 ]

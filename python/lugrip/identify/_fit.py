@@ -48,7 +48,7 @@ import numpy as np
 from .. import _core
 from .._contact import LimitSurface, _as_params, estimate_cor
 from .._observer import GAIN_MODES, INTEGRATORS, Observer
-from .._params import _UNITS, ContactParams
+from .._params import _UNITS, ContactParams, read_observer_settings
 from ..io import SlidingLog, read_log
 
 __all__ = [
@@ -644,6 +644,17 @@ class IdentificationResult:
     def success(self) -> bool:
         return self.status == "converged"
 
+    @property
+    def observer(self) -> dict:
+        """Settings of the observer inside the cost (keywords of :class:`lugrip.Observer`):
+        run online with exactly these, ``lugrip.Observer(result.params, **result.observer)``;
+        :meth:`save_yaml` writes them as the ``observer:`` block."""
+        return dict(self.settings.get("observer", {}))
+
+    def make_observer(self) -> Observer:
+        """The online observer the parameters were identified for."""
+        return Observer(self.params, **self.observer)
+
     def __getitem__(self, name: str) -> ParameterEstimate:
         for e in self.estimates:
             if e.name == name:
@@ -719,6 +730,9 @@ class IdentificationResult:
                 },
                 "c_max": {"value": self.params.c_max, "unit": "-"},
             },
+            # the observer inside the cost: the parameters are identified FOR it (MODEL.md
+            # 8.1), so online use must run the same one (lugrip observe --params reads this)
+            "observer": dict(self.observer),
             "identification": {
                 "status": self.status,
                 "message": self.message,
@@ -751,16 +765,19 @@ class IdentificationResult:
         }
 
     def save_yaml(self, path: str | Path) -> Path:
-        """Write the identified parameters with units, standard errors, bounds and the fit
-        summary. :meth:`lugrip.ContactParams.from_yaml` reads the file back (the
-        ``contact`` block); ``lugrip identify --params0`` accepts it."""
+        """Write the identified parameters with units, standard errors, bounds, the
+        ``observer:`` block (the settings of the observer inside the cost) and the fit
+        summary. :meth:`lugrip.ContactParams.from_yaml` reads the parameters back (the
+        ``contact`` block), :func:`lugrip.read_observer_settings` the observer block;
+        ``lugrip observe --params`` and ``lugrip identify --params0`` use both."""
         import yaml
 
         path = Path(path)
         path.parent.mkdir(parents=True, exist_ok=True)
         text = (
             "# lugrip identification (paper Section 4, MODEL.md 8): contact parameters\n"
-            "# value [unit], standard error, bounds; fit summary below\n"
+            "# value [unit], standard error, bounds; the observer they were identified with\n"
+            "# (use it online: lugrip observe --params reads the observer block); fit summary\n"
             + yaml.safe_dump(_plain(self.to_dict()), sort_keys=False)
         )
         tmp = path.with_name(path.name + ".tmp")
@@ -935,7 +952,11 @@ def identify(
             The per-object step of the paper is ``free=("mu", "beta_a")``.
         bounds: {name: (lower, upper)} overriding :data:`DEFAULT_BOUNDS`.
         observer: settings of the online observer (keywords of :class:`lugrip.Observer`, or
-            an Observer); default: the observer's defaults. Use what runs online.
+            an Observer). None: the ``observer:`` block of a params0 YAML file when it has
+            one (an earlier identification, e.g. the fingertip's for an object refit), else
+            the observer's defaults. The result records them (``result.observer``, the
+            ``observer:`` block of :meth:`IdentificationResult.save_yaml`): the parameters
+            are identified for that observer and must be used with it online.
         validation: fraction of maneuvers held out (random, ``seed``) or their keys/indices;
             0 or None: no validation set.
         loss: "squared" (eq. 32) or "huber" (residuals above ``huber_scale`` [rad/s] count
@@ -992,6 +1013,10 @@ def identify(
         and isinstance(params0, (str, os.PathLike))
         and Path(params0).suffix in (".yaml", ".yml")
     ):
+        if observer is None:
+            observer = read_observer_settings(params0)
+            if observer is not None:
+                observer.pop("dt", None)  # the nominal sample period is this data's
         params0 = ContactParams.from_yaml(params0)
     p_given = None if params0 is None else _as_params(params0)
     if p_given is None and len(free) < len(PARAMETERS):
@@ -1101,6 +1126,14 @@ def identify(
     idx = [PARAMETERS.index(n) for n in free_t]
 
     # --- problems
+    if observer is None:
+        observer = {}
+    if isinstance(observer, Mapping) and observer.get("dt") is None:
+        # the nominal sample period (sign hysteresis band of the CoR torque) is the data's,
+        # as in `lugrip observe`, which takes it from the log
+        steps = np.concatenate([m.dt[m.dt > 0] for m in mans] or [np.zeros(0)])
+        if steps.size:
+            observer = {**observer, "dt": float(np.median(steps))}
     osettings, odict = _observer_settings(observer, p0)
     settings = _core.IdentificationSettings()
     settings.observer = osettings
