@@ -2,6 +2,7 @@
 // loops over 1-D contiguous float64 arrays (shape handling lives in the Python layer).
 #include <nanobind/nanobind.h>
 #include <nanobind/ndarray.h>
+#include <nanobind/stl/optional.h>
 #include <nanobind/stl/string.h>
 #include <nanobind/stl/tuple.h>
 
@@ -237,6 +238,8 @@ NB_MODULE(_core, m) {
       .def_rw("k_i", &GraspControllerSettings::k_i)
       .def_rw("anti_windup", &GraspControllerSettings::anti_windup)
       .def_rw("gain_schedule_force", &GraspControllerSettings::gain_schedule_force)
+      .def_rw("omega_deadband", &GraspControllerSettings::omega_deadband)
+      .def_rw("static_equivalent_slippage", &GraspControllerSettings::static_equivalent_slippage)
       .def_rw("f_min", &GraspControllerSettings::f_min)
       .def_rw("f_max", &GraspControllerSettings::f_max)
       .def_rw("max_rate_up", &GraspControllerSettings::max_rate_up)
@@ -308,19 +311,21 @@ NB_MODULE(_core, m) {
       .def_prop_ro("mu", &GraspController::mu)
       .def_prop_ro("dynamic_filter", [](const GraspController& c) { return c.dynamic_filter(0); })
       .def("step", [](GraspController& c, double w0, double s0, double c0, double f0, int st0, bool p0,
-                      double w1, double s1, double c1, double f1, int st1, bool p1) {
+                      double w1, double s1, double c1, double f1, int st1, bool p1, double r0,
+                      double r1) {
         GraspControllerInput in;
-        in.fingers[0] = FingerInput{w0, s0, c0, f0, static_cast<Status>(st0), p0};
-        in.fingers[1] = FingerInput{w1, s1, c1, f1, static_cast<Status>(st1), p1};
+        in.fingers[0] = FingerInput{w0, s0, c0, f0, static_cast<Status>(st0), p0, r0};
+        in.fingers[1] = FingerInput{w1, s1, c1, f1, static_cast<Status>(st1), p1, r1};
         GraspControllerOutput out;
         c.step(in, out);
         return out;
-      }, "Per-finger values of finger 0 then finger 1: omega_hat, S, c_tilde, f_t, status, present.")
+      }, "Per-finger values of finger 0 then finger 1: omega_hat, S, c_tilde, f_t, status, present; then omega_resolution of both.")
       .def("run", [](GraspController& c, const Fingers2& w, const Fingers2& S, const Fingers2& ct,
-                     const Fingers2& ft, const Status2& st, const Bool2& present, const Int1& requests) {
+                     const Fingers2& ft, const Status2& st, const Bool2& present, const Int1& requests,
+                     const Fingers2& res) {
         const size_t n = w.shape(0);
         if (S.shape(0) != n || ct.shape(0) != n || ft.shape(0) != n || st.shape(0) != n ||
-            present.shape(0) != n || requests.shape(0) != n)
+            present.shape(0) != n || requests.shape(0) != n || res.shape(0) != n)
           throw std::invalid_argument("arrays must have the same length");
         auto force = new_array<double>(n), fns = new_array<double>(n), fnd = new_array<double>(n),
              floor = new_array<double>(n), slip = new_array<double>(n), err = new_array<double>(n),
@@ -329,7 +334,7 @@ NB_MODULE(_core, m) {
         auto mode = new_array<int32_t>(n), pend = new_array<int32_t>(n), status = new_array<int32_t>(n);
         auto issued = new_array<bool>(n), fin = new_array<bool>(n), sat = new_array<bool>(n),
              rl = new_array<bool>(n), held = new_array<bool>(n);
-        const double *pw = w.data(), *ps = S.data(), *pc = ct.data(), *pf = ft.data();
+        const double *pw = w.data(), *ps = S.data(), *pc = ct.data(), *pf = ft.data(), *pr = res.data();
         const int32_t *pst = st.data(), *prq = requests.data();
         const bool* pp = present.data();
         {
@@ -341,7 +346,7 @@ NB_MODULE(_core, m) {
             else if (prq[i] == 2) c.request_slipping_avoidance();
             for (int k = 0; k < 2; ++k) {
               const size_t j = 2 * i + k;
-              in.fingers[k] = FingerInput{pw[j], ps[j], pc[j], pf[j], static_cast<Status>(pst[j]), pp[j]};
+              in.fingers[k] = FingerInput{pw[j], ps[j], pc[j], pf[j], static_cast<Status>(pst[j]), pp[j], pr[j]};
             }
             c.step(in, o);
             force.data()[i] = o.force; fns.data()[i] = o.static_force; fnd.data()[i] = o.dynamic_force;
@@ -363,7 +368,7 @@ NB_MODULE(_core, m) {
         d["command_issued"] = issued; d["pivot_finished"] = fin; d["saturated"] = sat;
         d["rate_limited"] = rl; d["held"] = held;
         return d;
-      }, "omega_hat"_a, "S"_a, "c_tilde"_a, "f_t"_a, "status"_a, "present"_a, "requests"_a,
+      }, "omega_hat"_a, "S"_a, "c_tilde"_a, "f_t"_a, "status"_a, "present"_a, "requests"_a, "omega_resolution"_a,
          "Runs step() over (N, 2) arrays in C++ (requests: 0 none, 1 pivoting, 2 slipping "
          "avoidance, applied before the sample); returns a dict of (N,) arrays.");
 
@@ -847,6 +852,7 @@ NB_MODULE(_core, m) {
         .def(nb::init<>())
         .def_rw("plant", &ClosedLoopConfig::plant)
         .def_rw("observer", &ClosedLoopConfig::observer)
+        .def_rw("estimator", &ClosedLoopConfig::estimator)
         .def_rw("controller", &ClosedLoopConfig::controller)
         .def_rw("kind", &ClosedLoopConfig::kind)
         .def_rw("controller_start", &ClosedLoopConfig::controller_start)

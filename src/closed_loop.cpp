@@ -67,6 +67,7 @@ bool validate(const ClosedLoopConfig& c, std::string* message) {
   std::string msg, sub;
   if (!validate(c.plant, &sub)) append_prefixed(msg, sub, "plant.");
   if (!validate(c.observer, &sub)) append_prefixed(msg, sub, "observer.");
+  if (c.estimator && !validate(*c.estimator, &sub)) append_prefixed(msg, sub, "estimator.");
   if (!validate(c.controller, &sub)) append_prefixed(msg, sub, "controller.");
   const double fs = c.plant.sensor.rate;
   if (std::isfinite(fs) && fs > 0.0) {
@@ -159,11 +160,18 @@ void ClosedLoopLog::append(const ClosedLoopSample& s) {
 
 // --- loop ------------------------------------------------------------------------------------
 
+namespace {
+// The plant's contact model (tables shared by copy) or one built from the estimator parameters.
+Observer make_observer(const ClosedLoopConfig& c, const GraspPlant& plant) {
+  return c.estimator ? Observer(*c.estimator, c.observer) : Observer(plant.contact_model(), c.observer);
+}
+}  // namespace
+
 ClosedLoop::ClosedLoop(const ClosedLoopConfig& config)
     : cfg_(sorted(checked(config))),
       plant_(cfg_.plant),
-      obs_{Observer(plant_.contact_model(), cfg_.observer), Observer(plant_.contact_model(), cfg_.observer)},
-      ctrl_(cfg_.plant.contact, cfg_.controller) {
+      obs_{make_observer(cfg_, plant_), make_observer(cfg_, plant_)},
+      ctrl_(cfg_.estimator.value_or(cfg_.plant.contact), cfg_.controller) {
   dt_ = 1.0 / cfg_.plant.sensor.rate;
   ratio_ = cfg_.controller.command_ratio;
   reset();
@@ -203,7 +211,7 @@ void ClosedLoop::apply_events(double t) noexcept {
 
 void ClosedLoop::cone_command() noexcept {
   const GraspControllerSettings& s = cfg_.controller;
-  const double mu = cfg_.plant.contact.mu, margin = cfg_.cone_margin;
+  const double mu = cfg_.estimator.value_or(cfg_.plant.contact).mu, margin = cfg_.cone_margin;
   const double T = ratio_ * dt_;
   double u = 0.0, ft_max = 0.0;
   for (int i = 0; i < 2; ++i) {
@@ -240,6 +248,7 @@ void ClosedLoop::step(ClosedLoopSample& out) noexcept {
     const ObserverOutput& o = oout_[i];
     FingerInput& f = cin.fingers[i];
     f.omega_hat = o.omega_hat;
+    f.omega_resolution = o.omega_resolution;
     f.slippage = o.S;
     f.c_tilde = o.c_tilde;
     f.f_t = in.f_t;

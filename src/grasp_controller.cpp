@@ -40,7 +40,7 @@ bool finger_valid(const FingerInput& f) noexcept {
   return is_valid(f.status) && std::isfinite(f.omega_hat) && std::fabs(f.omega_hat) <= kMaxInput &&
          std::isfinite(f.slippage) && f.slippage >= 0.0 && f.slippage <= kMaxSlippage &&
          std::isfinite(f.c_tilde) && std::fabs(f.c_tilde) <= kMaxInput && std::isfinite(f.f_t) &&
-         std::fabs(f.f_t) <= kMaxInput;
+         std::fabs(f.f_t) <= kMaxInput && std::isfinite(f.omega_resolution) && f.omega_resolution >= 0.0;
 }
 
 const GraspControllerSettings& checked(const GraspControllerSettings& s) {
@@ -78,6 +78,8 @@ bool validate(const GraspControllerSettings& s, std::string* message) {
   if (!(std::isfinite(s.f_max) && s.f_max > s.f_min)) bad("f_max", s.f_max, "must be finite and > f_min");
   positive_or_inf("max_rate_up", s.max_rate_up);
   positive_or_inf("max_rate_down", s.max_rate_down);
+  if (!(std::isfinite(s.omega_deadband) && s.omega_deadband >= 0.0))
+    bad("omega_deadband", s.omega_deadband, "must be finite and >= 0");
   if (!(std::isfinite(s.invalid_raise_step) && s.invalid_raise_step >= 0.0))
     bad("invalid_raise_step", s.invalid_raise_step, "must be finite and >= 0");
   if (!(std::isfinite(s.s_pivot) && s.s_pivot > 1.0)) bad("s_pivot", s.s_pivot, "must be finite and > 1");
@@ -100,6 +102,8 @@ std::string to_string(const GraspControllerSettings& s) {
          ", p_cd=" + num(s.p_cd) + ", z_cd=" + num(s.z_cd) + ", dynamic_enabled=" + flag(s.dynamic_enabled) +
          ", s_ref=" + num(s.s_ref) + ", k_p=" + num(s.k_p) + ", k_i=" + num(s.k_i) +
          ", anti_windup=" + flag(s.anti_windup) + ", gain_schedule_force=" + num(s.gain_schedule_force) +
+         ", static_equivalent_slippage=" + flag(s.static_equivalent_slippage) +
+         ", omega_deadband=" + num(s.omega_deadband) +
          ", f_min=" + num(s.f_min) + ", f_max=" + num(s.f_max) +
          ", max_rate_up=" + num(s.max_rate_up) + ", max_rate_down=" + num(s.max_rate_down) +
          ", invalid_raise_step=" + num(s.invalid_raise_step) + ", s_pivot=" + num(s.s_pivot) +
@@ -143,6 +147,7 @@ GraspController::GraspController(const ContactParams& params, const GraspControl
     : s_(checked(settings)) {
   validate_or_throw(params);
   mu_ = params.mu;
+  gamma_ = params.gamma;
   dt_ = 1.0 / s_.sensor_rate;
   t_cmd_ = s_.command_ratio * dt_;
   pivot_decay_ = std::exp(-t_cmd_ / s_.tau_pivot);
@@ -250,7 +255,12 @@ void GraspController::step(const GraspControllerInput& in, GraspControllerOutput
     f_t_max = std::max(f_t_max, std::fabs(f.f_t));
     ++n_valid;
     if (dynamic) {
-      const double y = cd_[i].step(f.omega_hat);
+      double w = f.omega_hat;
+      if (s_.omega_deadband > 0.0) {
+        const double band = s_.omega_deadband * f.omega_resolution;
+        w = std::copysign(std::max(0.0, std::fabs(w) - band), w);
+      }
+      const double y = cd_[i].step(w);
       peak_ = std::max(peak_, std::fabs(y));
       out.dynamic_sample[i] = y;
     } else {
@@ -322,6 +332,14 @@ void GraspController::issue_command(bool valid, double slip) noexcept {
   if (mode_ == ControllerMode::SlippingAvoidance) {
     // PI on e = S - s_ref: e > 0 (closer to slip than wanted) raises the force (MODEL.md 9.4).
     e = slip - s_.s_ref;
+    // Integrated error: with static_equivalent_slippage the slippage the static part alone would
+    // give, S_s = S ((f_ns + f_nd) / f_ns)^(1 + gamma) at the last command (= S when f_nd = 0).
+    // Only the integrator uses it: in the proportional term the ratio would feed the new f_ns
+    // back into the next error and alternate from command to command.
+    double e_i = e;
+    if (s_.static_equivalent_slippage && s_.dynamic_enabled && last_.dynamic_force > 0.0 &&
+        last_.static_force > 0.0)
+      e_i = slip * std::pow(1.0 + last_.dynamic_force / last_.static_force, 1.0 + gamma_) - s_.s_ref;
     const double scale = s_.gain_schedule_force > 0.0 ? command_ / s_.gain_schedule_force : 1.0;
     const double k_p = s_.k_p * scale, k_i = s_.k_i * scale;
     if (init_static_) {  // bumpless (re)start from the last command
@@ -334,7 +352,7 @@ void GraspController::issue_command(bool valid, double slip) noexcept {
       c.saturated = true;
       if (s_.anti_windup) integrator_ = f_ns - k_p * e;  // back-calculation, static part only
     }
-    integrator_ += k_i * t_cmd_ * e;  // forward Euler
+    integrator_ += k_i * t_cmd_ * e_i;  // forward Euler
     if (s_.dynamic_enabled) {
       const double head_room = s_.f_max - f_ns;
       f_nd = clamp(peak_, 0.0, head_room);

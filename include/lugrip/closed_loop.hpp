@@ -11,6 +11,7 @@
 
 #include <array>
 #include <cstdint>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -60,6 +61,7 @@ struct ModeEvent {
 //! |---|---|---|---|
 //! | plant | object, contact, actuator, sensors, moves, disturbances (GraspPlant) | | (required) |
 //! | observer | settings of both fingers' Observer | | ObserverSettings() |
+//! | estimator | contact parameters the observers and the controller use (what the robot believes); unset: the plant's own | | unset |
 //! | controller | GraspController settings (also the range/rate limits of the baselines) | | GraspControllerSettings() |
 //! | kind | which law computes the command | | Lugrip |
 //! | controller_start | before this time the command stays at plant.actuator.f_init | s | 0 |
@@ -70,6 +72,10 @@ struct ModeEvent {
 struct ClosedLoopConfig {
   PlantConfig plant;
   ObserverSettings observer;
+  //! Contact parameters of the estimator side (observers, controller). A real fingertip is not
+  //! the lumped model: set this to the parameters identified for the simulated fingertip (or to
+  //! deliberately wrong ones, to study mismatch). Unset: plant.contact.
+  std::optional<ContactParams> estimator;
   GraspControllerSettings controller;
   ControllerKind kind = ControllerKind::Lugrip;
   double controller_start = 0.0;

@@ -39,6 +39,20 @@ struct GraspControllerSettings {
   //! when (k_p - k_i T) |dS/df_n| > 1, i.e. below ~3 N for a translational load (S = 0.8 f*/f_n),
   //! and limit-cycles there (tests: ControllerClosedLoop.*). >= 0, finite.
   double gain_schedule_force = 0.0;
+  //! (*) not in the paper (default true; false = paper). When true the PI integrates the
+  //! slippage the static part alone would give, S_s = S ((f_ns + f_nd) / f_ns)^(1 + gamma) (g
+  //! grows as f_n^(1 + gamma) at a fixed CoR; f_ns, f_nd of the last command), instead of S; the
+  //! proportional term keeps S. While f_nd holds the object after a slip, S is low because of
+  //! f_nd, and the paper's PI unwinds f_ns, so the object slips again when f_nd has decayed (a
+  //! slip / force-spike cycle on heavy rotational loads); with S_s, f_ns keeps rising to the
+  //! force the load needs. Identical to the paper when f_nd = 0.
+  bool static_equivalent_slippage = true;
+  //! (*) not in the paper (default 1; 0 = off = paper). Dead band of the dynamic part in multiples of each
+  //! finger's FingerInput::omega_resolution: C_d sees sign(w) max(0, |w| - band) with
+  //! band = omega_deadband * omega_resolution. The slip speed enters the wrench only through
+  //! viscous friction, so below the resolution omega_hat is sensor noise seen through 1/sigma_1;
+  //! rectified by |C_d .| it would add a noise-driven force. >= 0, finite.
+  double omega_deadband = 1.0;
 
   // --- force range and rate limits (MODEL.md 9.5) --------------------------------------------
   double f_min = 0.1;   //!< [N] minimum force (keeps contact), > 0
@@ -92,6 +106,9 @@ struct FingerInput {
   double f_t = 0.0;        //!< tangential force [N] (magnitude is used; pivoting floor)
   Status status = Status::Ok;  //!< observer status of this sample
   bool present = true;     //!< false: this finger is not used (one-finger operation)
+  //! speed resolution of omega_hat [rad/s] (ObserverOutput::omega_resolution), >= 0; used by
+  //! the dead band (GraspControllerSettings::omega_deadband); 0: none
+  double omega_resolution = 0.0;
 };
 
 //! Input of one step(): the two fingertips at one sensor sample.
@@ -210,6 +227,7 @@ class GraspController {
 
   GraspControllerSettings s_;
   double mu_ = 1.0;
+  double gamma_ = 0.25;
   double dt_ = 0.002, t_cmd_ = 0.02, pivot_decay_ = 0.0;
   std::array<LagFilter, kMaxFingers> cd_{};
   ControllerMode mode_ = ControllerMode::SlippingAvoidance;

@@ -35,12 +35,13 @@ REQUEST_NONE, REQUEST_PIVOTING, REQUEST_SLIPPING_AVOIDANCE = 0, 1, 2
 
 _SETTINGS_FIELDS = (
     "sensor_rate", "command_ratio", "k_cd", "p_cd", "z_cd", "dynamic_enabled", "s_ref", "k_p",
-    "k_i", "anti_windup", "gain_schedule_force", "f_min", "f_max", "max_rate_up",
-    "max_rate_down", "invalid_raise_step", "s_pivot", "tau_pivot", "k_f", "pivot_floor_factor",
+    "k_i", "anti_windup", "gain_schedule_force", "static_equivalent_slippage",
+    "omega_deadband", "f_min", "f_max",
+    "max_rate_up", "max_rate_down", "invalid_raise_step", "s_pivot", "tau_pivot", "k_f", "pivot_floor_factor",
     "pivot_end_c_tilde", "pivot_end_samples", "pivot_timeout",
 )
 _INT_FIELDS = ("command_ratio", "pivot_end_samples")
-_BOOL_FIELDS = ("dynamic_enabled", "anti_windup")
+_BOOL_FIELDS = ("dynamic_enabled", "anti_windup", "static_equivalent_slippage")
 
 
 class ControllerMode(enum.IntEnum):
@@ -204,8 +205,10 @@ class GraspController:
         **settings: any GraspControllerSettings field (see :func:`controller_settings` for the
             names and defaults): rates (sensor_rate [Hz], command_ratio), C_d (k_cd [N s/rad],
             p_cd, z_cd [rad/s], dynamic_enabled), PI (s_ref, k_p [N], k_i [N/s], anti_windup,
-            gain_schedule_force [N], 0 = off), range (f_min, f_max [N]), rate limits
-            (max_rate_up, max_rate_down [N/s], inf = off), invalid_raise_step [N], pivoting
+            gain_schedule_force [N], 0 = off; static_equivalent_slippage: regulate the S of the
+            static part alone; omega_deadband: dead band of C_d in omega resolutions, 0 = off),
+            range (f_min, f_max [N]), rate
+            limits (max_rate_up, max_rate_down [N/s], inf = off), invalid_raise_step [N], pivoting
             (s_pivot, tau_pivot [s], k_f [N], pivot_floor_factor, pivot_end_c_tilde,
             pivot_end_samples, pivot_timeout [s]).
 
@@ -288,7 +291,7 @@ class GraspController:
 
     # --- stepping --------------------------------------------------------------------------
     def step(self, omega_hat, S, c_tilde=0.0, f_t=0.0, status=Status.OK,
-             present=None) -> ControllerOutput:
+             present=None, omega_resolution=0.0) -> ControllerOutput:
         """One sensor sample. Scalars describe finger 0 alone (finger 1 absent unless `present`
         says otherwise, then it gets the same values); length-2 sequences describe both fingers.
 
@@ -296,9 +299,11 @@ class GraspController:
             omega_hat: estimated sliding velocity [rad/s]; S: slippage indicator [-];
             c_tilde: normalized CoR [-]; f_t: tangential force [N]; status: observer Status;
             present: per-finger bools (default: the fingers given).
+            omega_resolution: the observer's speed resolution [rad/s] (``omega_resolution`` of
+                its output), used by the dead band of the dynamic part (``omega_deadband``).
         """
         vals = [np.atleast_1d(np.asarray(v, dtype=np.float64))
-                for v in (omega_hat, S, c_tilde, f_t)]
+                for v in (omega_hat, S, c_tilde, f_t, omega_resolution)]
         st = np.atleast_1d(np.asarray(status, dtype=np.int64))
         n_fingers = max(len(v) for v in vals + [st])
         if n_fingers > 2 or any(len(v) not in (1, n_fingers) for v in vals + [st]):
@@ -310,13 +315,13 @@ class GraspController:
         else:
             p = np.broadcast_to(np.asarray(present, dtype=bool), (2,))
             pres = (bool(p[0]), bool(p[1]))
-        w, s, c, f = (tuple(float(x) for x in v) for v in vals)
+        w, s, c, f, r = (tuple(float(x) for x in v) for v in vals)
         o = self._ctrl.step(w[0], s[0], c[0], f[0], int(st[0]), pres[0],
-                            w[1], s[1], c[1], f[1], int(st[1]), pres[1])
+                            w[1], s[1], c[1], f[1], int(st[1]), pres[1], r[0], r[1])
         return ControllerOutput._from_core(o)
 
     def run(self, omega_hat, S, c_tilde=0.0, f_t=0.0, status=None, present=None,
-            requests=None) -> ControllerRun:
+            requests=None, omega_resolution=0.0) -> ControllerRun:
         """Step over N sensor samples in one C++ loop (state carried over between calls).
 
         Args:
@@ -328,11 +333,13 @@ class GraspController:
             requests: (N,) ints applied before each sample (REQUEST_NONE, REQUEST_PIVOTING,
                 REQUEST_SLIPPING_AVOIDANCE), or a dict {sample index: "pivoting" |
                 "slipping_avoidance"}.
+            omega_resolution: the observers' speed resolution [rad/s], like omega_hat (used by
+                the dead band ``omega_deadband``; default 0: no dead band).
 
         Returns:
             ControllerRun with (N,) arrays.
         """
-        arrays = [np.asarray(v) for v in (omega_hat, S, c_tilde, f_t)]
+        arrays = [np.asarray(v) for v in (omega_hat, S, c_tilde, f_t, omega_resolution)]
         extra = [np.asarray(v) for v in (status,) if v is not None]
         shaped = [a for a in arrays + extra if a.ndim >= 1]
         if not shaped:
@@ -344,8 +351,10 @@ class GraspController:
             raise ValueError("all per-sample inputs must have the same number of samples")
         n = lengths.pop()
         two = any(a.ndim == 2 and a.shape[1] == 2 for a in shaped)
-        w, s, c, f = (_per_finger(a, n, name, np.float64)
-                      for a, name in zip(arrays, ("omega_hat", "S", "c_tilde", "f_t")))
+        w, s, c, f, res = (
+            _per_finger(a, n, name, np.float64)
+            for a, name in zip(arrays, ("omega_hat", "S", "c_tilde", "f_t", "omega_resolution"))
+        )
         st = _per_finger(Status.OK if status is None else status, n, "status", np.int32)
         if present is None:
             pres = np.broadcast_to(np.array([True, two]), (n, 2))
@@ -361,7 +370,7 @@ class GraspController:
                 req[int(index)] = codes[what]
         elif requests is not None:
             req[:] = np.asarray(requests, dtype=np.int32)
-        r = self._ctrl.run(w, s, c, f, st, pres, req)
+        r = self._ctrl.run(w, s, c, f, st, pres, req, res)
         dyn = np.stack([r.pop("dynamic_sample_0"), r.pop("dynamic_sample_1")], axis=1)
         return ControllerRun(dynamic_sample=dyn, **r)
 

@@ -84,6 +84,8 @@ TEST(ControllerSettings, EachBadFieldIsNamed) {
       {"k_p", [](GraspControllerSettings& s) { s.k_p = 0.0; }},
       {"k_i", [](GraspControllerSettings& s) { s.k_i = kInf; }},
       {"gain_schedule_force", [](GraspControllerSettings& s) { s.gain_schedule_force = -1.0; }},
+      {"omega_deadband", [](GraspControllerSettings& s) { s.omega_deadband = -1.0; }},
+      {"omega_deadband", [](GraspControllerSettings& s) { s.omega_deadband = kNaN; }},
       {"f_min", [](GraspControllerSettings& s) { s.f_min = 0.0; }},
       {"f_max", [](GraspControllerSettings& s) { s.f_max = 0.05; }},  // below f_min
       {"max_rate_up", [](GraspControllerSettings& s) { s.max_rate_up = 0.0; }},
@@ -224,6 +226,7 @@ TEST(ControllerDynamicPart, AbsoluteValueAfterFilteringAndPeakHold) {
 TEST(ControllerDynamicPart, ClippedToTheHeadRoomWithoutTouchingTheIntegrator) {
   GraspControllerSettings s;
   s.max_rate_up = s.max_rate_down = kInf;
+  s.static_equivalent_slippage = false;  // the paper's PI: e = S - s_ref
   GraspController c(can(), s);
   c.reset(15.0);
   const auto out = run(c, one(0.8, 1.0), 11);  // second command: C_d output ~ 160 N
@@ -232,6 +235,87 @@ TEST(ControllerDynamicPart, ClippedToTheHeadRoomWithoutTouchingTheIntegrator) {
   EXPECT_EQ(out.force, 20.0);
   EXPECT_TRUE(out.saturated);
   EXPECT_NEAR(out.integrator, 15.0, 1e-12);
+}
+
+TEST(ControllerDynamicPart, DeadBandRemovesSpeedsBelowTheObserverResolution) {
+  // C_d sees sign(w) max(0, |w| - k r): below the band no dynamic force at all, above it the
+  // output equals that of a band-free controller fed the shrunk speed.
+  GraspControllerSettings banded, plain;
+  banded.omega_deadband = 2.0;
+  plain.omega_deadband = 0.0;
+  banded.static_equivalent_slippage = plain.static_equivalent_slippage = false;  // dead band alone
+  const double r = 0.01;  // [rad/s] resolution reported by the observer
+  for (double w : {-0.019, 0.0, 0.015, 0.0199}) {
+    GraspController c(can(), banded);
+    GraspControllerInput in = one(0.8, w);
+    in.fingers[0].omega_resolution = r;
+    const auto out = run(c, in, 30);
+    EXPECT_EQ(out.dynamic_force, 0.0) << w;
+    EXPECT_EQ(out.dynamic_sample[0], 0.0) << w;
+  }
+  for (double w : {-0.5, 0.03, 0.2}) {
+    GraspController a(can(), banded), b(can(), plain);
+    GraspControllerInput ia = one(0.8, w), ib = one(0.8, std::copysign(std::fabs(w) - 2.0 * r, w));
+    ia.fingers[0].omega_resolution = r;
+    GraspControllerOutput oa, ob;
+    for (int i = 0; i < 30; ++i) {
+      a.step(ia, oa);
+      b.step(ib, ob);
+      EXPECT_NEAR(oa.dynamic_sample[0], ob.dynamic_sample[0], 1e-12 * (1.0 + std::fabs(ob.dynamic_sample[0])));
+    }
+    EXPECT_GT(oa.dynamic_force, 0.0);
+    EXPECT_NEAR(oa.force, ob.force, 1e-9);
+  }
+  // A negative or non-finite resolution is an invalid sample: the command is held.
+  GraspController c(can(), banded);
+  GraspControllerInput bad = one(0.8, 0.1);
+  bad.fingers[0].omega_resolution = -1.0;
+  EXPECT_EQ(run(c, bad, 10).status, Status::InvalidSample);
+}
+
+TEST(ControllerStaticPart, StaticEquivalentSlippageKeepsRaisingWhileTheDynamicPartHolds) {
+  // After a slip the dynamic part holds the object and S drops below s_ref. The paper's PI then
+  // unwinds f_ns; with static_equivalent_slippage it integrates S_s = S ((f_ns + f_nd)/f_ns)^(1+gamma),
+  // the slippage at the static force alone, which is above s_ref here: f_ns keeps rising.
+  const ContactParams p = can();
+  GraspControllerSettings on, off;
+  on.max_rate_up = on.max_rate_down = off.max_rate_up = off.max_rate_down = kInf;
+  off.static_equivalent_slippage = false;
+  GraspController a(p, on), b(p, off);
+  a.reset(3.0);
+  b.reset(3.0);
+  GraspControllerOutput oa, ob;
+  a.step(one(0.8), oa);  // command 0 (f_nd = 0)
+  b.step(one(0.8), ob);
+  // Next command period: a slip (omega 0.2 rad/s) at S = 0.8 -> f_nd > 0 at the tick.
+  oa = run(a, one(0.8, 0.2), 10);
+  ob = run(b, one(0.8, 0.2), 10);
+  ASSERT_TRUE(oa.command_issued);
+  ASSERT_GT(oa.dynamic_force, 1.0);
+  EXPECT_NEAR(oa.static_force, ob.static_force, 1e-12);  // f_nd was 0 before: same law
+  const double fns = oa.static_force, fnd = oa.dynamic_force;
+  // Second period: no slip, S lowered by the extra force.
+  const double S = 0.5;
+  const double I0a = oa.integrator, I0b = ob.integrator;
+  oa = run(a, one(S, 0.0), 10);
+  ob = run(b, one(S, 0.0), 10);
+  const double e_s = S * std::pow((fns + fnd) / fns, 1.0 + p.gamma) - 0.8;
+  ASSERT_GT(e_s, 0.0);
+  EXPECT_NEAR(oa.error, S - 0.8, 1e-12);  // the proportional term keeps S
+  EXPECT_NEAR(oa.integrator - I0a, on.k_i * 0.02 * e_s, 1e-9);
+  EXPECT_NEAR(ob.error, S - 0.8, 1e-12);
+  EXPECT_LT(ob.integrator, I0b);  // the paper's PI unwinds
+  oa = run(a, one(S, 0.0), 10);  // the next command uses the new integrators
+  ob = run(b, one(S, 0.0), 10);
+  EXPECT_GT(oa.static_force, ob.static_force + 0.5);
+  // Once the dynamic part has decayed to zero the two laws are identical again.
+  GraspControllerSettings quiet = on;
+  quiet.dynamic_enabled = false;
+  GraspController q(p, quiet), r(p, off);
+  q.reset(4.0);
+  r.reset(4.0);
+  const auto oq = run(q, one(0.6, 0.0), 50), orr = run(r, one(0.6, 0.0), 50);
+  EXPECT_NEAR(oq.force, orr.force, 1e-12);
 }
 
 TEST(ControllerDynamicPart, DisabledAndReenabledFromRest) {

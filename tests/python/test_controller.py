@@ -294,3 +294,22 @@ def test_closed_loop_settles_at_the_static_force(obj, ft, tau):
     f_static = lugrip.static_grasp_force(obj, ft, tau)
     tail = np.array(forces[-250:])  # last 5 s
     assert np.all(np.abs(tail / f_static - 1) < 0.01)
+
+
+def test_dead_band_ignores_speeds_below_the_observer_resolution():
+    """omega_deadband (in multiples of the observer's omega_resolution) removes the noise-level
+    speeds from C_d: no dynamic force below the band, the force of the shrunk speed above it."""
+    kw = {"omega_deadband": 2.0, "static_equivalent_slippage": False}
+    below = lugrip.GraspController("aluminium_can", **kw).run(
+        np.full(40, 0.015), 0.8, omega_resolution=0.01
+    )
+    assert np.all(below.dynamic_force == 0.0)
+    blind = lugrip.GraspController("aluminium_can", **kw).run(np.full(40, 0.015), 0.8)
+    assert blind.dynamic_force[-1] > 0.5  # resolution 0 (not given): no band
+    above = lugrip.GraspController("aluminium_can", **kw).run(
+        np.full(40, 0.035), 0.8, omega_resolution=0.01
+    )
+    shrunk = lugrip.GraspController("aluminium_can", **kw).run(np.full(40, 0.015), 0.8)
+    np.testing.assert_allclose(above.force, shrunk.force, rtol=1e-12)
+    out = lugrip.GraspController("aluminium_can", **kw).step(0.015, 0.8, omega_resolution=0.01)
+    assert out.dynamic_force == 0.0
