@@ -209,3 +209,27 @@ def test_property_command_finite_in_limits(
         assert np.all(np.isfinite(np.asarray(v, dtype=float)))
     assert np.all(r.command >= f_min - 1e-12) and np.all(r.command <= 15.0 + 1e-12)
     assert np.all((r.S_0 >= 0.0) & (r.S_0 <= 1.0) & (r.S_1 >= 0.0) & (r.S_1 <= 1.0))
+
+
+def test_estimator_parameters_feed_the_observers_and_default_to_the_plants():
+    """The observers and the controller use `estimator` (what the robot believes about the
+    contact); unset, the plant's parameters. The patch plant has its own bristles, so an observer
+    that believes Table 1's sigma_z = 2 sees the lift-off slip of this pad ~100x too slow and the
+    block turns far more before the force catches up."""
+    p = plant(0.2, (0.0035, 0.0), {"preset": "small_resin_block", "sigma_z": 3.3e-3}, seed=7)
+    assert closed_loop_config(p, None, OBS).estimator is None
+    c = closed_loop_config(p, None, OBS, estimator={"sigma_z": 2.0})
+    assert c.estimator.sigma_z == 2.0 and c.estimator.mu == 0.7  # overrides on the plant's
+    assert closed_loop_config(p, None, OBS, estimator="big_resin_block").estimator.mu == 0.85
+    c = closed_loop_config(p, None, OBS, estimator={"preset": "big_resin_block", "mu": 0.5})
+    assert c.estimator.mu == 0.5 and c.estimator.beta_a == 1.24e7
+    with pytest.raises(ValueError):
+        closed_loop_config(p, None, OBS, estimator={"sigma_z": -1.0})
+    with pytest.raises(ValueError):
+        closed_loop_config(p, None, OBS, estimator=3.0)
+    own = run_closed_loop(p, None, OBS, None, 4.0)
+    table1 = run_closed_loop(p, None, OBS, None, 4.0, estimator={"sigma_z": 2.0})
+    rot_own = np.degrees(np.max(np.abs(own["rotation"])))
+    rot_t1 = np.degrees(np.max(np.abs(table1["rotation"])))
+    assert rot_own < 1.0, rot_own  # measured 0.3 deg
+    assert rot_t1 > 10.0 * rot_own, (rot_own, rot_t1)  # measured ~20 deg

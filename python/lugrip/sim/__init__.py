@@ -12,7 +12,7 @@ experiments as scenarios in :mod:`lugrip.sim.scenarios`). The loops run in C++.
     True
 """
 
-from ._closed_loop import ClosedLoopRun, closed_loop_config, run_closed_loop
+from ._closed_loop import ClosedLoopRun, closed_loop_config, estimator_params, run_closed_loop
 from ._plant import (
     ActuatorConfig,
     Disturbance,
@@ -29,10 +29,8 @@ from ._plant import (
 )
 
 __all__ = [
-    "ClosedLoopRun",
-    "closed_loop_config",
-    "run_closed_loop",
     "ActuatorConfig",
+    "ClosedLoopRun",
     "Disturbance",
     "DropConfig",
     "GraspPlant",
@@ -43,5 +41,8 @@ __all__ = [
     "PlantConfig",
     "PlantLog",
     "SensorConfig",
+    "closed_loop_config",
+    "estimator_params",
     "lift",
+    "run_closed_loop",
 ]

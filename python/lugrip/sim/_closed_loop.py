@@ -17,6 +17,7 @@ import numpy as np
 from .. import _core
 from .._controller import _core_settings
 from .._observer import Observer
+from .._params import ContactParams
 from ._plant import PlantConfig
 
 __all__ = [
@@ -24,6 +25,7 @@ __all__ = [
     "MODE_ACTIONS",
     "ClosedLoopRun",
     "closed_loop_config",
+    "estimator_params",
     "run_closed_loop",
 ]
 
@@ -141,6 +143,30 @@ def _schedule(mode_schedule) -> list[tuple[float, Any]]:
     return out
 
 
+def estimator_params(
+    plant_contact: ContactParams, estimator: ContactParams | Mapping[str, Any] | str | None
+) -> ContactParams | None:
+    """The contact parameters the estimator side (observers, controller) uses.
+
+    ``None``: the plant's own (returns None). A :class:`ContactParams` is used as is; a preset
+    name (``"big_resin_block"``) loads that object; a mapping with ``preset`` loads it and
+    applies the other keys; any other mapping overrides fields of the plant's parameters, e.g.
+    ``{"sigma_z": 0.0033}`` (a fingertip whose pre-sliding damping differs from Table 1).
+    """
+    if estimator is None:
+        return None
+    if isinstance(estimator, ContactParams):
+        return estimator
+    if isinstance(estimator, str):
+        return ContactParams.preset(estimator)
+    if isinstance(estimator, Mapping):
+        d = dict(estimator)
+        if "preset" in d:
+            return ContactParams.preset(str(d.pop("preset"))).replace(**d)
+        return plant_contact.replace(**d)
+    raise ValueError("estimator: expected None, ContactParams, a preset name or a mapping")
+
+
 def closed_loop_config(
     config: PlantConfig | Mapping[str, Any],
     controller_settings: Mapping[str, Any] | None = None,
@@ -152,6 +178,7 @@ def closed_loop_config(
     constant_force: float = 1.0,
     cone_margin: float = 0.8,
     cone_release_rate: float = 0.0,
+    estimator: ContactParams | Mapping[str, Any] | str | None = None,
 ) -> _core.ClosedLoopConfig:
     """The validated C++ ClosedLoopConfig (see :func:`run_closed_loop` for the arguments)."""
     plant = config if isinstance(config, PlantConfig) else PlantConfig.from_dict(config)
@@ -165,7 +192,10 @@ def closed_loop_config(
         raise ValueError(f"kind {kind!r}: expected one of {', '.join(CONTROLLER_KINDS)}")
     c = _core.ClosedLoopConfig()
     c.plant = plant.to_core()
-    c.observer = Observer(plant.contact, **obs)._settings
+    est = estimator_params(plant.contact, estimator)
+    c.observer = Observer(est or plant.contact, **obs)._settings
+    if est is not None:
+        c.estimator = est.to_core()
     c.controller = _core_settings(ctrl)
     c.kind = CONTROLLER_KINDS[str(kind)]
     c.controller_start = float(controller_start)
@@ -192,6 +222,7 @@ def run_closed_loop(
     constant_force: float = 1.0,
     cone_margin: float = 0.8,
     cone_release_rate: float = 0.0,
+    estimator: ContactParams | Mapping[str, Any] | str | None = None,
 ) -> ClosedLoopRun:
     """Simulate the grasp in closed loop for `duration` seconds (one C++ call).
 
@@ -214,6 +245,8 @@ def run_closed_loop(
             when the measured utilisation |f_t| / (mu f_n) reaches the margin; blind to torsion.
         cone_release_rate: friction-cone baseline: decrease rate while below the margin [N/s]
             (0: the command only rises).
+        estimator: contact parameters of the observers and the controller (what the robot
+            believes about the contact), see :func:`estimator_params`; None: the plant's own.
 
     Returns:
         :class:`ClosedLoopRun` (dict of numpy arrays).
@@ -231,6 +264,7 @@ def run_closed_loop(
         constant_force=constant_force,
         cone_margin=cone_margin,
         cone_release_rate=cone_release_rate,
+        estimator=estimator,
     )
     duration = float(duration)
     if not (math.isfinite(duration) and duration >= 0.0):
