@@ -12,6 +12,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 import yaml
+from lugrip import sim
 from lugrip.cli import main
 from lugrip.sim import scenarios as sc
 from lugrip.sim.report import write_json, write_outputs
@@ -69,14 +70,14 @@ def test_scenario_file_is_complete_and_documented(name):
         and s.hold_time < s.steady_window[0] < s.steady_window[1] <= s.duration
     )
     cfg = s.plant_config()
-    # the object's Table 2 mu, beta_A with Table 1 for the rest, except sigma_z: the simulated
-    # pad's own pre-sliding damping t_d sigma0 (cell damping time 0.2 ms), not Table 1's 2
-    assert cfg.contact == sc.ContactParams.preset(cfg_preset(name)).replace(
-        sigma_z=cfg.contact.sigma_z
-    )
-    assert cfg.contact.sigma_z == pytest.approx(
-        cfg.patch.bristle_damping * cfg.contact.sigma0, rel=0.01
-    )
+    assert cfg.contact == sc.ContactParams.preset(cfg_preset(name))  # Table 2 mu, beta_A + Table 1
+    # with the patch plant the observer gets the simulated pad's own pre-sliding damping
+    # t_d sigma0 (cell damping time 0.2 ms), not Table 1's 2; the lumped plant is the observer's
+    # own model and keeps the plant's parameters
+    est = sim.estimator_params(cfg.contact, s.estimator_for("patch"))
+    assert est == cfg.contact.replace(sigma_z=est.sigma_z)
+    assert est.sigma_z == pytest.approx(cfg.patch.bristle_damping * cfg.contact.sigma0, rel=0.01)
+    assert s.estimator_for("lumped") is None
 
 
 def cfg_preset(name: str) -> str:
