@@ -2,6 +2,14 @@
 force/torque fingertips (limit surface + revisited LuGre friction, MODEL.md).
 
 The real-time core is C++17 (``lugrip._core``); this package is numpy in, numpy out.
+
+Parameters and the observer they belong to: ``lugrip identify`` (:func:`identify`,
+:meth:`IdentificationResult.save_yaml`) writes the identified :class:`ContactParams` together
+with the settings of the observer inside its cost as an ``observer:`` block of the YAML.
+:func:`read_observer_settings` returns that block as keywords of :class:`Observer` (None for
+files without it, e.g. ``objects/*.yaml``), and ``Observer("fit.yaml")`` starts from it
+(keywords given to Observer override it), so the observer run online is the one the
+parameters were identified for.
 """
 
 from ._core import __version__
@@ -27,7 +35,7 @@ from ._observer import (
     observability,
     sensor_wrench,
 )
-from ._params import PRESETS, ContactParams
+from ._params import PRESETS, ContactParams, read_observer_settings
 from ._controller import (
     ControllerMode,
     GraspController,
@@ -52,6 +60,7 @@ __all__ = [
     "__version__",
     "ContactParams",
     "PRESETS",
+    "read_observer_settings",
     "LimitSurface",
     "Status",
     "CorEstimate",

@@ -5,7 +5,9 @@ from __future__ import annotations
 import atexit
 import enum
 import functools
+import os
 from dataclasses import dataclass
+from pathlib import Path
 
 import numpy as np
 
@@ -127,14 +129,32 @@ def _model(params: ContactParams) -> _core.ContactModel:
 atexit.register(_model.cache_clear)
 
 
+def _params_path(params) -> Path | None:
+    """The YAML file `params` names (an os.PathLike, or a str ending in .yaml/.yml), else None
+    (ContactParams, preset names, dicts)."""
+    if isinstance(params, os.PathLike):
+        return Path(params)
+    if isinstance(params, str) and Path(params).suffix.lower() in (".yaml", ".yml"):
+        return Path(params)
+    return None
+
+
 def _as_params(params) -> ContactParams:
+    """ContactParams from ContactParams, a preset name, a dict (flat or the YAML layout) or a
+    parameter YAML file (a path, or a str ending in .yaml/.yml)."""
     if isinstance(params, ContactParams):
         return params
+    path = _params_path(params)
+    if path is not None:
+        return ContactParams.from_yaml(path)
     if isinstance(params, str):
         return ContactParams.preset(params)
     if isinstance(params, dict):
         return ContactParams.from_dict(params)
-    raise TypeError(f"expected ContactParams, a preset name or a dict, got {type(params).__name__}")
+    raise TypeError(
+        "expected ContactParams, a preset name, a dict or a .yaml file, "
+        f"got {type(params).__name__}"
+    )
 
 
 def contact_radius(params, f_n):

@@ -18,7 +18,8 @@ from collections.abc import Mapping
 import numpy as np
 
 from . import _core
-from ._contact import Status, _as_params, _flat, _model, _shaped
+from ._contact import Status, _as_params, _flat, _model, _params_path, _shaped
+from ._params import read_observer_settings
 
 __all__ = [
     "GAIN_MODES",
@@ -214,12 +215,19 @@ class Observer:
     ``speed_observable`` in the outputs.
 
     Args:
-        params: ContactParams, a preset name or a dict.
-        dt: nominal sample period [s] (used when a step gives no dt).
+        params: ContactParams, a preset name, a dict, or a parameter YAML file (a path, or a
+            str ending in .yaml/.yml). When the file has an ``observer:`` block (written by
+            ``lugrip identify`` / :meth:`lugrip.IdentificationResult.save_yaml`: the observer
+            the parameters were identified with, see :func:`lugrip.read_observer_settings`),
+            those settings are the starting point and the keywords below override them one by
+            one; files without the block (``objects/*.yaml``) start from the defaults.
+        dt: nominal sample period [s] (used when a step gives no dt; default 0.002).
         integrator: "rosenbrock" (default: L-stable, 2nd order), "implicit" (exponential-
             implicit Euler), "rk4" (the paper's one step per sample), "rk4_adaptive".
         gain_mode: "fixed" (l = gain) or "bandwidth" (l = bandwidth / sigma_1 clipped to
-            [gain_min, gain_max]). Default: "fixed" when only `gain` is given, else "bandwidth".
+            [gain_min, gain_max]). Default: "fixed" when only `gain` is given, else "bandwidth"
+            (with a file's observer block: that rule applied to the keywords given here, and the
+            block's gain_mode when neither `gain` nor `bandwidth` is given).
         gain: fixed observer gain l [1/(kg m^2)] (default 200).
         bandwidth: B = l sigma_1 [1/s] (default 3000; the rate at which omega_hat converges
             in sliding: higher tracks slip ramps with less lag, lower filters torque noise).
@@ -227,27 +235,41 @@ class Observer:
         torque_cutoff [Hz], filter_force, cor_sign_sigmas, max_invalid, max_dt_gap [s],
         torque_noise [N m], resolution_max [rad/s], omega_limit [rad/s], substeps,
         max_substeps) and of CorSettings (f_n_min [N], force_limit [N], torque_limit [N m],
-        zero_force, zero_torque). None keeps the C++ default.
+        zero_force, zero_torque). None means "not given": the file's observer block, else
+        the C++ default.
 
     Raises:
-        ValueError: naming every invalid setting.
+        ValueError: naming every invalid setting (for a file's observer block: the file, the
+            block and the setting).
     """
 
     def __init__(
         self,
         params,
         *,
-        dt: float = 0.002,
-        integrator: str = "rosenbrock",
+        dt: float | None = None,
+        integrator: str | None = None,
         gain_mode: str | None = None,
         gain: float | None = None,
         bandwidth: float | None = None,
         **settings,
     ):
+        given = {"dt": dt, "integrator": integrator, "gain_mode": gain_mode, "gain": gain}
+        given.update(bandwidth=bandwidth, **settings)
+        given = {k: v for k, v in given.items() if v is not None}
+        path = _params_path(params)
         self.params = _as_params(params)
+        block = read_observer_settings(path) if path is not None else None
+        if block:
+            if "gain_mode" not in given and ("gain" in given or "bandwidth" in given):
+                # the keywords' own rule: a gain alone means a fixed gain
+                given["gain_mode"] = "bandwidth" if "bandwidth" in given else "fixed"
+            given = {k: v for k, v in {**block, **given}.items() if v is not None}
         s = _core.ObserverSettings()
-        s.dt = float(dt)
-        s.integrator = _enum(INTEGRATORS, "integrator", integrator)
+        s.dt = float(given.pop("dt", 0.002))
+        s.integrator = _enum(INTEGRATORS, "integrator", given.pop("integrator", "rosenbrock"))
+        gain, bandwidth = given.pop("gain", None), given.pop("bandwidth", None)
+        gain_mode = given.pop("gain_mode", None)
         if gain_mode is None:
             gain_mode = "fixed" if gain is not None and bandwidth is None else "bandwidth"
         s.gain_mode = _enum(GAIN_MODES, "gain_mode", gain_mode)
@@ -256,9 +278,7 @@ class Observer:
         if bandwidth is not None:
             s.bandwidth = float(bandwidth)
         cor = s.cor
-        for name, value in settings.items():
-            if value is None:
-                continue
+        for name, value in given.items():
             if name in _COR_FIELDS:
                 setattr(cor, name, float(value))
             elif name in _OBS_FIELDS:

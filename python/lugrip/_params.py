@@ -195,6 +195,9 @@ def read_observer_settings(path: str | Path) -> dict[str, Any] | None:
     parameters were identified with, as keywords of :class:`lugrip.Observer`, so that the
     observer used online is the one inside the identification cost (MODEL.md 8.1). None when
     the file has no such block (e.g. ``objects/*.yaml``, ``lugrip params`` output).
+    ``lugrip.Observer(path)`` starts from this block (its keywords override it), as do
+    ``lugrip observe --params``, ``lugrip identify --params0`` and ``lugrip.identify`` with a
+    YAML ``params0``.
 
     Raises:
         ValueError: the block is not a mapping or holds an unknown or invalid setting.

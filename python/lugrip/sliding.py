@@ -797,10 +797,13 @@ def evaluate(
     it (:func:`score`).
 
     Args:
-        params: the observer's parameters (default: the SyntheticSliding's true ones).
+        params: the observer's parameters (default: the SyntheticSliding's true ones):
+            ContactParams, a preset name, a dict or a parameter YAML file; a file's
+            ``observer:`` block (written by ``lugrip identify``) is the base of the settings.
         observer: a ready :class:`lugrip.Observer` (then ``params`` and settings are unused).
         observer_settings: keywords of :class:`lugrip.Observer` (integrator, gain, bandwidth,
-            ...); none: the defaults.
+            ...), overriding the file's observer block; none: the block, else the defaults.
+            The nominal dt is always the log's sample period.
 
     Returns:
         (run, score).

@@ -7,6 +7,8 @@ from __future__ import annotations
 
 import dataclasses
 import math
+import warnings
+from pathlib import Path
 
 import lugrip
 import numpy as np
@@ -511,6 +513,154 @@ def test_settings_validation_and_modes():
         Observer(TABLE1, bogus=1.0)
     with pytest.raises(ValueError, match="sigma0"):
         Observer({**TABLE1.to_dict(), "sigma0": -1.0})
+
+
+# ---------------------------------------------------------------------------------------------
+# settings from a parameter YAML's observer block (written by lugrip identify)
+# ---------------------------------------------------------------------------------------------
+
+OBJECTS = Path(__file__).resolve().parents[2] / "objects"
+
+
+def _yaml_with_block(path, block_text: str) -> Path:
+    """TABLE1's YAML (ContactParams.to_yaml) with a hand-written observer block."""
+    path.write_text(TABLE1.to_yaml() + block_text)
+    return path
+
+
+def test_observer_from_identified_yaml_runs_the_identification_observer(tmp_path):
+    """The YAML written by lugrip.identify's save_yaml gives Observer(path) the parameters AND
+    the observer inside the cost (a non-default one here, so that it is distinguishable from
+    the defaults): same settings, same omega_hat; keywords override single settings."""
+    from lugrip.sliding import simulate_sliding
+
+    log = simulate_sliding(TABLE1, 4, seed=11, c_range=(0.02, 1.4), omega_range=(0.002, 0.5))
+    inside = {"integrator": "implicit", "bandwidth": 700.0, "torque_cutoff": 5.0}
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")  # a 2-iteration fit warns that it did not converge
+        fit = lugrip.identify(log, observer=inside, validation=0, max_iterations=2)
+    path = fit.save_yaml(tmp_path / "fit.yaml")
+    assert lugrip.read_observer_settings(path) == fit.observer
+
+    for source in (path, str(path)):  # os.PathLike or a str ending in .yaml
+        obs = Observer(source)
+        assert obs.params == fit.params
+        assert obs.settings == fit.observer
+    s = Observer(path).settings
+    assert (s["integrator"], s["gain_mode"], s["bandwidth"], s["torque_cutoff"]) == (
+        "implicit",
+        "bandwidth",
+        700.0,
+        5.0,
+    )
+    assert s["dt"] == pytest.approx(float(np.median(np.diff(log.t))))  # the data's period
+    w = Observer(path).run(log).omega_hat
+    np.testing.assert_array_equal(w, fit.make_observer().run(log).omega_hat)
+    # the block matters: the default observer (3000/s, Rosenbrock) gives other estimates
+    assert np.max(np.abs(w - Observer(fit.params).run(log).omega_hat)) > 1e-4
+
+    # a keyword overrides its setting only; the rest of the block stays
+    over = Observer(path, bandwidth=3000.0)
+    assert over.settings == {**fit.observer, "bandwidth": 3000.0}
+    np.testing.assert_array_equal(
+        over.run(log).omega_hat,
+        Observer(fit.params, **{**fit.observer, "bandwidth": 3000.0}).run(log).omega_hat,
+    )
+    # a gain alone means a fixed gain, as for Observer(params, gain=...)
+    fixed = Observer(path, gain=350.0).settings
+    assert (fixed["gain_mode"], fixed["gain"], fixed["integrator"]) == ("fixed", 350.0, "implicit")
+    # None = not given: the block's value
+    assert Observer(path, torque_cutoff=None, integrator=None).settings == fit.observer
+
+
+def test_observer_from_hand_written_yaml_block(tmp_path):
+    path = _yaml_with_block(
+        tmp_path / "hand.yaml",
+        "observer:\n  integrator: rk4\n  gain: 500\n  torque_cutoff: 5.0\n  f_n_min: 0.2\n",
+    )
+    default = Observer(TABLE1).settings
+    s = Observer(path).settings
+    # a gain alone in the block: fixed gain (the keyword rule); unnamed settings: defaults
+    assert s == {
+        **default,
+        "integrator": "rk4",
+        "gain_mode": "fixed",
+        "gain": 500.0,
+        "torque_cutoff": 5.0,
+        "f_n_min": 0.2,
+    }
+    # bandwidth given: bandwidth mode at that rate, the block's other settings kept
+    s = Observer(path, bandwidth=800.0, dt=0.001).settings
+    assert (s["gain_mode"], s["bandwidth"], s["dt"], s["integrator"], s["f_n_min"]) == (
+        "bandwidth",
+        800.0,
+        0.001,
+        "rk4",
+        0.2,
+    )
+    assert Observer(path, gain_mode="bandwidth").settings["bandwidth"] == default["bandwidth"]
+    # the rk4 fixed-gain observer of the block is the one that runs
+    data = concat(maneuvers(TABLE1, 3, seed=7))
+    np.testing.assert_array_equal(
+        Observer(path).run(data).omega_hat,
+        Observer(TABLE1, integrator="rk4", gain=500.0, torque_cutoff=5.0, f_n_min=0.2)
+        .run(data)
+        .omega_hat,
+    )
+    # written with ContactParams.to_yaml(observer=...): the same
+    p2 = tmp_path / "written.yml"
+    TABLE1.to_yaml(p2, observer={"integrator": "rk4", "gain": 500, "torque_cutoff": 5.0})
+    assert Observer(str(p2)).settings == {**Observer(path).settings, "f_n_min": default["f_n_min"]}
+
+
+def test_observer_from_yaml_without_block_keeps_the_defaults():
+    path = OBJECTS / "table1_cardboard.yaml"
+    assert lugrip.read_observer_settings(path) is None
+    obs = Observer(path)
+    assert obs.params == ContactParams.from_yaml(path)
+    assert obs.settings == Observer(TABLE1).settings
+    assert obs.settings["bandwidth"] == 3000.0
+    assert Observer(str(path), gain=300.0).settings["gain_mode"] == "fixed"
+
+
+@pytest.mark.parametrize(
+    "block, field",
+    [
+        ("  bandwidth: -5.0\n", "bandwidth"),
+        ("  bandwith: 700\n", "bandwith"),  # unknown setting
+        ("  max_substeps: 2.5\n", "max_substeps"),
+        ("  integrator: euler\n", "integrator"),
+        ("  f_n_min: -1.0\n", "f_n_min"),
+    ],
+)
+def test_observer_from_yaml_with_bad_block_names_the_field(tmp_path, block, field):
+    path = _yaml_with_block(tmp_path / "bad.yaml", "observer:\n" + block)
+    with pytest.raises(ValueError, match=field) as err:
+        Observer(path)
+    assert str(path) in str(err.value) and "observer" in str(err.value)
+    with pytest.raises(ValueError, match=field):  # a keyword does not hide a bad block
+        Observer(path, bandwidth=3000.0)
+
+
+def test_observer_from_yaml_whose_block_is_not_a_mapping(tmp_path):
+    path = _yaml_with_block(tmp_path / "bad.yaml", "observer: 3000\n")
+    with pytest.raises(ValueError, match="observer: expected a mapping"):
+        Observer(path)
+
+
+def test_evaluate_with_a_yaml_uses_its_block_and_the_logs_period(tmp_path):
+    from lugrip.sliding import evaluate, simulate_maneuvers
+
+    data = simulate_maneuvers(TABLE1, 4, seed=3)
+    path = _yaml_with_block(
+        tmp_path / "fit.yaml", "observer:\n  bandwidth: 400.0\n  dt: 0.01\n  integrator: rk4\n"
+    )
+    run, _ = evaluate(data, path)
+    ref = Observer(TABLE1, bandwidth=400.0, integrator="rk4", dt=data.log.sample_period)
+    np.testing.assert_array_equal(run.omega_hat, ref.run(data.log).omega_hat)
+    run_kw, _ = evaluate(data, path, bandwidth=3000.0)
+    ref = Observer(TABLE1, integrator="rk4", dt=data.log.sample_period)
+    np.testing.assert_array_equal(run_kw.omega_hat, ref.run(data.log).omega_hat)
 
 
 def test_step_statuses_and_reset():

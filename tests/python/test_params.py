@@ -181,3 +181,37 @@ def test_from_dict_layouts():
     flat = lugrip.ContactParams.from_dict(TABLE1)
     nested = lugrip.ContactParams.from_dict({"contact": {k: {"value": v, "unit": "x"} for k, v in TABLE1.items()}})
     assert flat == nested == lugrip.ContactParams.table1()
+
+
+def test_yaml_files_wherever_params_are_taken(tmp_path):
+    """Functions taking parameters accept a YAML file (a path, or a str ending in .yaml/.yml)
+    as well as ContactParams, preset names and dicts; other strings are preset names."""
+    import numpy as np
+
+    can = lugrip.ContactParams.preset("aluminium_can")
+    path = tmp_path / "can.yml"
+    can.to_yaml(path)
+    want = lugrip.g(can, 3.0, 0.4)
+    for source in (path, str(path)):
+        assert lugrip.g(source, 3.0, 0.4) == want
+        np.testing.assert_array_equal(
+            lugrip.sigma_1(source, [1.0, 5.0], 0.2), lugrip.sigma_1(can, [1.0, 5.0], 0.2)
+        )
+    assert lugrip.g(path, 3.0, 0.4) != lugrip.g("table1", 3.0, 0.4)
+    with pytest.raises(ValueError, match="unknown preset 'can'"):
+        lugrip.g("can", 3.0, 0.4)
+    with pytest.raises(FileNotFoundError):
+        lugrip.g(str(tmp_path / "missing.yaml"), 3.0, 0.4)
+    with pytest.raises(TypeError, match=".yaml file"):
+        lugrip.g(3.5, 3.0, 0.4)
+
+
+def test_read_observer_settings_is_exported(tmp_path):
+    assert "read_observer_settings" in lugrip.__all__
+    assert "read_observer_settings" in lugrip.__doc__
+    path = tmp_path / "p.yaml"
+    lugrip.ContactParams.table1().to_yaml(path, observer={"bandwidth": 700.0, "integrator": "rk4"})
+    assert lugrip.read_observer_settings(path) == {"bandwidth": 700.0, "integrator": "rk4"}
+    assert yaml.safe_load(path.read_text())["observer"]["bandwidth"] == 700.0
+    lugrip.ContactParams.table1().to_yaml(path)
+    assert lugrip.read_observer_settings(path) is None
