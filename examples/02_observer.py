@@ -36,7 +36,10 @@ def main(out_dir: str | None = None) -> float:
         path = lugrip.write_log(data.log, Path(tmp) / "sliding.csv")
         log = lugrip.read_log(path)  # t, f_n, f_x, f_y, tau, omega, maneuver
 
-    observer = lugrip.Observer(params)  # default settings: Rosenbrock, l = 100 / sigma_1
+    # Default settings: Rosenbrock update, bandwidth mode l = 3000 / sigma_1 (omega_hat
+    # converges at 3000/s while sliding). With identified parameters pass the YAML written by
+    # `lugrip identify` instead: lugrip.Observer("fit.yaml") uses its observer block.
+    observer = lugrip.Observer(params)
     run = observer.run(log)  # restarts at every maneuver change
     sc = score(log, run, maneuvers=data.maneuvers, truth_slip=data.slip)
     for line in sc.lines():

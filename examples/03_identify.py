@@ -6,7 +6,11 @@ mu and beta_A (paper Sections 4 and 6).
 2. Identify all six parameters with lugrip.identify: the start point is computed from the data,
    the cost is the online observer's velocity error (eq. 32) in C++ with its exact gradient;
    the fit reports the validation RMSE, standard errors and what the data cannot separate.
-3. Per-object step: a few fast maneuvers on a Table 2 object, refit of mu and beta_A only.
+   The parameters are identified FOR that observer (default settings: bandwidth 3000/s), so
+   the YAML carries its settings as an observer: block, and the online observer built from the
+   YAML (lugrip.Observer("fingertip.yaml"), lugrip observe --params) is the same one.
+3. Per-object step: a few fast maneuvers on a Table 2 object, refit of mu and beta_A only,
+   starting from the fingertip's YAML (its parameters and its observer block).
 4. The rubbing alternative: rub the fingertip at known angular speeds and regress the torque.
 
     python examples/03_identify.py [OUT_DIR]
@@ -15,6 +19,7 @@ The same with the command line:
     lugrip simulate-sliding --out fingertip.csv --maneuvers 60
     lugrip identify fingertip.csv --out fingertip.yaml --report OUT_DIR
     lugrip identify object.csv --free mu,beta_a --params0 fingertip.yaml --out object.yaml
+    lugrip observe object.csv --params object.yaml --out est.csv
 """
 
 from __future__ import annotations
@@ -30,27 +35,39 @@ from lugrip.identify import IdentificationWarning
 from lugrip.sim import PatchContact
 from lugrip.sliding import simulate_sliding
 
-# The observer used online; identification must use the same. A fast one (bandwidth 3000/s)
-# gives back the physical parameters; with the default (100/s) sigma0 and sigma_z also absorb
-# the observer's lag (BENCHMARKS.md, issue 4).
-ONLINE = {"bandwidth": 3000.0}
-
 
 def main(out_dir: str | None = None) -> lugrip.ContactParams:
+    with tempfile.TemporaryDirectory() as tmp:
+        return _main(Path(tmp), out_dir)
+
+
+def _main(tmp: Path, out_dir: str | None) -> lugrip.ContactParams:
     truth = lugrip.ContactParams.table1()
     log = simulate_sliding(truth, 60, seed=3, c_range=(0.02, 1.4), omega_range=(0.002, 0.5))
-    with tempfile.TemporaryDirectory() as tmp:
-        log = lugrip.read_log(lugrip.write_log(log, Path(tmp) / "fingertip.csv"))
+    log = lugrip.read_log(lugrip.write_log(log, tmp / "fingertip.csv"))
     print(f"fingertip logs: {len(np.unique(log.maneuver))} maneuvers, {len(log)} samples")
 
+    # The observer inside the cost has the default settings (bandwidth 3000/s: fast enough that
+    # the physical parameters come back; a slow observer's lag would be absorbed by sigma0 and
+    # sigma_z, BENCHMARKS.md issue 4). Pass observer={...} to identify for another one.
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", IdentificationWarning)
-        fit = lugrip.identify(log, observer=ONLINE)  # start from the data, all six free
+        fit = lugrip.identify(log)  # start from the data, all six free
     print(fit.summary())
     for name in ("mu", "beta_a", "sigma0", "sigma_z", "delta", "gamma"):
         print(
             f"  {name:8s} identified / true = {getattr(fit.params, name) / getattr(truth, name):.4f}"
         )
+
+    # The YAML keeps the parameters with the observer they were identified for.
+    fingertip_yaml = fit.save_yaml(tmp / "fingertip.yaml")
+    block = lugrip.read_observer_settings(fingertip_yaml)
+    print(
+        f"{fingertip_yaml.name}: observer block {block['integrator']}, {block['gain_mode']} "
+        f"{block['bandwidth']:g}/s"
+    )
+    online = lugrip.Observer(fingertip_yaml)  # the identified parameters and their observer
+    print(f"online observer from the YAML: RMSE {online.run(log).rmse(log.omega):.4g} rad/s")
     if out_dir is not None:
         from lugrip.commands.identify import write_report
 
@@ -60,17 +77,17 @@ def main(out_dir: str | None = None) -> lugrip.ContactParams:
     # Per-object step: the fingertip's parameters stay, mu and beta_A are refitted from ten
     # maneuvers that slide fast enough (0.5-5 rad/s) for the weak viscous friction to show.
     obj = lugrip.ContactParams.preset("aluminium_can")
+    # params0 = the fingertip's YAML: its parameters and, from its observer block, its observer.
     obj_log = simulate_sliding(
         obj, 10, seed=4, c_range=(0.02, 1.4), omega_range=(0.5, 5.0), stick_fraction=0.0
     )
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", IdentificationWarning)
-        refit = lugrip.identify(
-            obj_log, fit.params, free="mu,beta_a", observer={"bandwidth": 1000.0}, validation=0.0
-        )
+        refit = lugrip.identify(obj_log, fingertip_yaml, free="mu,beta_a", validation=0.0)
     print(
         f"object refit: mu {refit.params.mu:.4f} (true {obj.mu}), beta_A "
-        f"{refit.params.beta_a:.4g} (true {obj.beta_a:.4g}) in {refit.fit_time:.2f} s"
+        f"{refit.params.beta_a:.4g} (true {obj.beta_a:.4g}) in {refit.fit_time:.2f} s, observer "
+        f"bandwidth {refit.observer['bandwidth']:g}/s (the fingertip YAML's)"
     )
 
     # Rubbing: rotate the fingertip on the object at known speeds (here on the distributed
