@@ -258,34 +258,33 @@ Status CorEstimator::step(const CorInput& in, CorOutput& out) noexcept {
   const double f = std::fabs(ft_t), t = std::fabs(tau_t);
   const double prev = last_.c_tilde;
 
-  CorOutput r;
-  r.ft_tilde = ft_t;
-  r.tau_tilde = tau_t;
-  r.rho = rho;
+  // The result is assembled in locals and written field by field to last_ and out (no
+  // zero-initialised temporary, no struct copy through the stack).
   const double f_pow = f * std::pow(f, p.gamma);  // |f~_t|^(gamma+1)
   // |sigma| overflows for a denormal torque: report it as the largest finite value, like t = 0.
-  r.sigma = t > 0.0 ? std::copysign(std::fmin(f_pow / t, std::numeric_limits<double>::max()), in.tau)
-                    : (f > 0.0 ? std::numeric_limits<double>::max() : 0.0);
+  const double sigma = t > 0.0 ? std::copysign(std::fmin(f_pow / t, std::numeric_limits<double>::max()), in.tau)
+                               : (f > 0.0 ? std::numeric_limits<double>::max() : 0.0);
   double a = 0.0, sign = 1.0;
   LsPoint point;              // LS point at the final a when a branch already evaluated it
   double point_a = -1.0;
   Status status = Status::Ok;
   int iters = 0;
+  bool inside;
   if (f < s_.zero_force && t < s_.zero_torque) {  // no wrench: the CoR is undefined
     a = std::fabs(prev);
     sign = prev < 0.0 ? -1.0 : 1.0;
-    r.inside = true;
+    inside = true;
     status = Status::Degenerate;
   } else if (f < s_.zero_force) {  // pure torque: rotation about the patch centre
     a = 0.0;
-    r.inside = t < 1.0;
+    inside = t < 1.0;
   } else {
     const bool no_torque = t < s_.zero_torque;
     const double a_sigma = t > 0.0 ? model_.invert_sigma(f_pow / t, &iters)
                                    : std::numeric_limits<double>::infinity();
     const LsPoint q = ls.eval(a_sigma);
-    r.inside = f * f + t * t < q.F * q.F + q.T * q.T;
-    if (r.inside) {
+    inside = f * f + t * t < q.F * q.F + q.T * q.T;
+    if (inside) {
       a = a_sigma;
       point = q;
     } else {
@@ -299,30 +298,44 @@ Status CorEstimator::step(const CorInput& in, CorOutput& out) noexcept {
     else
       sign = -(in.f_t < 0.0 ? -1.0 : 1.0) * (in.tau < 0.0 ? -1.0 : 1.0);
   }
+  bool saturated = false;
   if (a >= p.c_max) {
-    r.saturated = a > p.c_max || status != Status::Degenerate;
+    saturated = a > p.c_max || status != Status::Degenerate;
     a = p.c_max;
     if (status == Status::Ok) status = Status::Saturated;
   }
-  r.c_tilde = sign * a;
-  r.c = r.c_tilde * rho;
+  const double c_tilde = sign * a;
+  const double c = c_tilde * rho;
   const LsPoint q = (a == point_a) ? point : ls.eval(a);
   const double r2 = rho * rho;
-  r.g = p.mu * f_n * rho * (ls.xi() * q.T + a * q.F);
-  r.sigma_1 = kPi * p.beta_a * r2 * r2 * (r.c_tilde * r.c_tilde + 0.5);
-  r.y = in.tau - r.c * in.f_t;
+  const double g = p.mu * f_n * rho * (ls.xi() * q.T + a * q.F);
+  const double sigma_1 = kPi * p.beta_a * r2 * r2 * (c_tilde * c_tilde + 0.5);
+  const double y = in.tau - c * in.f_t;
   // Overflow guard for settings/parameters at the edge of their valid ranges (e.g. force_limit
   // near DBL_MAX makes c f_t overflow, beta_a near 1e300 makes sigma_1 overflow): outputs stay
   // finite, the sample is reported as unusable and the previous estimate is held.
-  if (!(std::isfinite(r.c) && std::isfinite(r.g) && std::isfinite(r.sigma_1) && std::isfinite(r.y))) {
+  if (!(std::isfinite(c) && std::isfinite(g) && std::isfinite(sigma_1) && std::isfinite(y))) {
     out = last_;
     out.iterations = iters;
     return out.status = Status::InvalidSample;
   }
-  r.iterations = iters;
-  r.status = status;
-  last_ = r;
-  out = r;
+  auto fill = [&](CorOutput& o) {
+    o.c_tilde = c_tilde;
+    o.c = c;
+    o.ft_tilde = ft_t;
+    o.tau_tilde = tau_t;
+    o.sigma = sigma;
+    o.rho = rho;
+    o.g = g;
+    o.sigma_1 = sigma_1;
+    o.y = y;
+    o.inside = inside;
+    o.saturated = saturated;
+    o.iterations = iters;
+    o.status = status;
+  };
+  fill(last_);
+  fill(out);
   return status;
 }
 

@@ -141,7 +141,30 @@ GraspPlant::GraspPlant(const PlantConfig& config)
   h_ = 1.0 / cfg_.rate;
   steps_per_sample_ = static_cast<int>(integer_ratio(cfg_.rate, cfg_.sensor.rate));
   steps_per_command_ = static_cast<int>(integer_ratio(cfg_.rate, cfg_.actuator.command_rate));
+  act_decay_ = cfg_.actuator.time_constant > 0.0 ? std::exp(-h_ / cfg_.actuator.time_constant) : 0.0;
+  const double tf = cfg_.sensor.filter_time_constant;
+  filt_alpha_ = tf > 0.0 ? -std::expm1(-h_ / tf) : 1.0;
   reset();
+}
+
+void GraspPlant::trig(double th, double& c, double& s) noexcept {
+  if (!(trig_ok_ && th == trig_th_)) {  // NaN never hits (NaN != NaN)
+    trig_c_ = std::cos(th);
+    trig_s_ = std::sin(th);
+    trig_th_ = th;
+    trig_ok_ = true;
+  }
+  c = trig_c_;
+  s = trig_s_;
+}
+
+double GraspPlant::rho_at(double f_n) noexcept {
+  if (!(rho_ok_ && f_n == rho_fn_)) {
+    rho_ = model_.rho(f_n);
+    rho_fn_ = f_n;
+    rho_ok_ = true;
+  }
+  return rho_;
 }
 
 void GraspPlant::gripper_at(double t, double& x, double& y, double& vx, double& vy) const noexcept {
@@ -166,12 +189,21 @@ void GraspPlant::gripper_at(double t, double& x, double& y, double& vx, double& 
   }
 }
 
-void GraspPlant::disturbance_at(double t, double theta, double& fx, double& fy, double& tau) const noexcept {
+namespace {
+// Sum of the active pulses at t; cs(c, s) gives cos and sin of the object angle (only called
+// when a pulse is active).
+template <class Trig>
+void sum_pulses(const std::vector<Disturbance>& ds, double t, Trig&& cs, double& fx, double& fy, double& tau) noexcept {
   fx = fy = tau = 0.0;
-  const double c = std::cos(theta), s = std::sin(theta);
-  for (const Disturbance& d : cfg_.disturbances) {
+  double c = 1.0, s = 0.0;
+  bool have_cs = false;
+  for (const Disturbance& d : ds) {
     const double u = (t - d.t_start) / d.duration;
     if (!(u >= 0.0 && u < 1.0)) continue;
+    if (!have_cs) {
+      cs(c, s);
+      have_cs = true;
+    }
     double a = 0.0;
     switch (d.shape) {
       case PulseShape::Rectangular: a = 1.0; break;
@@ -185,6 +217,16 @@ void GraspPlant::disturbance_at(double t, double theta, double& fx, double& fy, 
     fy += qy;
     tau += a * d.torque + px * qy - py * qx;
   }
+}
+}  // namespace
+
+void GraspPlant::disturbance_at(double t, double theta, double& fx, double& fy, double& tau) const noexcept {
+  sum_pulses(cfg_.disturbances, t, [theta](double& c, double& s) { c = std::cos(theta); s = std::sin(theta); },
+             fx, fy, tau);
+}
+
+void GraspPlant::disturbance_cs(double t, double c, double s, double& fx, double& fy, double& tau) const noexcept {
+  sum_pulses(cfg_.disturbances, t, [c, s](double& cc, double& ss) { cc = c; ss = s; }, fx, fy, tau);
 }
 
 void GraspPlant::reset() noexcept {
@@ -204,6 +246,9 @@ void GraspPlant::reset() noexcept {
   lumped_z_ = lumped_c_ = lumped_slip_ = 0.0;
   patch_.reset();
   cor_.reset();
+  trig_ok_ = rho_ok_ = false;
+  cmd_phase_ = sample_phase_ = 0;
+  sample_index_ = 0;
   for (int i = 0; i < 2; ++i) rng_[i].seed_with(cfg_.seed * 0x9E3779B97F4A7C15ULL + static_cast<uint64_t>(i + 1));
   st_ = PlantState();
   report_state();
@@ -254,10 +299,11 @@ bool GraspPlant::step() noexcept {
   const int64_t n = st_.steps;
   const double t0 = static_cast<double>(n) * h_;
   // Actuator: ZOH of the command at the command ticks, saturation, first-order lag, rate limit.
-  if (n % steps_per_command_ == 0) f_held_ = f_cmd_;
+  if (cmd_phase_ == 0) f_held_ = f_cmd_;  // n % steps_per_command_ == 0
+  if (++cmd_phase_ == steps_per_command_) cmd_phase_ = 0;
   const ActuatorConfig& a = cfg_.actuator;
   const double target = clampd(f_held_, 0.0, a.f_max);
-  double f = a.time_constant > 0.0 ? target + (f_act_ - target) * std::exp(-h_ / a.time_constant) : target;
+  double f = a.time_constant > 0.0 ? target + (f_act_ - target) * act_decay_ : target;
   const double dmax = a.rate_limit * h_;
   f = clampd(f, f_act_ - dmax, f_act_ + dmax);
   f_act_ = clampd(f, 0.0, a.f_max);
@@ -273,8 +319,7 @@ bool GraspPlant::step() noexcept {
   st_.steps = n + 1;
   st_.t = static_cast<double>(n + 1) * h_;
   // Sensor anti-alias low-pass (continuous-time first order, exact for a held input).
-  const double tf = cfg_.sensor.filter_time_constant;
-  const double alpha = tf > 0.0 ? -std::expm1(-h_ / tf) : 1.0;
+  const double alpha = filt_alpha_;
   for (int i = 0; i < 2; ++i) {
     double w[4];
     true_wrench(i, w);
@@ -282,7 +327,8 @@ bool GraspPlant::step() noexcept {
   }
   report_state();
   update_drop();
-  if ((n + 1) % steps_per_sample_ == 0) {
+  if (++sample_phase_ == steps_per_sample_) {  // (n + 1) % steps_per_sample_ == 0
+    sample_phase_ = 0;
     take_sample();
     return true;
   }
@@ -335,7 +381,9 @@ void GraspPlant::substep_patch(double h, double t0) noexcept {
   gripper_at(t1, gx1, gy1, gvx1, gvy1);
   const double agx = (gvx1 - gvx0) / h, agy = (gvy1 - gvy0) / h;  // exact velocity increment
   double efx, efy, etau;
-  disturbance_at(t1, th_, efx, efy, etau);
+  double c0, s0;
+  trig(th_, c0, s0);
+  disturbance_cs(t1, c0, s0, efx, efy, etau);
   efx += ext_fx_;
   efy += ext_fy_;
   etau += ext_tau_;
@@ -397,7 +445,8 @@ void GraspPlant::substep_patch(double h, double t0) noexcept {
   om_ = nom;
   twist_map(ux_, uy_, nVx, nVy, nom, h);
   th_ += h * nom;
-  const double cth = std::cos(th_), sth = std::sin(th_);
+  double cth, sth;
+  trig(th_, cth, sth);
   rx_ = ux_ + cth * o.cog_x - sth * o.cog_y;
   ry_ = uy_ + sth * o.cog_x + cth * o.cog_y;
   // Landing on the support (inelastic).
@@ -420,8 +469,11 @@ void GraspPlant::substep_lumped(double h, double t0) noexcept {
   gripper_at(t0, gx0, gy0, gvx0, gvy0);
   gripper_at(t1, gx1, gy1, gvx1, gvy1);
   const double agx = (gvx1 - gvx0) / h, agy = (gvy1 - gvy0) / h;
+  // No translation: the object point at the grasp point stays there, r = R(theta) cog.
+  double c, s;
+  trig(th_, c, s);
   double efx, efy, etau;
-  disturbance_at(t1, th_, efx, efy, etau);
+  disturbance_cs(t1, c, s, efx, efy, etau);
   efx += ext_fx_;
   efy += ext_fy_;
   etau += ext_tau_;
@@ -429,8 +481,6 @@ void GraspPlant::substep_lumped(double h, double t0) noexcept {
   st_.ext_fy = efy;
   st_.ext_tau = etau;
 
-  // No translation: the object point at the grasp point stays there, r = R(theta) cog.
-  const double c = std::cos(th_), s = std::sin(th_);
   const double rx = c * o.cog_x - s * o.cog_y, ry = s * o.cog_x + c * o.cog_y;
   const double I_O = o.inertia + m * (rx * rx + ry * ry);
   // Load on the object other than friction (gravity, gripper acceleration, pushes).
@@ -462,16 +512,25 @@ void GraspPlant::substep_lumped(double h, double t0) noexcept {
   double c_cor = 0.0;
   if (f_n > 1e-9) {
     // CoR of the quasi-static friction wrench (f_t, -tau_L/2) in the slider frame (y along f_t).
-    CorOutput co;
-    cor_.step(CorInput{f_n, f_t, -0.5 * tauL}, co);
+    CorOutput& co = cor_out_;
+    const Status cs = cor_.step(CorInput{f_n, f_t, -0.5 * tauL}, co);
     const double ct = co.c_tilde;
-    const double rho = model_.rho(f_n);
+    // A fresh estimate carries rho, sigma_1 and g at this f_n and c~, computed by the same
+    // expressions as ContactModel::rho / sigma_1 / g (bit-identical); a held one (f_n below the
+    // estimator's contact threshold) does not.
+    const bool fresh = cs == Status::Ok || cs == Status::Saturated || cs == Status::Degenerate;
+    if (fresh) {
+      rho_fn_ = f_n;
+      rho_ = co.rho;
+      rho_ok_ = true;
+    }
+    const double rho = rho_at(f_n);
     c_cor = ct * rho;
     RotorCoefficients rc;
     rc.sigma0 = cfg_.contact.sigma0;
     rc.sigma_z = cfg_.contact.sigma_z;
-    rc.sigma_1 = model_.sigma_1(f_n, ct);
-    rc.g = std::max(model_.g(f_n, ct), 1e-12);
+    rc.sigma_1 = fresh ? co.sigma_1 : model_.sigma_1(f_n, ct);
+    rc.g = std::max(fresh ? co.g : model_.g(f_n, ct), 1e-12);
     rc.gain = 2.0 / I_O;
     rc.drive = 0.5 * tauL + c_cor * f_t;
     double z = lumped_z_, w = om_;
@@ -499,7 +558,8 @@ void GraspPlant::substep_lumped(double h, double t0) noexcept {
   Vx_ = -om_ * c_cor * yhx;
   Vy_ = -om_ * c_cor * yhy;
   lumped_slip_ += h * std::fabs(om_ * c_cor);
-  const double c1 = std::cos(th_), s1 = std::sin(th_);
+  double c1, s1;
+  trig(th_, c1, s1);
   rx_ = c1 * o.cog_x - s1 * o.cog_y;
   ry_ = s1 * o.cog_x + c1 * o.cog_y;
   vx_ = -om_ * ry_;  // CoG velocity relative to the gripper (rotation about the grasp point)
@@ -528,19 +588,22 @@ void GraspPlant::true_wrench(int finger, double out[4]) const noexcept {
 }
 
 void GraspPlant::take_sample() noexcept {
-  const int64_t index = st_.steps / steps_per_sample_;
+  const int64_t index = sample_index_++;  // st_.steps / steps_per_sample_
   const SensorConfig& sc = cfg_.sensor;
   const ObjectConfig& o = cfg_.object;
   // displacement of the object point that was at the grasp point: u = r - R(theta) cog
   const double ux = ux_, uy = uy_;  // zero for the lumped plant
-  const double rho = f_act_ > 0.0 ? model_.rho(f_act_) : 0.0;
+  const double rho = f_act_ > 0.0 ? rho_at(f_act_) : 0.0;
   // |CoR - pad centre| / rho of the relative motion
-  const double vnorm = std::hypot(Vx_, Vy_);
   double a;
-  if (rho <= 0.0 || (vnorm == 0.0 && om_ == 0.0)) a = 0.0;
-  else if (vnorm >= 1e3 * rho * std::fabs(om_)) a = 1e3;
-  else a = vnorm / (rho * std::fabs(om_));
-  if (cfg_.model == PlantModel::Lumped) a = rho > 0.0 ? std::min(std::fabs(lumped_c_) / rho, 1e3) : 0.0;
+  if (cfg_.model == PlantModel::Lumped) {
+    a = rho > 0.0 ? std::min(std::fabs(lumped_c_) / rho, 1e3) : 0.0;
+  } else {
+    const double vnorm = std::hypot(Vx_, Vy_);
+    if (rho <= 0.0 || (vnorm == 0.0 && om_ == 0.0)) a = 0.0;
+    else if (vnorm >= 1e3 * rho * std::fabs(om_)) a = 1e3;
+    else a = vnorm / (rho * std::fabs(om_));
+  }
   for (int i = 0; i < 2; ++i) {
     FingerSample& f = sample_[i];
     const double sgn = i == 0 ? 1.0 : -1.0;  // x_i and z_i flip for finger 1

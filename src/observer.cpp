@@ -208,8 +208,8 @@ Status Observer::step(const ObserverInput& in, ObserverOutput& out) noexcept {
   const double bound = rc.g / rc.sigma0;
 
   // (3)-(4) update and projection, or (re)initialisation.
-  ObserverOutput r;
-  r.cor_side_flipped = flipped;
+  bool projected = false, diverged = false, capped = false;
+  int substeps = 0;
   Status status = cor_status;
   if (init) {
     z_ = clip(rc.drive / rc.sigma0, bound);
@@ -218,38 +218,50 @@ Status Observer::step(const ObserverInput& in, ObserverOutput& out) noexcept {
     status = Status::Reinitialized;
   } else {
     double z = z_, w = omega_;
-    r.projected = rotor_advance(z, w, h, rc, s_.integrator, s_.substeps, s_.max_substeps, &r.substeps, &r.substeps_capped);
+    projected = rotor_advance(z, w, h, rc, s_.integrator, s_.substeps, s_.max_substeps, &substeps, &capped);
     if (std::isfinite(z) && std::isfinite(w) && std::fabs(w) <= s_.omega_limit) {
       z_ = z;
       omega_ = w;
     } else {
-      r.diverged = true;
-      r.projected = false;
+      diverged = true;
+      projected = false;
       z_ = clip(rc.drive / rc.sigma0, bound);
       omega_ = 0.0;
       status = Status::Reinitialized;
     }
   }
-  r.omega_hat = omega_;
-  r.z_hat = z_;
-  r.S = std::min(p.sigma0 * std::fabs(z_) / rc.g, 1.0);
-  r.c_tilde = co.c_tilde;
-  r.c = co.c;
-  r.g = rc.g;
-  r.sigma_1 = co.sigma_1;
-  r.y = rc.drive;
-  r.tau_cor = tau_cor;
-  r.ft_cor = ft_cor;
-  r.gain = rc.gain;
-  r.omega_resolution = co.sigma_1 > 0.0 ? std::min(s_.torque_noise / co.sigma_1, std::numeric_limits<double>::max())
-                                        : (s_.torque_noise > 0.0 ? std::numeric_limits<double>::max() : 0.0);
-  r.speed_observable = r.omega_resolution <= s_.resolution_max;
-  r.inside = co.inside;
-  r.saturated = co.saturated;
-  r.cor_iterations = co.iterations;
-  r.status = status;
-  last_ = r;
-  out = r;
+  const double S = std::min(p.sigma0 * std::fabs(z_) / rc.g, 1.0);
+  const double omega_resolution =
+      co.sigma_1 > 0.0 ? std::min(s_.torque_noise / co.sigma_1, std::numeric_limits<double>::max())
+                       : (s_.torque_noise > 0.0 ? std::numeric_limits<double>::max() : 0.0);
+  // Written field by field to last_ and out (no zero-initialised temporary, no struct copy
+  // through the stack).
+  auto fill = [&](ObserverOutput& r) {
+    r.omega_hat = omega_;
+    r.z_hat = z_;
+    r.S = S;
+    r.c_tilde = co.c_tilde;
+    r.c = co.c;
+    r.g = rc.g;
+    r.sigma_1 = co.sigma_1;
+    r.y = rc.drive;
+    r.tau_cor = tau_cor;
+    r.ft_cor = ft_cor;
+    r.gain = rc.gain;
+    r.omega_resolution = omega_resolution;
+    r.speed_observable = omega_resolution <= s_.resolution_max;
+    r.inside = co.inside;
+    r.saturated = co.saturated;
+    r.projected = projected;
+    r.cor_side_flipped = flipped;
+    r.diverged = diverged;
+    r.substeps_capped = capped;
+    r.substeps = substeps;
+    r.cor_iterations = co.iterations;
+    r.status = status;
+  };
+  fill(last_);
+  fill(out);
   return status;
 }
 

@@ -350,6 +350,21 @@ class GraspPlant {
   std::array<NormalRng, 2> rng_;
   std::array<FingerSample, 2> sample_;
 
+  // Exact caches of run-time constants and of values recomputed with bit-identical inputs
+  // (same inputs -> same bits as the direct computation; they only skip repeated work).
+  double act_decay_ = 0.0;   // exp(-h / actuator.time_constant) (0 when there is no lag)
+  double filt_alpha_ = 1.0;  // -expm1(-h / sensor.filter_time_constant) (1 when off)
+  double trig_th_ = 0.0, trig_c_ = 1.0, trig_s_ = 0.0;  // cos, sin of the angle trig_th_
+  bool trig_ok_ = false;
+  double rho_fn_ = 0.0, rho_ = 0.0;  // rho(rho_fn_) of the contact model
+  bool rho_ok_ = false;
+  int cmd_phase_ = 0, sample_phase_ = 0;  // steps since the last command tick / sensor sample
+  int64_t sample_index_ = 0;               // index of the next sensor sample
+  CorOutput cor_out_;                      // scratch of the lumped plant's CoR estimate
+  void trig(double th, double& c, double& s) noexcept;  // cos, sin (cached on the exact angle)
+  double rho_at(double f_n) noexcept;                   // model_.rho (cached on the exact f_n)
+  void disturbance_cs(double t, double c, double s, double& fx, double& fy, double& tau) const noexcept;
+
   void substep_patch(double h, double t0) noexcept;
   void substep_lumped(double h, double t0) noexcept;
   void take_sample() noexcept;

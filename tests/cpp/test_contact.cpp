@@ -538,6 +538,44 @@ TEST(CorEstimator, OutputFieldsAreConsistent) {
   }
 }
 
+// The lumped plant (GraspPlant) takes rho, g and sigma_1 of a fresh estimate from the CorOutput
+// instead of calling ContactModel::rho / g / sigma_1 again; that is only an exact shortcut if the
+// estimator's fields are bit-identical to those functions. Checked on every branch (inside,
+// outside, saturated, pure torque, degenerate) at random loads.
+TEST(CorEstimator, RhoGSigma1AreBitIdenticalToTheModelFunctions) {
+  for (const ContactParams& p : {table1_params(), object_params("small_resin_block")}) {
+    const ContactModel& m = model_for(p);
+    CorEstimator est(m);
+    std::mt19937 gen(77);
+    std::uniform_real_distribution<double> u(0.0, 1.0);
+    int fresh = 0, by_status[3] = {0, 0, 0};
+    for (int i = 0; i < 20000; ++i) {
+      const double f_n = 0.03 * std::pow(500.0, u(gen));
+      const double tmax = p.mu * m.xi() * p.delta * std::pow(f_n, p.gamma + 1.0);
+      double f_t = p.mu * f_n * 2.0 * u(gen), tau = tmax * (4.0 * u(gen) - 2.0);
+      switch (i % 10) {
+        case 0: f_t = 0.0; break;                   // pure torque
+        case 1: f_t = 0.0; tau = 0.0; break;         // degenerate (previous CoR held)
+        case 2: tau = 1e-3 * tmax * u(gen); break;   // translation-dominated: saturated
+        default: break;
+      }
+      CorOutput o;
+      const Status st = est.step({f_n, f_t, tau}, o);
+      ASSERT_TRUE(st == Status::Ok || st == Status::Saturated || st == Status::Degenerate) << to_string(st);
+      ++fresh;
+      ++by_status[static_cast<int>(st)];
+      ASSERT_EQ(o.rho, m.rho(f_n)) << f_n;
+      ASSERT_EQ(o.g, m.g(f_n, o.c_tilde)) << f_n << " " << f_t << " " << tau;
+      ASSERT_EQ(o.sigma_1, m.sigma_1(f_n, o.c_tilde)) << f_n << " " << f_t << " " << tau;
+      ASSERT_EQ(o.c, o.c_tilde * m.rho(f_n));
+    }
+    EXPECT_EQ(fresh, 20000);
+    EXPECT_GT(by_status[0], 1000);  // every branch was exercised
+    EXPECT_GT(by_status[1], 1000);
+    EXPECT_GT(by_status[2], 1000);
+  }
+}
+
 // ------------------------------------------------------------ degenerate cases (MODEL.md 5.5) ----
 
 TEST(CorEstimator, DegenerateCases) {

@@ -695,3 +695,100 @@ TEST(GraspPlantLumped, PivotsTowardVerticalAndReadsTheLoad) {
   EXPECT_EQ(st.slip_x, 0.0);  // no translation state
   EXPECT_EQ(st.slip_y, 0.0);
 }
+
+// ---------------------------------------------------------------------------------------------
+// Exact caches of the plant (cos/sin of the object angle, rho at the actuator force, the actuator
+// decay and filter constants, the lumped CoR's rho/g/sigma_1): every cached value must equal,
+// bit for bit, the direct computation from the same inputs.
+
+namespace {
+PlantConfig cache_config(PlantModel model) {
+  PlantConfig c = base_config(0.2, 3.0);
+  c.model = model;
+  c.object.cog_x = 0.01;
+  c.object.cog_y = -0.004;
+  c.object.theta0 = 0.3;
+  c.sensor.filter_time_constant = 0.003;
+  c.sensor.force_noise = 0.004;
+  c.sensor.torque_noise = 1e-5;
+  c.actuator.time_constant = 0.02;
+  c.drop.rotation_limit = std::numeric_limits<double>::infinity();
+  c.drop.slip_limit = std::numeric_limits<double>::infinity();
+  // pulses applied off the CoG (the force moment needs cos/sin of theta), overlapping
+  c.disturbances.push_back(Disturbance{0.05, 0.3, PulseShape::HalfSine, 0.8, -0.5, 0.01, 0.02, 0.01});
+  c.disturbances.push_back(Disturbance{0.2, 0.2, PulseShape::Triangle, -0.4, 0.3, -0.02, -0.01, 0.0});
+  return c;
+}
+}  // namespace
+
+TEST(GraspPlantCaches, BitIdenticalToTheDirectComputation) {
+  for (PlantModel model : {PlantModel::Lumped, PlantModel::Patch}) {
+    const PlantConfig c = cache_config(model);
+    GraspPlant plant(c);
+    const double h = plant.dt();
+    const double decay = std::exp(-h / c.actuator.time_constant);
+    const double cmd[] = {3.0, 1.2, 0.5, 2.5, 0.0, 4.0};
+    int rotating = 0, pushed = 0;
+    for (int n = 0; n < 600; ++n) {
+      if (n % 100 == 0) plant.set_command(cmd[n / 100]);
+      const double theta = plant.state().theta, f_prev = plant.state().f_n;
+      const double held = (n % plant.steps_per_command() == 0) ? plant.state().f_cmd : plant.state().f_held;
+      const bool sample = plant.step();
+      const PlantState& st = plant.state();
+      // disturbance of the step at its end time, with the angle at its start (fresh cos/sin)
+      double fx, fy, tau;
+      plant.disturbance_at(static_cast<double>(n) * h + 0.0 * h + h, theta, fx, fy, tau);
+      ASSERT_EQ(st.ext_fx, fx) << n;
+      ASSERT_EQ(st.ext_fy, fy) << n;
+      ASSERT_EQ(st.ext_tau, tau) << n;
+      if (tau != 0.0) ++pushed;
+      // CoG from the end angle (fresh cos/sin)
+      const double ct = std::cos(st.theta), sn = std::sin(st.theta);
+      ASSERT_EQ(st.x, st.slip_x + ct * c.object.cog_x - sn * c.object.cog_y) << n;
+      ASSERT_EQ(st.y, st.slip_y + sn * c.object.cog_x + ct * c.object.cog_y) << n;
+      if (st.theta != theta) ++rotating;
+      // actuator lag with a fresh exp (the rate limit is 0.2 N per step here)
+      const double target = std::min(std::max(held, 0.0), c.actuator.f_max);
+      double f = target + (f_prev - target) * decay;
+      const double dmax = c.actuator.rate_limit * h;
+      f = std::min(std::max(f, f_prev - dmax), f_prev + dmax);
+      ASSERT_EQ(st.f_n, std::min(std::max(f, 0.0), c.actuator.f_max)) << n;
+      if (sample) {
+        const double rho = plant.contact_model().rho(st.f_n);
+        ASSERT_EQ(plant.sensor_sample(0).rho, rho) << n;
+        ASSERT_EQ(plant.sensor_sample(1).rho, rho) << n;
+      }
+    }
+    EXPECT_GT(rotating, 100) << to_string(model);  // the angle changed: the cache was refreshed
+    EXPECT_GT(pushed, 100) << to_string(model);
+  }
+}
+
+TEST(GraspPlantCaches, ResetRepeatsTheRunBitForBit) {
+  // Caches must not leak across reset(): a second run from reset() equals the first exactly, and
+  // equals a fresh plant's run.
+  for (PlantModel model : {PlantModel::Lumped, PlantModel::Patch}) {
+    const PlantConfig c = cache_config(model);
+    GraspPlant a(c), b(c);
+    std::vector<double> first;
+    auto run = [&](GraspPlant& p, std::vector<double>& out) {
+      for (int n = 0; n < 400; ++n) {
+        if (n % 50 == 0) p.set_command(0.5 + 0.01 * n);
+        p.step();
+        const PlantState& st = p.state();
+        out.insert(out.end(), {st.theta, st.omega, st.f_n, st.contact_tau, st.contact_fx, st.ext_tau,
+                               p.sensor_sample(0).tau, p.sensor_sample(1).f_x, p.sensor_sample(0).c_tilde});
+      }
+    };
+    run(a, first);
+    a.reset();
+    std::vector<double> second, fresh;
+    run(a, second);
+    run(b, fresh);
+    ASSERT_EQ(first.size(), second.size());
+    for (size_t i = 0; i < first.size(); ++i) {
+      ASSERT_EQ(first[i], second[i]) << to_string(model) << " " << i;
+      ASSERT_EQ(first[i], fresh[i]) << to_string(model) << " " << i;
+    }
+  }
+}
