@@ -233,3 +233,23 @@ def test_estimator_parameters_feed_the_observers_and_default_to_the_plants():
     rot_t1 = np.degrees(np.max(np.abs(table1["rotation"])))
     assert rot_own < 1.0, rot_own  # measured 0.3 deg
     assert rot_t1 > 10.0 * rot_own, (rot_own, rot_t1)  # measured ~20 deg
+
+
+def test_estimator_from_an_identified_yaml_brings_its_observer(tmp_path):
+    """A parameter file written after identification (parameters + the observer block it was
+    identified with) drives the simulated observers: its parameters and its observer settings,
+    with the simulator's own settings (rate, sensor noise, explicit options) on top."""
+    p = plant(0.2, (0.0035, 0.0), "small_resin_block")
+    fitted = lugrip.ContactParams.preset("small_resin_block").replace(sigma_z=3.3e-3, mu=0.72)
+    path = tmp_path / "pad.yaml"
+    fitted.to_yaml(path, observer={"bandwidth": 500.0, "integrator": "implicit"})
+    c = closed_loop_config(p, None, OBS, estimator=path)
+    assert c.estimator.mu == 0.72 and c.estimator.sigma_z == 3.3e-3
+    assert c.observer.bandwidth == 500.0
+    assert c.observer.integrator == _core.Integrator.Implicit
+    assert c.observer.cor_sign_sigmas == OBS["cor_sign_sigmas"]  # explicit settings on top
+    assert c.observer.dt == pytest.approx(0.002)
+    own = closed_loop_config(p, None, {"bandwidth": 80.0}, estimator=str(path))
+    assert own.observer.bandwidth == 80.0
+    r = run_closed_loop(p, None, OBS, None, 3.0, estimator=path)
+    assert not r["dropped"][-1] and np.all(r["finite"])

@@ -9,12 +9,14 @@ by the gripper, whose force follows it with a first-order lag. Deterministic wit
 from __future__ import annotations
 
 import math
+import os
 from collections.abc import Iterable, Mapping
 from typing import Any
 
 import numpy as np
 
 from .. import _core
+from .._contact import _params_path
 from .._controller import _core_settings
 from .._observer import Observer
 from .._params import ContactParams
@@ -144,19 +146,24 @@ def _schedule(mode_schedule) -> list[tuple[float, Any]]:
 
 
 def estimator_params(
-    plant_contact: ContactParams, estimator: ContactParams | Mapping[str, Any] | str | None
+    plant_contact: ContactParams,
+    estimator: ContactParams | Mapping[str, Any] | str | os.PathLike | None,
 ) -> ContactParams | None:
     """The contact parameters the estimator side (observers, controller) uses.
 
-    ``None``: the plant's own (returns None). A :class:`ContactParams` is used as is; a preset
-    name (``"big_resin_block"``) loads that object; a mapping with ``preset`` loads it and
-    applies the other keys; any other mapping overrides fields of the plant's parameters, e.g.
-    ``{"sigma_z": 0.0033}`` (a fingertip whose pre-sliding damping differs from Table 1).
+    ``None``: the plant's own (returns None). A :class:`ContactParams` is used as is; a
+    parameter YAML file (a path, or a str ending in .yaml/.yml, e.g. written by
+    ``lugrip identify``) is read; a preset name (``"big_resin_block"``) loads that object; a
+    mapping with ``preset`` loads it and applies the other keys; any other mapping overrides
+    fields of the plant's parameters, e.g. ``{"sigma_z": 0.0033}`` (a fingertip whose
+    pre-sliding damping differs from Table 1).
     """
     if estimator is None:
         return None
     if isinstance(estimator, ContactParams):
         return estimator
+    if _params_path(estimator) is not None:
+        return ContactParams.from_yaml(_params_path(estimator))
     if isinstance(estimator, str):
         return ContactParams.preset(estimator)
     if isinstance(estimator, Mapping):
@@ -164,7 +171,9 @@ def estimator_params(
         if "preset" in d:
             return ContactParams.preset(str(d.pop("preset"))).replace(**d)
         return plant_contact.replace(**d)
-    raise ValueError("estimator: expected None, ContactParams, a preset name or a mapping")
+    raise ValueError(
+        "estimator: expected None, ContactParams, a YAML file, a preset name or a mapping"
+    )
 
 
 def closed_loop_config(
@@ -193,7 +202,10 @@ def closed_loop_config(
     c = _core.ClosedLoopConfig()
     c.plant = plant.to_core()
     est = estimator_params(plant.contact, estimator)
-    c.observer = Observer(est or plant.contact, **obs)._settings
+    # A parameter YAML from identification carries the observer it was identified with (its
+    # observer: block); Observer(path) starts from it, the settings above override it.
+    path = None if estimator is None else _params_path(estimator)
+    c.observer = Observer(path if path is not None else (est or plant.contact), **obs)._settings
     if est is not None:
         c.estimator = est.to_core()
     c.controller = _core_settings(ctrl)
@@ -247,6 +259,8 @@ def run_closed_loop(
             (0: the command only rises).
         estimator: contact parameters of the observers and the controller (what the robot
             believes about the contact), see :func:`estimator_params`; None: the plant's own.
+            A YAML written by ``lugrip identify`` also brings its ``observer:`` block (the
+            observer it was identified with) as the base of `observer_settings`.
 
     Returns:
         :class:`ClosedLoopRun` (dict of numpy arrays).
