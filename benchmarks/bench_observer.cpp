@@ -239,13 +239,13 @@ void run_params(const char* label, const lugrip::ContactParams& p, const Stream&
     bool single;
   };
   const Variant variants[] = {
-      {"observer/rosenbrock", "default settings (ROS2, l = 100/sigma_1)", lugrip::Integrator::Rosenbrock,
+      {"observer/rosenbrock", "default settings (ROS2, l = bandwidth/sigma_1)", lugrip::Integrator::Rosenbrock,
        lugrip::GainMode::Bandwidth, true},
-      {"observer/implicit", "exponential-implicit Euler, l = 100/sigma_1", lugrip::Integrator::Implicit,
+      {"observer/implicit", "exponential-implicit Euler, l = bandwidth/sigma_1", lugrip::Integrator::Implicit,
        lugrip::GainMode::Bandwidth, false},
       {"observer/rk4", "one RK4 step per sample, fixed l = 200 (paper)", lugrip::Integrator::Rk4,
        lugrip::GainMode::Fixed, false},
-      {"observer/rk4_adaptive", "RK4 with adaptive substeps, l = 100/sigma_1", lugrip::Integrator::Rk4Adaptive,
+      {"observer/rk4_adaptive", "RK4 with adaptive substeps, l = bandwidth/sigma_1", lugrip::Integrator::Rk4Adaptive,
        lugrip::GainMode::Bandwidth, false},
   };
   for (const Variant& v : variants) {

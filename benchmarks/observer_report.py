@@ -771,8 +771,8 @@ def render(R) -> str:
     for r in R["cpp"]["rows"]:
         b = r["batched"]
         L.append(
-            # bench_observer runs the DEFAULT bandwidth; its labels name the former default
-            f"| {r['params']} | {r['name']} ({r['detail'].replace('l = 100/sigma_1', BL)}) | "
+            # bench_observer runs the DEFAULT bandwidth; its labels name the rule, BL the value
+            f"| {r['params']} | {r['name']} ({r['detail'].replace('l = bandwidth/sigma_1', BL)}) | "
             f"{b['median_ns']:.0f} | "
             f"{b['p99_ns']:.0f} | {b['worst_ns']:.0f} | {r['mean_substeps']:.2f} | "
             f"{r['mean_cor_iterations']:.2f} | {b['allocations']} | {r['diverged']} |"
