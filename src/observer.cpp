@@ -88,19 +88,29 @@ bool validate(const ObserverSettings& s, std::string* message) {
 namespace {
 // Hysteresis band: cor_sign_sigmas standard deviations of white torque noise after the
 // first-order low-pass at the nominal rate (variance ratio alpha / (2 - alpha)).
+// Coefficient of the first-order low-pass of the CoR inputs over a step h.
+double filter_alpha(const ObserverSettings& s, double h) {
+  return s.torque_cutoff > 0.0 ? -std::expm1(-kTwoPi * s.torque_cutoff * h) : 1.0;
+}
 double sign_band(const ObserverSettings& s) {
-  const double alpha = s.torque_cutoff > 0.0 ? -std::expm1(-kTwoPi * s.torque_cutoff * s.dt) : 1.0;
+  const double alpha = filter_alpha(s, s.dt);
   return s.cor_sign_sigmas * s.torque_noise * std::sqrt(alpha / (2.0 - alpha));
 }
 }  // namespace
 
 Observer::Observer(const ContactParams& params, const ObserverSettings& settings)
-    : cor_(params, checked(settings).cor), s_(settings), sign_band_(sign_band(settings)) {
+    : cor_(params, checked(settings).cor),
+      s_(settings),
+      sign_band_(sign_band(settings)),
+      alpha_dt_(filter_alpha(settings, settings.dt)) {
   reset();
 }
 
 Observer::Observer(const ContactModel& model, const ObserverSettings& settings)
-    : cor_(model, checked(settings).cor), s_(settings), sign_band_(sign_band(settings)) {
+    : cor_(model, checked(settings).cor),
+      s_(settings),
+      sign_band_(sign_band(settings)),
+      alpha_dt_(filter_alpha(settings, settings.dt)) {
   reset();
 }
 
@@ -170,7 +180,8 @@ Status Observer::step(const ObserverInput& in, ObserverOutput& out) noexcept {
     ft_f_ = in.f_t;
     cor_sign_ = in.tau < 0.0 ? -1.0 : 1.0;
   } else {
-    const double alpha = s_.torque_cutoff > 0.0 ? -std::expm1(-kTwoPi * s_.torque_cutoff * h) : 1.0;
+    // at the nominal period the coefficient computed at construction (the same value)
+    const double alpha = h == s_.dt ? alpha_dt_ : filter_alpha(s_, h);
     tau_f_ += alpha * (in.tau - tau_f_);
     ft_f_ += alpha * (in.f_t - ft_f_);
     if (std::fabs(tau_f_) > sign_band_) {

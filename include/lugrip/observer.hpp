@@ -170,6 +170,7 @@ class Observer {
   double cor_sign_ = 1.0; // side of the CoR torque (hysteresis)
   double pending_ = 0.0;  // time of skipped (invalid) samples, added to the next step
   double sign_band_ = 0.0;  // [N m] CoR sign hysteresis (cor_sign_sigmas x filtered noise std)
+  double alpha_dt_ = 1.0;   // low-pass coefficient of the CoR inputs at the nominal period
   int invalid_run_ = 0;
   bool need_init_ = true;
   ObserverOutput last_;
