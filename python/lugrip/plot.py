@@ -37,10 +37,12 @@ __all__ = [
     "axis_label",
     "color",
     "inset_zoom",
+    "merged_legend",
     "new_figure",
     "panel_labels",
     "save",
     "style",
+    "twin_y",
 ]
 
 PALETTE: tuple[str, ...] = (
@@ -176,6 +178,33 @@ def axis_label(name: str, symbol: str | None = None, unit: str | None = None) ->
     if unit:
         text += f" [{unit}]"
     return text
+
+
+def twin_y(ax: Axes, label: str | None = None, *, color: str | None = None) -> Axes:
+    """A right-hand y axis sharing the x axis of `ax`: its spine shown (the style hides right
+    spines), no grid of its own (the grid of `ax` stands), label and tick labels in `color`
+    when given."""
+    twin = ax.twinx()
+    if label:
+        if color is None:
+            twin.set_ylabel(label)
+        else:
+            twin.set_ylabel(label, color=color)
+    if color is not None:
+        twin.tick_params(axis="y", colors=color)
+    twin.spines["right"].set_visible(True)
+    twin.grid(False)
+    return twin
+
+
+def merged_legend(ax: Axes, *others: Axes, **kwargs):
+    """One legend on `ax` with the labelled artists of `ax` and then of `others` (e.g. a
+    :func:`twin_y` axis); kwargs as for ``Axes.legend``. Returns the Legend."""
+    handles, labels = ax.get_legend_handles_labels()
+    for other in others:
+        h, lab = other.get_legend_handles_labels()
+        handles, labels = handles + h, labels + lab
+    return ax.legend(handles, labels, **kwargs)
 
 
 def panel_labels(axes: Sequence[Axes], *, start: str = "a") -> None:

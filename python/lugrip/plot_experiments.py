@@ -13,6 +13,7 @@ Shaded: the lift (grey), disturbances (orange), pivoting (green).
 
 from __future__ import annotations
 
+import contextlib
 from collections.abc import Mapping, Sequence
 from pathlib import Path
 
@@ -30,77 +31,103 @@ __all__ = [
     "write_figures",
 ]
 
-# Colours (the paper's where it names them, mapped to the project palette).
-BLUE, RED, MAGENTA, GREEN = "#0072B2", "#D55E00", "#CC79A7", "#009E73"
-CYAN, ORANGE, BLACK, GREY = "#56B4E9", "#E69F00", "#000000", "#999999"
+# Colours (the paper's where it names them): the project palette, in its order.
+BLUE, RED, GREEN, MAGENTA, ORANGE, CYAN, BLACK, GREY = plot.PALETTE
+
+WIDTH = 8.0
+"""Width of every experiment figure [in]."""
+
+# Shading per phase: colour, alpha.
+_PHASE_STYLE = {"lift": (GREY, 0.12), "disturbance": (ORANGE, 0.25), "pivoting": (GREEN, 0.12)}
+
+
+@contextlib.contextmanager
+def _stacked(rows: int, row_height: float, title: str, duration: float):
+    """Yields (fig, axes): a column of `rows` panels sharing the time axis, in the project
+    style. On leaving: time label under the last panel, time from 0 to `duration`, panel
+    letters (a), (b), ..."""
+    with plot.style():
+        fig, axes = plot.new_figure(
+            rows, 1, sharex=True, width=WIDTH, row_height=row_height, title=title
+        )
+        yield fig, axes
+        axes[-1].set_xlabel(plot.axis_label("time", "t", "s"))
+        axes[-1].set_xlim(0.0, duration)
+        plot.panel_labels(axes)
+
+
+def _phases(scenario, run=None) -> list[tuple[str, float, float, bool]]:
+    """(kind, start, end, first of its kind) of the lifts, the disturbances and (from the run's
+    controller mode) the pivoting interval, in drawing order."""
+    cfg = scenario.plant_config()
+    spans = [("lift", m.t_start, m.t_start + m.duration, k == 0) for k, m in enumerate(cfg.moves)]
+    spans += [
+        ("disturbance", d.t_start, d.t_start + d.duration, k == 0)
+        for k, d in enumerate(cfg.disturbances)
+    ]
+    if run is not None and np.any(run["mode"] == 1):
+        piv = run["t"][run["mode"] == 1]
+        spans.append(("pivoting", piv[0], piv[-1], True))
+    return spans
 
 
 def _mark_phases(ax, scenario, run=None, *, label: bool = False) -> None:
-    """Shade the lift, the disturbances and the pivoting interval on an axis."""
-    cfg = scenario.plant_config()
-    for k, m in enumerate(cfg.moves):
+    """Shade the lift, the disturbances and the pivoting interval on an axis (with `label`,
+    one legend entry per kind)."""
+    for kind, start, end, first in _phases(scenario, run):
+        color, alpha = _PHASE_STYLE[kind]
         ax.axvspan(
-            m.t_start,
-            m.t_start + m.duration,
-            color=GREY,
-            alpha=0.12,
-            lw=0,
-            label="lift" if (label and k == 0) else None,
+            start, end, color=color, alpha=alpha, lw=0, label=kind if label and first else None
         )
-    for k, d in enumerate(cfg.disturbances):
-        ax.axvspan(
-            d.t_start,
-            d.t_start + d.duration,
-            color=ORANGE,
-            alpha=0.25,
-            lw=0,
-            label="disturbance" if (label and k == 0) else None,
-        )
-    if run is not None and np.any(run["mode"] == 1):
-        t = run["t"]
-        piv = t[run["mode"] == 1]
-        ax.axvspan(
-            piv[0], piv[-1], color=GREEN, alpha=0.12, lw=0, label="pivoting" if label else None
-        )
+
+
+def _line(ax, run, y, color: str, lw: float, **kwargs):
+    """Plot `y` (a column name of the run, or values on its time base) against the run's time."""
+    return ax.plot(run["t"], run[y] if isinstance(y, str) else y, color=color, lw=lw, **kwargs)
+
+
+def _torque_nmm(run) -> np.ndarray:
+    return np.abs(run["tau_meas_0"]) * 1e3
+
+
+def _torque_axis(ax, curves, *, headroom: float, color: str | None = None):
+    """Right-hand axis of |tau| [N mm]: one line per (run, colour, width, label), y from 0 to
+    headroom times the largest |tau| of the first run (at least 1 N mm)."""
+    ax2 = plot.twin_y(ax, plot.axis_label("torque", r"|\tau|", "N mm"), color=color)
+    for run, c, lw, label in curves:
+        _line(ax2, run, _torque_nmm(run), c, lw, label=label)
+    peak = float(np.max(np.abs(curves[0][0]["tau_meas_0"])))
+    ax2.set_ylim(bottom=0.0, top=max(1.0, headroom * peak * 1e3))
+    return ax2
 
 
 def _c_tilde(run) -> np.ndarray:
     return 0.5 * (np.abs(run["c_tilde_0"]) + np.abs(run["c_tilde_1"]))
 
 
+def _s_ref(scenario) -> float:
+    return scenario.controller.get("s_ref", 0.8)
+
+
 def _force_panel(ax, scenario, run, *, tangential: bool, torque: bool, legend_loc="upper right"):
-    t = run["t"]
-    ax.plot(t, run["f_n_meas_0"], color=BLUE, lw=1.6, label="grasp force $f_n$")
-    ax.plot(t, run["command"], color=BLACK, lw=0.8, ls="--", alpha=0.7, label="command")
+    _line(ax, run, "f_n_meas_0", BLUE, 1.6, label="grasp force $f_n$")
+    _line(ax, run, "command", BLACK, 0.8, ls="--", alpha=0.7, label="command")
     if tangential:
-        ax.plot(t, run["f_t_meas_0"], color=RED, lw=1.3, label="tangential load $f_t$")
+        _line(ax, run, "f_t_meas_0", RED, 1.3, label="tangential load $f_t$")
     ax.set_ylabel(plot.axis_label("force", None, "N"))
+    twins = []
     if torque:
-        ax2 = ax.twinx()
-        ax2.plot(
-            t, np.abs(run["tau_meas_0"]) * 1e3, color=MAGENTA, lw=1.3, label=r"torque $|\tau|$"
-        )
-        ax2.set_ylabel(plot.axis_label("torque", r"|\tau|", "N mm"), color=MAGENTA)
-        ax2.tick_params(axis="y", colors=MAGENTA)
-        ax2.spines["right"].set_visible(True)
-        ax2.grid(False)
-        ax2.set_ylim(
-            bottom=0.0, top=max(1.0, 1.15 * float(np.max(np.abs(run["tau_meas_0"]))) * 1e3)
-        )
-        h2, l2 = ax2.get_legend_handles_labels()
-    else:
-        h2, l2 = [], []
-    h1, l1 = ax.get_legend_handles_labels()
-    ax.legend(h1 + h2, l1 + l2, loc=legend_loc, ncol=2, fontsize=8)
+        curves = [(run, MAGENTA, 1.3, r"torque $|\tau|$")]
+        twins.append(_torque_axis(ax, curves, headroom=1.15, color=MAGENTA))
+    plot.merged_legend(ax, *twins, loc=legend_loc, ncol=2, fontsize=8)
     ax.set_ylim(bottom=0.0)
     _mark_phases(ax, scenario, run)
 
 
-def _s_panel(ax, scenario, run, s_ref: float = 0.8):
-    t = run["t"]
-    ax.plot(t, run.S, color=BLUE, lw=1.4, label="slippage indicator $S$")
-    ax.plot(t, _c_tilde(run), color=RED, lw=1.4, label=r"estimated $\tilde c$")
-    ax.axhline(s_ref, color=BLUE, lw=0.8, ls=":", alpha=0.8)
+def _s_panel(ax, scenario, run):
+    _line(ax, run, run.S, BLUE, 1.4, label="slippage indicator $S$")
+    _line(ax, run, _c_tilde(run), RED, 1.4, label=r"estimated $\tilde c$")
+    ax.axhline(_s_ref(scenario), color=BLUE, lw=0.8, ls=":", alpha=0.8)
     ax.set_ylabel(plot.axis_label("S, $\\tilde c$", None, "-"))
     ax.set_ylim(0.0, 1.65)
     ax.legend(loc="lower right", ncol=2, fontsize=8)
@@ -108,140 +135,95 @@ def _s_panel(ax, scenario, run, s_ref: float = 0.8):
 
 
 def _omega_panel(ax, scenario, run):
-    t = run["t"]
-    ax.plot(t, run["omega_hat_0"], color=BLUE, lw=1.2)
+    _line(ax, run, "omega_hat_0", BLUE, 1.2)
     ax.set_ylabel(plot.axis_label("slip velocity", r"\hat\omega", "rad/s"))
     _mark_phases(ax, scenario, run)
 
 
-def _finish(fig, axes, duration: float | None = None):
-    axes[-1].set_xlabel(plot.axis_label("time", "t", "s"))
-    if duration is not None:
-        axes[-1].set_xlim(0.0, duration)
-    plot.panel_labels(axes)
+def _force_s_omega(result, title: str, **force_panel):
+    """Figures 11 and 13: force panel (options `force_panel`), S and c~, omega_hat."""
+    s, run = result.scenario, result.runs["lugrip"]
+    with _stacked(3, 2.3, title, s.duration) as (fig, (ax_f, ax_s, ax_w)):
+        _force_panel(ax_f, s, run, **force_panel)
+        _s_panel(ax_s, s, run)
+        _omega_panel(ax_w, s, run)
     return fig
 
 
 def figure_11(result):
     """Figure 11: exp1, big resin block (grasp force; S and c~; omega_hat)."""
-    s, run = result.scenario, result.runs["lugrip"]
-    with plot.style():
-        fig, axes = plot.new_figure(
-            3,
-            1,
-            sharex=True,
-            width=8.0,
-            row_height=2.3,
-            title="Figure 11 (simulated): big resin block grasped above its CoG",
-        )
-        _force_panel(axes[0], s, run, tangential=False, torque=False)
-        _s_panel(axes[1], s, run, s.controller.get("s_ref", 0.8))
-        _omega_panel(axes[2], s, run)
-        return _finish(fig, axes, s.duration)
+    return _force_s_omega(
+        result,
+        "Figure 11 (simulated): big resin block grasped above its CoG",
+        tangential=False,
+        torque=False,
+    )
 
 
 def figure_13(result):
     """Figure 13: exp2, small resin block (force, tangential load, torque; S and c~; omega_hat)."""
-    s, run = result.scenario, result.runs["lugrip"]
-    with plot.style():
-        fig, axes = plot.new_figure(
-            3,
-            1,
-            sharex=True,
-            width=8.0,
-            row_height=2.3,
-            title="Figure 13 (simulated): small resin block grasped off its CoG",
-        )
-        _force_panel(axes[0], s, run, tangential=True, torque=True, legend_loc="center right")
-        _s_panel(axes[1], s, run, s.controller.get("s_ref", 0.8))
-        _omega_panel(axes[2], s, run)
-        return _finish(fig, axes, s.duration)
+    return _force_s_omega(
+        result,
+        "Figure 13 (simulated): small resin block grasped off its CoG",
+        tangential=True,
+        torque=True,
+        legend_loc="center right",
+    )
 
 
 def figure_15(result):
     """Figure 15: exp3, bottle lift and pivot (grasp force and torque; c~)."""
     s, run = result.scenario, result.runs["lugrip"]
-    with plot.style():
-        fig, axes = plot.new_figure(
-            2,
-            1,
-            sharex=True,
-            width=8.0,
-            row_height=2.6,
-            title="Figure 15 (simulated): plastic bottle lifted and pivoted",
-        )
-        _force_panel(axes[0], s, run, tangential=False, torque=True, legend_loc="upper right")
-        t = run["t"]
-        ax = axes[1]
-        ax.plot(t, _c_tilde(run), color=RED, lw=1.4, label=r"estimated $\tilde c$")
+    title = "Figure 15 (simulated): plastic bottle lifted and pivoted"
+    with _stacked(2, 2.6, title, s.duration) as (fig, (ax_f, ax)):
+        _force_panel(ax_f, s, run, tangential=False, torque=True)
+        _line(ax, run, _c_tilde(run), RED, 1.4, label=r"estimated $\tilde c$")
         thr = float(s.controller.get("pivot_end_c_tilde", 1.0))
         ax.axhline(thr, color=BLACK, lw=0.8, ls=":", label="end of pivoting ($\\tilde c$ = 1)")
         ax.set_ylim(0.0, 1.65)
         ax.set_ylabel(plot.axis_label("CoR", r"\tilde c", "-"))
         _mark_phases(ax, s, run, label=True)
         ax.legend(loc="lower right", ncol=2, fontsize=8)
-        return _finish(fig, axes, s.duration)
+    return fig
 
 
 def figure_17(full, empty):
     """Figure 17: exp4, full and empty can (force, tangential force, torque; S)."""
-    rf, re = full.runs["lugrip"], empty.runs["lugrip"]
-    with plot.style():
-        fig, axes = plot.new_figure(
-            2,
-            1,
-            sharex=True,
-            width=8.0,
-            row_height=2.8,
-            title="Figure 17 (simulated): aluminium can, full and empty",
-        )
-        ax = axes[0]
-        t = rf["t"]
-        ax.plot(t, rf["f_n_meas_0"], color=BLUE, lw=1.6, label="full: grasp force")
-        ax.plot(t, rf["f_t_meas_0"], color=RED, lw=1.2, label="full: tangential force")
-        ax.plot(re["t"], re["f_n_meas_0"], color=MAGENTA, lw=1.6, label="empty: grasp force")
-        ax.plot(re["t"], re["f_t_meas_0"], color=GREEN, lw=1.2, label="empty: tangential force")
+    s, rf, re = full.scenario, full.runs["lugrip"], empty.runs["lugrip"]
+    title = "Figure 17 (simulated): aluminium can, full and empty"
+    with _stacked(2, 2.8, title, s.duration) as (fig, (ax, ax_s)):
+        _line(ax, rf, "f_n_meas_0", BLUE, 1.6, label="full: grasp force")
+        _line(ax, rf, "f_t_meas_0", RED, 1.2, label="full: tangential force")
+        _line(ax, re, "f_n_meas_0", MAGENTA, 1.6, label="empty: grasp force")
+        _line(ax, re, "f_t_meas_0", GREEN, 1.2, label="empty: tangential force")
         ax.set_ylabel(plot.axis_label("force", None, "N"))
         ax.set_ylim(bottom=0.0)
-        ax2 = ax.twinx()
-        ax2.plot(
-            t, np.abs(rf["tau_meas_0"]) * 1e3, color=CYAN, lw=1.2, label=r"full: torque $|\tau|$"
+        curves = [
+            (rf, CYAN, 1.2, r"full: torque $|\tau|$"),
+            (re, ORANGE, 1.2, r"empty: torque $|\tau|$"),
+        ]
+        ax2 = _torque_axis(ax, curves, headroom=2.2)
+        plot.merged_legend(
+            ax, ax2, loc="lower left", bbox_to_anchor=(0.0, 1.02), ncol=3, fontsize=7.5
         )
-        ax2.plot(
-            re["t"],
-            np.abs(re["tau_meas_0"]) * 1e3,
-            color=ORANGE,
-            lw=1.2,
-            label=r"empty: torque $|\tau|$",
-        )
-        ax2.set_ylabel(plot.axis_label("torque", r"|\tau|", "N mm"))
-        ax2.spines["right"].set_visible(True)
-        ax2.grid(False)
-        ax2.set_ylim(bottom=0.0, top=max(1.0, 2.2 * float(np.max(np.abs(rf["tau_meas_0"]))) * 1e3))
-        h1, l1 = ax.get_legend_handles_labels()
-        h2, l2 = ax2.get_legend_handles_labels()
-        ax.legend(
-            h1 + h2, l1 + l2, loc="lower left", bbox_to_anchor=(0.0, 1.02), ncol=3, fontsize=7.5
-        )
-        _mark_phases(ax, full.scenario, rf)
+        _mark_phases(ax, s, rf)
         # inset: the empty can's force on its own scale
         ins = ax.inset_axes([0.33, 0.40, 0.3, 0.25])
-        ins.plot(re["t"], re["f_n_meas_0"], color=MAGENTA, lw=1.2)
-        ins.plot(re["t"], re["f_t_meas_0"], color=GREEN, lw=1.0)
+        _line(ins, re, "f_n_meas_0", MAGENTA, 1.2)
+        _line(ins, re, "f_t_meas_0", GREEN, 1.0)
         ins.set_xlim(re["t"][0], re["t"][-1])
         ins.set_ylim(0.0, 0.5)
         ins.set_title("empty can [N]", fontsize=7.5)
         ins.tick_params(labelsize=7)
         ins.grid(True, alpha=0.35, linewidth=0.6)
-        ax = axes[1]
-        ax.plot(t, rf.S, color=BLUE, lw=1.3, label="full: $S$")
-        ax.plot(re["t"], re.S, color=RED, lw=1.3, label="empty: $S$")
-        ax.axhline(full.scenario.controller.get("s_ref", 0.8), color=BLACK, lw=0.8, ls=":")
-        ax.set_ylim(0.0, 1.1)
-        ax.set_ylabel(plot.axis_label("slippage indicator", "S", "-"))
-        ax.legend(loc="lower right", fontsize=8)
-        _mark_phases(ax, full.scenario, rf)
-        return _finish(fig, axes, full.scenario.duration)
+        _line(ax_s, rf, rf.S, BLUE, 1.3, label="full: $S$")
+        _line(ax_s, re, re.S, RED, 1.3, label="empty: $S$")
+        ax_s.axhline(_s_ref(s), color=BLACK, lw=0.8, ls=":")
+        ax_s.set_ylim(0.0, 1.1)
+        ax_s.set_ylabel(plot.axis_label("slippage indicator", "S", "-"))
+        ax_s.legend(loc="lower right", fontsize=8)
+        _mark_phases(ax_s, s, rf)
+    return fig
 
 
 _KIND_STYLE = {
@@ -256,42 +238,33 @@ def figure_baselines(result):
     """lugrip against the baselines on one scenario: grasp-force command, and the true
     translational slip [mm] and rotation [deg] of the object relative to the fingers."""
     s = result.scenario
-    with plot.style():
-        fig, axes = plot.new_figure(
-            3,
-            1,
-            sharex=True,
-            width=8.0,
-            row_height=2.1,
-            title=f"{s.name}: lugrip vs baselines (ground truth)",
-        )
+    title = f"{s.name}: lugrip vs baselines (ground truth)"
+    with _stacked(3, 2.1, title, s.duration) as (fig, axes):
         for kind, run in result.runs.items():
             color, ls, label = _KIND_STYLE.get(kind, (GREY, "-", kind))
             m = result.metrics[kind]
             if kind == "constant_force" and m.get("constant_force") is not None:
                 label = f"constant force {m['constant_force']:.2f} N (minimum that survives)"
-            t = run["t"]
-            axes[0].plot(t, run["command"], color=color, ls=ls, lw=1.4, label=label)
-            axes[1].plot(t, run["slip"] * 1e3, color=color, ls=ls, lw=1.4)
-            axes[2].plot(t, np.degrees(run["rotation"]), color=color, ls=ls, lw=1.4)
+            _line(axes[0], run, "command", color, 1.4, ls=ls, label=label)
+            _line(axes[1], run, run["slip"] * 1e3, color, 1.4, ls=ls)
+            _line(axes[2], run, np.degrees(run["rotation"]), color, 1.4, ls=ls)
         axes[0].set_ylabel(plot.axis_label("command", "f_n", "N"))
         axes[0].set_ylim(bottom=0.0)
         axes[0].legend(loc="lower right", fontsize=7.5, ncol=2)
         axes[1].set_ylabel(plot.axis_label("slip", None, "mm"))
         axes[2].set_ylabel(plot.axis_label("rotation", None, "deg"))
-        hold = s.hold_time
         for ax in axes:
             _mark_phases(ax, s)
-            ax.axvline(hold, color=BLACK, lw=0.8, ls=":")
+            ax.axvline(s.hold_time, color=BLACK, lw=0.8, ls=":")
         axes[1].text(
-            hold,
+            s.hold_time,
             0.97,
             " hold starts",
             transform=axes[1].get_xaxis_transform(),
             fontsize=7.5,
             va="top",
         )
-        return _finish(fig, axes, s.duration)
+    return fig
 
 
 #: Paper figure per scenario (exp4 full and empty share Figure 17).
