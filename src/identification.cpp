@@ -10,6 +10,8 @@
 #include <string>
 #include <thread>
 
+#include "lugrip/detail/rotor_steps.hpp"
+
 namespace lugrip {
 
 namespace {
@@ -113,110 +115,28 @@ inline Dual operator/(double a, const Dual& b) { return Dual(a) / b; }
 inline Dual& operator+=(Dual& a, const Dual& b) { return a = a + b; }
 inline Dual& operator-=(Dual& a, const Dual& b) { return a = a - b; }
 
-inline double value(double x) { return x; }
-inline double value(const Dual& x) { return x.v; }
-inline double fabs_(double x) { return std::fabs(x); }
-inline Dual fabs_(const Dual& x) { return x.v < 0.0 ? -x : x; }
-inline double expm1_(double x) { return std::expm1(x); }
-inline Dual expm1_(const Dual& x) {
+// Scalar functions of the rotor steps (lugrip/detail/rotor_steps.hpp), found by ADL.
+inline double scalar_value(const Dual& x) { return x.v; }
+inline Dual scalar_fabs(const Dual& x) { return x.v < 0.0 ? -x : x; }
+inline Dual scalar_expm1(const Dual& x) {
   Dual r(std::expm1(x.v));
   const double e = std::exp(x.v);
   for (int i = 0; i < N; ++i) r.d[i] = e * x.d[i];
   return r;
 }
 
-// ------------------------------------------------------------------------------------------
-// Replica of the rotor integrators of slider_model.cpp (rotor_advance), templated on the scalar
-// type so the same sequence of operations yields the value and its parameter derivatives.
-// ------------------------------------------------------------------------------------------
-template <class T>
-struct Coef {
-  T sigma0, sigma_z, sigma_1, g, gain, drive;
+// Frozen rotor coefficients as duals (RotorCoefficients with T = Dual).
+struct DualCoefficients {
+  Dual sigma0, sigma_z, sigma_1, g, gain, drive;
 };
 
-template <class T>
-inline T zdot(const T& z, const T& omega, const T& sigma0, const T& g) {
-  return omega - sigma0 / g * z * (value(omega) < 0.0 ? -omega : omega);
-}
-
-template <class T>
-inline void rhs(const T& z, const T& w, const Coef<T>& c, T& dz, T& dw) {
-  dz = zdot(z, w, c.sigma0, c.g);
-  dw = c.gain * (c.drive - c.sigma0 * z - c.sigma_z * dz - c.sigma_1 * w);
-}
-
-template <class T>
-inline void project(T& z, const Coef<T>& c) {
-  const T bound = c.g / c.sigma0;
-  if (value(z) > value(bound)) z = bound;
-  else if (value(z) < -value(bound)) z = -bound;
-}
-
-template <class T>
-void step_implicit(T& z, T& omega, double h, const Coef<T>& c) {
-  const T ah = c.sigma0 / c.g * fabs_(omega) * h;
-  const T one_minus_e = -expm1_(-ah);
-  const T phi = value(ah) > 1e-12 ? one_minus_e / ah : T(1.0);
-  const T e = 1.0 - one_minus_e;
-  const T hk = h * c.gain;
-  const T rhs_ = omega + hk * (c.drive - c.sigma0 * e * z) + c.gain * c.sigma_z * one_minus_e * z;
-  const T den = 1.0 + hk * (c.sigma_1 + phi * (c.sigma_z + c.sigma0 * h));
-  const T w1 = rhs_ / den;
-  z = e * z + h * phi * w1;
-  omega = w1;
-}
-
-template <class T>
-void step_rk4(T& z, T& omega, double h, const Coef<T>& c) {
-  T k1z, k1w, k2z, k2w, k3z, k3w, k4z, k4w;
-  rhs(z, omega, c, k1z, k1w);
-  rhs(z + 0.5 * h * k1z, omega + 0.5 * h * k1w, c, k2z, k2w);
-  rhs(z + 0.5 * h * k2z, omega + 0.5 * h * k2w, c, k3z, k3w);
-  rhs(z + h * k3z, omega + h * k3w, c, k4z, k4w);
-  z += h / 6.0 * (k1z + 2.0 * k2z + 2.0 * k3z + k4z);
-  omega += h / 6.0 * (k1w + 2.0 * k2w + 2.0 * k3w + k4w);
-}
-
-template <class T>
-void step_rosenbrock(T& z, T& omega, double h, const Coef<T>& c) {
-  constexpr double gam = 1.7071067811865475244;
-  const double sgn = value(omega) > 0.0 ? 1.0 : (value(omega) < 0.0 ? -1.0 : 0.0);
-  const T a = c.sigma0 * fabs_(omega) / c.g;
-  const T b = 1.0 - c.sigma0 * z * sgn / c.g;
-  const double gh = gam * h;
-  const T m11 = 1.0 + gh * a, m12 = -gh * b;
-  const T m21 = gh * c.gain * (c.sigma0 - c.sigma_z * a), m22 = 1.0 + gh * c.gain * (c.sigma_1 + c.sigma_z * b);
-  const T inv_det = 1.0 / (m11 * m22 - m12 * m21);
-  T f1z, f1w;
-  rhs(z, omega, c, f1z, f1w);
-  const T k1z = (m22 * f1z - m12 * f1w) * inv_det;
-  const T k1w = (m11 * f1w - m21 * f1z) * inv_det;
-  T f2z, f2w;
-  rhs(z + h * k1z, omega + h * k1w, c, f2z, f2w);
-  f2z -= 2.0 * k1z;
-  f2w -= 2.0 * k1w;
-  const T k2z = (m22 * f2z - m12 * f2w) * inv_det;
-  const T k2w = (m11 * f2w - m21 * f2z) * inv_det;
-  z += h * (1.5 * k1z + 0.5 * k2z);
-  omega += h * (1.5 * k1w + 0.5 * k2w);
-}
-
-// The final pass of rotor_advance: projection, then n equal substeps each followed by the
+// The final pass of rotor_advance with the rotor steps of slider_model.cpp (the same templates,
+// lugrip/detail/rotor_steps.hpp): projection, then n equal substeps each followed by the
 // projection (the adaptive schemes redo a sample from its projected start with the final n).
-template <class T>
-void advance(T& z, T& omega, double h, const Coef<T>& c, Integrator scheme, int n) {
-  project(z, c);
-  n = std::max(n, 1);
-  const double hs = h / n;
-  for (int i = 0; i < n; ++i) {
-    switch (scheme) {
-      case Integrator::Implicit: step_implicit(z, omega, hs, c); break;
-      case Integrator::Rk4:
-      case Integrator::Rk4Adaptive: step_rk4(z, omega, hs, c); break;
-      case Integrator::Rosenbrock: step_rosenbrock(z, omega, hs, c); break;
-    }
-    project(z, c);
-  }
+void advance(Dual& z, Dual& omega, double h, const DualCoefficients& c, Integrator scheme, int n) {
+  detail::rotor_project(z, c);
+  bool projected = false;
+  detail::rotor_fixed_pass(z, omega, h, std::max(n, 1), c, scheme, projected);
 }
 
 inline bool scored_status(Status s) {
@@ -335,7 +255,7 @@ void run_segment(Observer& obs, const SegmentWork& w, int64_t begin, int64_t end
         const LsPoint q = ls.eval(a);
         const double G = xi * q.T + a * q.F;
         const double dG = xi * q.dT + q.F + a * q.dF;
-        Coef<Dual> c;
+        DualCoefficients c;
         c.sigma0 = sigma0;
         c.sigma_z = sigma_z;
         c.g = Dual(o.g);
@@ -363,7 +283,7 @@ void run_segment(Observer& obs, const SegmentWork& w, int64_t begin, int64_t end
         // (3) the state update
         if (st == Status::Reinitialized) {
           Dual zi = c.drive / c.sigma0;
-          project(zi, c);
+          detail::rotor_project(zi, c);
           z = zi;
           omega = Dual(0.0);
           z.v = o.z_hat;
@@ -396,7 +316,7 @@ void run_segment(Observer& obs, const SegmentWork& w, int64_t begin, int64_t end
           }
           if (!(sw <= w_limit && sz <= w.s->sensitivity_limit * bound)) {
             Dual zi = c.drive / c.sigma0;
-            project(zi, c);
+            detail::rotor_project(zi, c);
             z.d = zi.d;
             omega.d.fill(0.0);
             ++out.truncated;

@@ -1,5 +1,7 @@
 // lugrip — the planar slider about its centre of rotation (paper eqs. 1-2) and the one-step
-// integrators shared with the velocity observer (MODEL.md 7.1 and 7.4).
+// integrators shared with the velocity observer (MODEL.md 7.1 and 7.4). The integrators are
+// implemented once, templated on the scalar type, in lugrip/detail/rotor_steps.hpp (double here,
+// dual numbers in the identification's forward sensitivities).
 #pragma once
 
 #include <string>
@@ -49,9 +51,20 @@ struct RotorCoefficients {
   double drive = 0.0;    //!< u: external torque (plant) or measured y (observer) [N m]
 };
 
+namespace detail {
+//! Value of a scalar: the identity for double; another scalar type (the identification's dual
+//! numbers) provides its own overload, found by argument-dependent lookup.
+inline double scalar_value(double x) noexcept { return x; }
+//! Eq. 1 for any scalar type (see lugrip/detail/rotor_steps.hpp): the one implementation.
+template <class T>
+inline T rotor_zdot(const T& z, const T& omega, const T& sigma0, const T& g) noexcept {
+  return omega - sigma0 / g * z * (scalar_value(omega) < 0.0 ? -omega : omega);
+}
+}  // namespace detail
+
 //! Right-hand side zdot of eq. 1 at (z, omega).
 inline double lugre_zdot(double z, double omega, double sigma0, double g) noexcept {
-  return omega - sigma0 / g * z * (omega < 0.0 ? -omega : omega);
+  return detail::rotor_zdot(z, omega, sigma0, g);
 }
 
 //! One step of length h with the Implicit scheme (see Integrator::Implicit). Not projected.

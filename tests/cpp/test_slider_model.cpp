@@ -3,10 +3,13 @@
 
 #include <cmath>
 #include <limits>
+#include <random>
 #include <stdexcept>
 #include <string>
+#include <utility>
 #include <vector>
 
+#include "lugrip/detail/rotor_steps.hpp"
 #include "lugrip/slider_model.hpp"
 
 using namespace lugrip;
@@ -251,4 +254,149 @@ TEST(RotorStep, Rk4AdaptiveChoosesSubstepsFromTheStiffness) {
   rotor_advance(z, w, kDt, c, Integrator::Rk4Adaptive, 1, 3, &n, &capped);
   EXPECT_EQ(n, 3);
   EXPECT_TRUE(capped);
+}
+
+namespace {
+
+// A one-parameter forward-mode dual number: the shared rotor templates
+// (lugrip/detail/rotor_steps.hpp) instantiated with it must give the double functions' values
+// bit for bit (what the identification's tangent replica relies on) and the exact derivative.
+struct D1 {
+  double v = 0.0, d = 0.0;
+  D1() = default;
+  D1(double value, double deriv = 0.0) : v(value), d(deriv) {}  // NOLINT: constants promote
+};
+D1 operator-(const D1& a) { return {-a.v, -a.d}; }
+D1 operator+(const D1& a, const D1& b) { return {a.v + b.v, a.d + b.d}; }
+D1 operator-(const D1& a, const D1& b) { return {a.v - b.v, a.d - b.d}; }
+D1 operator*(const D1& a, const D1& b) { return {a.v * b.v, a.d * b.v + a.v * b.d}; }
+D1 operator/(const D1& a, const D1& b) {
+  const double q = a.v / b.v;
+  return {q, (a.d - q * b.d) / b.v};
+}
+D1& operator+=(D1& a, const D1& b) { return a = a + b; }
+D1& operator-=(D1& a, const D1& b) { return a = a - b; }
+double scalar_value(const D1& x) { return x.v; }
+D1 scalar_fabs(const D1& x) { return x.v < 0.0 ? -x : x; }
+D1 scalar_expm1(const D1& x) { return {std::expm1(x.v), std::exp(x.v) * x.d}; }
+
+struct D1Coefficients {
+  D1 sigma0, sigma_z, sigma_1, g, gain, drive;
+};
+
+// Coefficients and a state over several decades (stick, sliding, stiff and soft).
+struct RotorCase {
+  RotorCoefficients c;
+  double z, w, h;
+};
+RotorCase random_case(std::mt19937_64& rng) {
+  std::uniform_real_distribution<double> u(0.0, 1.0);
+  RotorCase r;
+  r.c.sigma0 = std::pow(10.0, 3.0 * u(rng) - 1.0);
+  r.c.sigma_z = std::pow(10.0, 4.0 * u(rng) - 5.0);
+  r.c.sigma_1 = std::pow(10.0, 5.0 * u(rng) - 6.0);
+  r.c.g = std::pow(10.0, 4.0 * u(rng) - 5.0);
+  r.c.gain = std::pow(10.0, 5.0 * u(rng) + 1.0);
+  r.c.drive = (4.0 * u(rng) - 2.0) * r.c.g;
+  r.z = (2.0 * u(rng) - 1.0) * r.c.g / r.c.sigma0;
+  r.w = (u(rng) < 0.5 ? -1.0 : 1.0) * std::pow(10.0, 4.0 * u(rng) - 3.0);
+  r.h = std::pow(10.0, 2.0 * u(rng) - 5.0);
+  return r;
+}
+
+// Dual coefficients from double ones, d/d drive seeded when seed_drive, else d/d sigma0.
+D1Coefficients dual(const RotorCoefficients& c, bool seed_drive) {
+  D1Coefficients r;
+  r.sigma0 = D1(c.sigma0, seed_drive ? 0.0 : 1.0);
+  r.sigma_z = c.sigma_z;
+  r.sigma_1 = c.sigma_1;
+  r.g = c.g;
+  r.gain = c.gain;
+  r.drive = D1(c.drive, seed_drive ? 1.0 : 0.0);
+  return r;
+}
+
+using DoubleStep = void (*)(double&, double&, double, const RotorCoefficients&) noexcept;
+
+}  // namespace
+
+TEST(RotorStep, DualInstantiationReproducesTheDoubleStepsAndDifferentiatesThem) {
+  std::mt19937_64 rng(2024);
+  const struct {
+    Integrator scheme;
+    DoubleStep step;
+  } kinds[] = {{Integrator::Implicit, rotor_step_implicit},
+               {Integrator::Rk4, rotor_step_rk4},
+               {Integrator::Rosenbrock, rotor_step_rosenbrock}};
+  int checked_derivatives = 0;
+  for (int k = 0; k < 2000; ++k) {
+    const RotorCase r = random_case(rng);
+    for (const auto& kind : kinds) {
+      SCOPED_TRACE(std::string(to_string(kind.scheme)) + " case " + std::to_string(k));
+      double z = r.z, w = r.w;
+      kind.step(z, w, r.h, r.c);
+      for (bool seed_drive : {false, true}) {
+        const D1Coefficients dc = dual(r.c, seed_drive);
+        D1 zd(r.z), wd(r.w);
+        if (kind.scheme == Integrator::Implicit) detail::rotor_implicit(zd, wd, r.h, dc);
+        else if (kind.scheme == Integrator::Rk4) detail::rotor_rk4(zd, wd, r.h, dc);
+        else detail::rotor_rosenbrock(zd, wd, r.h, dc);
+        // values: the same operations in the same order
+        ASSERT_EQ(zd.v, z);
+        ASSERT_EQ(wd.v, w);
+        // derivative: central difference of the double step, where the step resolves the
+        // dynamics (h Lambda <= 0.5) and omega keeps its sign (|omega| is not smooth at 0)
+        if (!(w * r.w > 0.0) || r.h * rotor_stiffness(r.w, r.c) > 0.5) continue;
+        auto run = [&](double delta) {
+          RotorCoefficients c = r.c;
+          (seed_drive ? c.drive : c.sigma0) += delta;
+          double zz = r.z, ww = r.w;
+          kind.step(zz, ww, r.h, c);
+          return std::make_pair(zz, ww);
+        };
+        const double p = seed_drive ? r.c.g : r.c.sigma0;
+        const double eps = 1e-6 * p;
+        const auto plus = run(eps), minus = run(-eps);
+        const double fd_w = (plus.second - minus.second) / (2.0 * eps);
+        const double fd_z = (plus.first - minus.first) / (2.0 * eps);
+        if (w * plus.second <= 0.0 || w * minus.second <= 0.0) continue;
+        const double tol_w = 1e-5 * (std::fabs(fd_w) + std::fabs(w) / p) + 1e-12;
+        const double tol_z = 1e-5 * (std::fabs(fd_z) + r.c.g / r.c.sigma0 / p) + 1e-15;
+        EXPECT_NEAR(wd.d, fd_w, tol_w) << (seed_drive ? "d/d drive" : "d/d sigma0");
+        EXPECT_NEAR(zd.d, fd_z, tol_z) << (seed_drive ? "d/d drive" : "d/d sigma0");
+        ++checked_derivatives;
+      }
+    }
+  }
+  EXPECT_GT(checked_derivatives, 4000);
+}
+
+TEST(RotorStep, AdaptiveSampleEqualsTheFixedPassWithItsSubstepCount) {
+  // The identification replays an adaptive sample as a fixed pass with the observer's reported
+  // substep count: rotor_advance must end exactly where that pass (dual, from the projected
+  // start) ends, for every scheme.
+  std::mt19937_64 rng(7);
+  int multi = 0;
+  for (int k = 0; k < 3000; ++k) {
+    RotorCase r = random_case(rng);
+    r.h *= 100.0;  // samples long enough to need substeps
+    if (k % 3 == 0) r.z *= 1.5;  // starts outside the current bound (g dropped)
+    for (Integrator s : {Integrator::Implicit, Integrator::Rk4, Integrator::Rk4Adaptive, Integrator::Rosenbrock}) {
+      SCOPED_TRACE(std::string(to_string(s)) + " case " + std::to_string(k));
+      double z = r.z, w = r.w;
+      int n = 0;
+      bool capped = false;
+      const bool projected = rotor_advance(z, w, r.h, r.c, s, 1 + k % 2, 400, &n, &capped);
+      if (capped || !std::isfinite(w)) continue;
+      if (n > 2) ++multi;
+      const D1Coefficients dc = dual(r.c, false);
+      D1 zd(r.z), wd(r.w);
+      bool pd = detail::rotor_project(zd, dc);
+      detail::rotor_fixed_pass(zd, wd, r.h, n, dc, s, pd);
+      ASSERT_EQ(zd.v, z);
+      ASSERT_EQ(wd.v, w);
+      EXPECT_EQ(pd, projected);
+    }
+  }
+  EXPECT_GT(multi, 500);  // the adaptive schemes did take several substeps
 }
