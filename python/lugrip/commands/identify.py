@@ -142,6 +142,12 @@ def register(subparsers) -> None:
         default=None,
         help="observer integrator (default rosenbrock)",
     )
+    p.add_argument(
+        "--score-saturated",
+        action="store_true",
+        help="also score samples where the CoR is clipped at c_max (default: left out, the "
+        "observer's omega_hat there is the slip about the clipped CoR, not the rotation)",
+    )
     p.add_argument("--threads", type=int, default=0, help="C++ worker threads (0: all cores)")
     p.add_argument(
         "--rubbing",
@@ -357,6 +363,7 @@ def run(args) -> int:
                 n_bootstrap=args.bootstrap,
                 start=args.start,
                 threads=args.threads,
+                score_saturated=args.score_saturated,
                 progress=bar,
             )
         except IdentificationError as err:

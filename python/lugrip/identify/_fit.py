@@ -608,6 +608,8 @@ class IdentificationResult:
         samples_train, samples_validation: scored samples.
         truncated: samples where the gradient guard restarted the sensitivities (the
             observer's discrete map was locally chaotic) at the final point.
+        samples_saturated: training samples left unscored at the final point because the
+            observer's CoR was clipped at c_max (``score_saturated=False``).
         settings: loss, weighting, method, observer settings, ...
         validation_trace: arrays for the Figure-5 plot of the validation maneuvers (t, omega,
             omega_hat, maneuver index) or None.
@@ -639,6 +641,7 @@ class IdentificationResult:
     truncated: int
     settings: dict
     validation_trace: dict | None = None
+    samples_saturated: int = 0
 
     @property
     def success(self) -> bool:
@@ -760,6 +763,7 @@ class IdentificationResult:
                 },
                 "identifiability": list(self.identifiability),
                 "truncated_gradient_samples": self.truncated,
+                "saturated_samples_unscored": self.samples_saturated,
                 "settings": self.settings,
             },
         }
@@ -933,6 +937,7 @@ def identify(
     slip_threshold: float = _DEFAULT_SLIP,
     max_gap: float | None = None,
     fix_unidentifiable: bool = True,
+    score_saturated: bool = False,
     threads: int = 0,
     k: float | None = None,
     c_max: float | None = None,
@@ -975,12 +980,20 @@ def identify(
             autocorrelation within maneuvers) or "bootstrap" (``n_bootstrap`` refits on
             maneuvers resampled with replacement).
         start: "data" (computed) or "params0"; default: params0 when given, else data.
-        slip_threshold: |omega| [rad/s] above which a sample counts as sliding (checks and the
-            initial guess).
+        slip_threshold: |omega| [rad/s] above which a sample counts as sliding (checks, the
+            initial guess and the clipped-CoR exclusion).
         max_gap: split segments at time steps above this [s] (default: 5 sample periods).
         fix_unidentifiable: fix gamma when the normal force does not vary and delta when the
             data hold only rotations (with an :class:`IdentifiabilityWarning`); False: keep
             them free and only warn.
+        score_saturated: also score sliding samples where the observer's CoR is clipped at
+            c_max. Default False: where the load puts the CoR beyond the clip (translation-
+            dominated sliding) the observer estimates the slip rate about the clipped CoR, not
+            the object's rotation, so no ground-truth omega compares with it; such samples
+            (|omega| > slip_threshold) still run through the observer but are left out of the
+            cost (``samples_saturated``); stick samples are scored (omega_hat ~ 0 there).
+            Scoring them bends mu, delta, beta_A and sigma0 (measured: mu x1.5 on logs with
+            10 % of such maneuvers).
         threads: C++ worker threads (0: all cores).
         k, c_max: pressure exponent and CoR clip when params0 is None (default 4 and 1.5).
         progress: called after every iteration as progress(iteration, cost, params).
@@ -1140,6 +1153,8 @@ def identify(
     settings.loss = _core.IdLoss.Huber if loss == "huber" else _core.IdLoss.Squared
     settings.huber_scale = float(huber_scale)
     settings.threads = int(threads)
+    settings.score_saturated = bool(score_saturated)
+    settings.slip_threshold = float(slip_threshold)
     msg = _core.validate_identification_settings(settings)
     if msg:
         raise ValueError("invalid identification settings:\n" + msg.rstrip())
@@ -1384,6 +1399,13 @@ def identify(
                     f"determined to +-{100 * sd:.2g} %, {free_t[i]} alone to "
                     f"+-{100 * stderr_log[i]:.2g} %"
                 )
+    if int(ev["saturated"]):
+        n_sat = int(ev["saturated"])
+        ident.append(
+            f"{n_sat} training samples ({100 * n_sat / max(n_sat + int(cnt.sum()), 1):.1f} %) "
+            "not scored: sliding with the CoR clipped at c_max (translation beyond the clip), "
+            "where omega_hat is the slip about the clipped CoR, not the object's rotation"
+        )
     if int(ev["truncated"]):
         ident.append(
             f"gradient truncated on {int(ev['truncated'])} samples where the observer "
@@ -1469,6 +1491,7 @@ def identify(
         samples_train=int(cnt.sum()),
         samples_validation=n_val,
         truncated=int(ev["truncated"]),
+        samples_saturated=int(ev["saturated"]),
         settings={
             "loss": loss,
             "huber_scale": float(huber_scale),
@@ -1478,6 +1501,7 @@ def identify(
             "validation": len(val_m),
             "seed": int(seed),
             "slip_threshold": float(slip_threshold),
+            "score_saturated": bool(score_saturated),
             "observer": dict(odict),
             "bounds": {n: list(bnds[n]) for n in free_t},
             "threads": int(threads),
