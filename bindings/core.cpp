@@ -951,9 +951,7 @@ NB_MODULE(_core, m) {
         .def_rw("loss", &IdentificationSettings::loss)
         .def_rw("huber_scale", &IdentificationSettings::huber_scale)
         .def_rw("threads", &IdentificationSettings::threads)
-        .def_rw("sensitivity_limit", &IdentificationSettings::sensitivity_limit)
-        .def_rw("score_saturated", &IdentificationSettings::score_saturated)
-        .def_rw("slip_threshold", &IdentificationSettings::slip_threshold);
+        .def_rw("sensitivity_limit", &IdentificationSettings::sensitivity_limit);
     m.def("validate_identification_settings", [](const IdentificationSettings& s) {
       std::string msg;
       validate(s, &msg);
@@ -1015,7 +1013,6 @@ NB_MODULE(_core, m) {
           d["reinitialized"] = ev.reinitialized;
           d["diverged"] = ev.diverged;
           d["truncated"] = ev.truncated;
-          d["saturated"] = ev.saturated;
           if (want_omega_hat) d["omega_hat"] = w_hat;
           return d;
         }, "params"_a, "derivatives"_a = true, "omega_hat"_a = false,

@@ -167,7 +167,7 @@ struct SegmentOut {
   SegmentSums sums;
   std::array<double, N * N> gn{};
   double replica_error = 0.0;
-  int64_t reinitialized = 0, diverged = 0, truncated = 0, saturated = 0;
+  int64_t reinitialized = 0, diverged = 0, truncated = 0;
 };
 
 void run_segment(Observer& obs, const SegmentWork& w, int64_t begin, int64_t end, SegmentOut& out) {
@@ -329,11 +329,6 @@ void run_segment(Observer& obs, const SegmentWork& w, int64_t begin, int64_t end
     const double target = d.omega[i];
     const double wt = d.weight[i];
     if (!(scored_status(st) && std::isfinite(target) && wt > 0.0)) continue;
-    if (o.saturated && !w.s->score_saturated && std::fabs(target) > w.s->slip_threshold) {
-      // slip about the clipped CoR: no ground truth compares with omega_hat
-      ++out.saturated;
-      continue;
-    }
     const double r = o.omega_hat - target;
     SegmentSums& S = out.sums;
     S.sse += r * r;
@@ -365,8 +360,6 @@ bool validate(const IdentificationSettings& s, std::string* message) {
     msg += "loss = " + std::to_string(static_cast<int>(s.loss)) + ": unknown loss (squared, huber)\n";
   if (!(std::isfinite(s.huber_scale) && s.huber_scale > 0.0))
     msg += "huber_scale = " + fmt(s.huber_scale) + ": must be finite and > 0 [rad/s]\n";
-  if (!(std::isfinite(s.slip_threshold) && s.slip_threshold >= 0.0))
-    msg += "slip_threshold = " + fmt(s.slip_threshold) + ": must be finite and >= 0\n";
   if (!(std::isfinite(s.sensitivity_limit) && s.sensitivity_limit > 0.0))
     msg += "sensitivity_limit = " + fmt(s.sensitivity_limit) + ": must be finite and > 0\n";
   if (!(s.threads >= 0)) msg += "threads = " + std::to_string(s.threads) + ": must be >= 0 (0: all cores)\n";
@@ -486,7 +479,6 @@ IdentificationEval IdentificationProblem::evaluate(const ContactParams& params, 
     ev.reinitialized += o.reinitialized;
     ev.diverged += o.diverged;
     ev.truncated += o.truncated;
-    ev.saturated += o.saturated;
   }
   if (ev.weight_sum > 0.0) {
     ev.cost = loss / ev.weight_sum;

@@ -32,8 +32,6 @@ enum class IdLoss : int {
 //! | loss | Squared or Huber | - | | Squared |
 //! | huber_scale | residual where the Huber loss turns linear | rad/s | > 0 | 0.05 |
 //! | threads | worker threads over segments (0: hardware concurrency) | - | >= 0 | 0 |
-//! | score_saturated | also score sliding samples where the observer's CoR is clipped at c_max (see below) | - | | false |
-//! | slip_threshold | ground-truth abs(omega) above which a sample counts as sliding | rad/s | >= 0 | 2e-3 |
 //! | sensitivity_limit | chattering guard: a state sensitivity beyond this many times its scale (per unit log-parameter; omega: the segment's largest |omega|, z: g/sigma0) restarts the sensitivities | - | > 0 | 100 |
 struct IdentificationSettings {
   ObserverSettings observer;
@@ -41,15 +39,6 @@ struct IdentificationSettings {
   double huber_scale = 0.05;
   int threads = 0;
   double sensitivity_limit = 100.0;
-  //! Where the load puts the CoR beyond the clip c_max (translation-dominated sliding), the
-  //! observer estimates the slip rate about the CLIPPED CoR, not the object's rotation about the
-  //! true one, and no ground-truth omega compares with it: scoring those samples makes the fit
-  //! bend mu, delta, beta_A and sigma0 to explain a quantity the model does not produce. Off by
-  //! default: such samples are run through the observer (its state stays continuous) but not
-  //! scored while the ground truth slides (abs(omega) > slip_threshold); in stick omega_hat ~ 0
-  //! whatever the CoR, and those samples are scored.
-  bool score_saturated = false;
-  double slip_threshold = 2.0e-3;
 };
 
 //! Checks every field (and the nested observer settings); one line per bad field in *message.
@@ -87,9 +76,6 @@ struct IdentificationEval {
   double cost = 0.0;         //!< sum(w loss(r)) / sum(w) over scored samples (eq. 32 for Squared, w = 1)
   double weight_sum = 0.0;   //!< sum(w)
   int64_t scored = 0;        //!< samples with a valid observer output, finite omega and w > 0
-  //! sliding samples with finite omega and w > 0 left unscored because the CoR was clipped at
-  //! c_max (IdentificationSettings::score_saturated = false)
-  int64_t saturated = 0;
   std::array<double, kIdParams> gradient{};  //!< d cost / dP
   //! Gauss-Newton matrix 2 sum(w v J J^T) / sum(w), row-major 6x6, J = d omega_hat / dP, v the
   //! IRLS weight of the loss (1 for Squared, min(1, s/|r|) for Huber).

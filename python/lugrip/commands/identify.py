@@ -145,8 +145,8 @@ def register(subparsers) -> None:
     p.add_argument(
         "--score-saturated",
         action="store_true",
-        help="also score samples where the CoR is clipped at c_max (default: left out, the "
-        "observer's omega_hat there is the slip about the clipped CoR, not the rotation)",
+        help="also score sliding samples where the observer clips the CoR at c_max (default: "
+        "left out, omega_hat there is the slip about the clipped CoR, not the rotation)",
     )
     p.add_argument("--threads", type=int, default=0, help="C++ worker threads (0: all cores)")
     p.add_argument(

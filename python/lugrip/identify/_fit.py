@@ -35,6 +35,8 @@ combinations (eigenvectors of the scale-free Gauss-Newton matrix) and the correl
 from __future__ import annotations
 
 import dataclasses
+import functools
+import inspect
 import math
 import os
 import time
@@ -608,8 +610,8 @@ class IdentificationResult:
         samples_train, samples_validation: scored samples.
         truncated: samples where the gradient guard restarted the sensitivities (the
             observer's discrete map was locally chaotic) at the final point.
-        samples_saturated: training samples left unscored at the final point because the
-            observer's CoR was clipped at c_max (``score_saturated=False``).
+        samples_saturated: sliding samples (training and validation) left unscored because
+            the observer's CoR was clipped at c_max there (``score_saturated=False``).
         settings: loss, weighting, method, observer settings, ...
         validation_trace: arrays for the Figure-5 plot of the validation maneuvers (t, omega,
             omega_hat, maneuver index) or None.
@@ -916,7 +918,7 @@ def _combination_text(weights: Mapping[str, float]) -> str:
     return " * ".join(parts)
 
 
-def identify(
+def _identify_pass(
     logs,
     params0=None,
     free: Sequence[str] | str = PARAMETERS,
@@ -942,6 +944,7 @@ def identify(
     k: float | None = None,
     c_max: float | None = None,
     progress: Callable[[int, float, ContactParams], None] | None = None,
+    clip_params: ContactParams | None = None,
 ) -> IdentificationResult:
     """Identify contact parameters from sliding logs with ground-truth velocity (paper
     Section 4): minimise the online observer's velocity error (eqs. 32-33) with SQP.
@@ -1153,11 +1156,21 @@ def identify(
     settings.loss = _core.IdLoss.Huber if loss == "huber" else _core.IdLoss.Squared
     settings.huber_scale = float(huber_scale)
     settings.threads = int(threads)
-    settings.score_saturated = bool(score_saturated)
-    settings.slip_threshold = float(slip_threshold)
     msg = _core.validate_identification_settings(settings)
     if msg:
         raise ValueError("invalid identification settings:\n" + msg.rstrip())
+    # Sliding samples whose CoR the online observer clips at c_max are not scored (their
+    # ground truth is left out, the observer still runs through them): computed at fixed
+    # parameters (`clip_params`, else the start) so that the cost stays smooth during the fit;
+    # identify() repeats the fit with the set found at the previous result until it settles.
+    n_clipped = 0
+    if not score_saturated:
+        cp = p0 if clip_params is None else clip_params
+        for m in mans:
+            mask = _clipped_sliding(m, cp, odict, slip_threshold)
+            if np.any(mask):
+                m.omega = np.where(mask, np.nan, m.omega)
+                n_clipped += int(mask.sum())
     val_idx = _split(keys, validation, seed)
     train_m = [m for i, m in enumerate(mans) if i not in set(val_idx)]
     val_m = [mans[i] for i in val_idx]
@@ -1399,12 +1412,12 @@ def identify(
                     f"determined to +-{100 * sd:.2g} %, {free_t[i]} alone to "
                     f"+-{100 * stderr_log[i]:.2g} %"
                 )
-    if int(ev["saturated"]):
-        n_sat = int(ev["saturated"])
+    if n_clipped:
+        n_all = sum(m.n for m in mans)
         ident.append(
-            f"{n_sat} training samples ({100 * n_sat / max(n_sat + int(cnt.sum()), 1):.1f} %) "
-            "not scored: sliding with the CoR clipped at c_max (translation beyond the clip), "
-            "where omega_hat is the slip about the clipped CoR, not the object's rotation"
+            f"{n_clipped} samples ({100 * n_clipped / max(n_all, 1):.1f} %) not scored: "
+            "sliding with the CoR clipped at c_max (translation beyond the clip), where "
+            "omega_hat is the slip about the clipped CoR, not the object's rotation"
         )
     if int(ev["truncated"]):
         ident.append(
@@ -1491,7 +1504,7 @@ def identify(
         samples_train=int(cnt.sum()),
         samples_validation=n_val,
         truncated=int(ev["truncated"]),
-        samples_saturated=int(ev["saturated"]),
+        samples_saturated=n_clipped,
         settings={
             "loss": loss,
             "huber_scale": float(huber_scale),
@@ -1509,6 +1522,73 @@ def identify(
         },
         validation_trace=trace_val,
     )
+
+
+def _clipped_sliding(
+    m: _Maneuver, params: ContactParams, odict: Mapping[str, Any], slip_threshold: float
+) -> np.ndarray:
+    """Samples of a maneuver where the online observer (run per segment, as in the cost) clips
+    the CoR at c_max while the ground truth slides (|omega| > slip_threshold)."""
+    mask = np.zeros(m.n, dtype=bool)
+    for a, b in zip(m.starts[:-1], m.starts[1:]):
+        run = Observer(params, **odict).run(
+            {"f_n": m.f_n[a:b], "f_t": m.f_t[a:b], "tau": m.tau[a:b], "t": m.t[a:b]}
+        )
+        mask[a:b] = np.asarray(run.saturated, dtype=bool)
+    with np.errstate(invalid="ignore"):
+        return mask & (np.abs(m.omega) > slip_threshold)
+
+
+@functools.wraps(_identify_pass)
+def identify(logs, params0=None, **kwargs) -> IdentificationResult:
+    # Without score_saturated the clipped-CoR samples are found at fixed parameters: the start
+    # for the first pass, then the previous pass's result (each pass starts from the same
+    # point), until the set and the estimates settle (at most 4 passes).
+    if "clip_params" in kwargs:
+        raise TypeError("identify() got an unexpected keyword argument 'clip_params'")
+    t0 = time.perf_counter()
+    r = _identify_pass(logs, params0, **kwargs)
+    if kwargs.get("score_saturated", False):
+        return r
+    passes, fit_time = 1, r.fit_time
+    if r.samples_saturated == 0:
+        # nothing clipped at the start: check the result without refitting (no iteration)
+        probe_kw = {**kwargs, "max_iterations": 0, "progress": None, "uncertainty": "gauss-newton"}
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")
+            probe = _identify_pass(logs, r.params, clip_params=r.params, **probe_kw)
+        if probe.samples_saturated == 0:
+            return dataclasses.replace(r, wall_time=time.perf_counter() - t0)
+    for _ in range(3):
+        nxt = _identify_pass(logs, params0, clip_params=r.params, **kwargs)
+        passes += 1
+        fit_time += nxt.fit_time
+        same_set = nxt.samples_saturated == r.samples_saturated
+        change = (
+            max(abs(math.log(getattr(nxt.params, n) / getattr(r.params, n))) for n in nxt.free)
+            if nxt.free
+            else 0.0
+        )
+        r = nxt
+        if same_set and change < 1e-3:
+            break
+    note = (
+        f"{passes} fits: the clipped-CoR samples were located at the previous fit's result "
+        "until the set settled"
+    )
+    return dataclasses.replace(
+        r,
+        identifiability=(*r.identifiability, note) if r.samples_saturated else r.identifiability,
+        wall_time=time.perf_counter() - t0,
+        fit_time=fit_time,
+    )
+
+
+_sig = inspect.signature(_identify_pass)
+identify.__signature__ = _sig.replace(
+    parameters=[q for q in _sig.parameters.values() if q.name != "clip_params"]
+)
+del _sig
 
 
 @dataclasses.dataclass
