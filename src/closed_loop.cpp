@@ -3,21 +3,16 @@
 
 #include <algorithm>
 #include <cmath>
-#include <cstdio>
-#include <cstdlib>
 #include <sstream>
 #include <stdexcept>
+
+#include "format.hpp"
 
 namespace lugrip {
 
 namespace {
 
-std::string num(double v) {
-  char buf[40];
-  std::snprintf(buf, sizeof buf, "%.15g", v);
-  if (std::strtod(buf, nullptr) != v) std::snprintf(buf, sizeof buf, "%.17g", v);
-  return buf;
-}
+std::string num(double v) { return detail::format_number(v); }
 
 // Prefixes every line of a sub-validator's message.
 void append_prefixed(std::string& msg, const std::string& sub, const char* prefix) {

@@ -6,6 +6,8 @@
 #include <stdexcept>
 #include <string>
 
+#include "format.hpp"
+
 namespace lugrip {
 
 namespace {
@@ -57,7 +59,7 @@ ContactModel::ContactModel(const ContactParams& params) : p_(checked(params)), l
     grid_a[j] = a;
     grid_s[j] = gp1 * std::log(q.F) - std::log(q.T);
     if (j > 0 && !(grid_s[j] > grid_s[j - 1]))
-      throw std::logic_error("ContactModel: sigma_LS is not increasing at a = " + std::to_string(a));
+      throw std::logic_error("ContactModel: sigma_LS is not increasing at a = " + detail::format_number(a));
   }
   inv_s0_ = grid_s.front();
   inv_s1_ = grid_s.back();
@@ -195,7 +197,7 @@ bool validate(const CorSettings& s, std::string* message) {
   std::string msg;
   auto positive = [&](const char* name, double v) {
     if (!(std::isfinite(v) && v > 0.0))
-      msg += std::string(name) + " = " + std::to_string(v) + ": must be finite and > 0\n";
+      msg += std::string(name) + " = " + detail::format_number(v) + ": must be finite and > 0\n";
   };
   positive("f_n_min", s.f_n_min);
   positive("force_limit", s.force_limit);

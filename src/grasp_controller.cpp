@@ -2,10 +2,10 @@
 
 #include <algorithm>
 #include <cmath>
-#include <cstdio>
-#include <cstdlib>
 #include <limits>
 #include <stdexcept>
+
+#include "format.hpp"
 
 namespace lugrip {
 
@@ -17,12 +17,7 @@ constexpr double kMaxSlippage = 1.0e3;
 constexpr double kMaxInput = 1.0e6;
 
 // Shortest of %.15g / %.17g that reads back exactly.
-std::string fmt(double v) {
-  char buf[40];
-  std::snprintf(buf, sizeof buf, "%.15g", v);
-  if (std::strtod(buf, nullptr) != v) std::snprintf(buf, sizeof buf, "%.17g", v);
-  return buf;
-}
+std::string fmt(double v) { return detail::format_number(v); }
 
 double clamp(double v, double lo, double hi) noexcept { return v < lo ? lo : (v > hi ? hi : v); }
 

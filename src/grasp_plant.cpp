@@ -10,6 +10,8 @@
 
 #include "lugrip/slider_model.hpp"
 
+#include "format.hpp"
+
 namespace lugrip {
 
 namespace {
@@ -26,12 +28,7 @@ long integer_ratio(double x, double y) {
   return static_cast<long>(n);
 }
 
-std::string num(double x) {
-  std::ostringstream s;
-  s.precision(17);
-  s << x;
-  return s.str();
-}
+std::string num(double v) { return detail::format_number(v); }
 
 const PlantConfig& checked(const PlantConfig& c) {
   std::string msg;

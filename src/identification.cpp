@@ -3,7 +3,6 @@
 #include <algorithm>
 #include <atomic>
 #include <cmath>
-#include <cstdio>
 #include <exception>
 #include <limits>
 #include <stdexcept>
@@ -11,6 +10,8 @@
 #include <thread>
 
 #include "lugrip/detail/rotor_steps.hpp"
+
+#include "format.hpp"
 
 namespace lugrip {
 
@@ -25,11 +26,7 @@ constexpr int kSigmaZ = static_cast<int>(IdParam::SigmaZ);
 constexpr int kDelta = static_cast<int>(IdParam::Delta);
 constexpr int kGamma = static_cast<int>(IdParam::Gamma);
 
-std::string fmt(double v) {
-  char buf[40];
-  std::snprintf(buf, sizeof buf, "%.17g", v);
-  return buf;
-}
+std::string fmt(double v) { return detail::format_number(v); }
 
 // ------------------------------------------------------------------------------------------
 // Forward-mode dual number: value and derivatives with respect to the six parameters. The value

@@ -2,21 +2,18 @@
 
 #include <algorithm>
 #include <cmath>
-#include <cstdio>
 #include <limits>
 #include <stdexcept>
 #include <string>
+
+#include "format.hpp"
 
 namespace lugrip {
 
 namespace {
 constexpr double kTwoPi = 6.28318530717958647692;
 
-std::string fmt(double v) {
-  char buf[40];
-  std::snprintf(buf, sizeof buf, "%.17g", v);
-  return buf;
-}
+std::string fmt(double v) { return detail::format_number(v); }
 
 const ObserverSettings& checked(const ObserverSettings& s) {
   std::string msg;

@@ -1,25 +1,18 @@
 #include "lugrip/params.hpp"
 
 #include <cmath>
-#include <cstdio>
-#include <cstdlib>
 #include <stdexcept>
 
 #include "lugrip/limit_surface.hpp"
 #include "lugrip/status.hpp"
 
+#include "format.hpp"
+
 namespace lugrip {
 
 namespace {
 // Shortest decimal that reads back as the same double (0.4, not 0.40000000000000002).
-std::string fmt(double v) {
-  char buf[40];
-  for (int precision = 6; precision <= 17; ++precision) {
-    std::snprintf(buf, sizeof buf, "%.*g", precision, v);
-    if (std::strtod(buf, nullptr) == v || std::isnan(v)) break;
-  }
-  return buf;
-}
+std::string fmt(double v) { return detail::format_number(v); }
 }  // namespace
 
 bool validate(const ContactParams& p, std::string* message) {
