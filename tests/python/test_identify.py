@@ -716,3 +716,20 @@ def test_cli_rubbing(tmp_path, capsys):
     assert obj.beta_a == pytest.approx(RESIN.beta_a, rel=0.05)
     assert obj.sigma0 == TABLE1.sigma0
     assert "rubbing (rotation" in capsys.readouterr().out
+
+
+def test_cli_identify_does_not_overwrite_without_force(tmp_path, capsys):
+    """An existing --out file is refused before any work (exit 2, one line); --force replaces it."""
+    from lugrip.cli import main
+
+    log = simulate_sliding(TABLE1, 3, seed=12, c_range=(0.02, 1.4))
+    csv = tmp_path / "log.csv"
+    lugrip.write_log(log, csv)
+    out = tmp_path / "fit.yaml"
+    out.write_text("keep me\n")
+    args = ["identify", str(csv), "--out", str(out), "--quiet", "--validation", "0"]
+    assert main(args + ["--max-iterations", "1"]) == 2
+    assert "exists; pass --force" in capsys.readouterr().err
+    assert out.read_text() == "keep me\n"
+    assert main(args + ["--max-iterations", "1", "--force"]) == 0
+    assert ContactParams.from_yaml(out).mu > 0

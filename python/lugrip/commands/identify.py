@@ -52,7 +52,8 @@ def register(subparsers) -> None:
         type=Path,
         required=True,
         metavar="YAML",
-        help="write the identified parameters (value, unit, std. error, bounds)",
+        help="write the identified parameters (value, unit, std. error, bounds); an existing "
+        "file is only replaced with --force",
     )
     p.add_argument(
         "--free",
@@ -149,6 +150,7 @@ def register(subparsers) -> None:
         "left out, omega_hat there is the slip about the clipped CoR, not the rotation)",
     )
     p.add_argument("--threads", type=int, default=0, help="C++ worker threads (0: all cores)")
+    p.add_argument("--force", action="store_true", help="overwrite an existing --out file")
     p.add_argument(
         "--rubbing",
         action="store_true",
@@ -283,6 +285,8 @@ def run(args) -> int:
     for path in args.logs:
         if not path.exists():
             raise CliError(f"{path}: no such file")
+    if args.out.exists() and not args.force:  # checked before any work
+        raise CliError(f"argument --out: {args.out} exists; pass --force to overwrite it")
     if args.rubbing:
         if args.params0 is None:
             raise CliError("--rubbing needs --params0 (the fingertip's delta and gamma)")
