@@ -1165,9 +1165,9 @@ def _identify_pass(
     # identify() repeats the fit with the set found at the previous result until it settles.
     n_clipped = 0
     if not score_saturated:
-        cp = p0 if clip_params is None else clip_params
+        online = Observer(p0 if clip_params is None else clip_params, **odict)
         for m in mans:
-            mask = _clipped_sliding(m, cp, odict, slip_threshold)
+            mask = _clipped_sliding(m, online, slip_threshold)
             if np.any(mask):
                 m.omega = np.where(mask, np.nan, m.omega)
                 n_clipped += int(mask.sum())
@@ -1524,16 +1524,12 @@ def _identify_pass(
     )
 
 
-def _clipped_sliding(
-    m: _Maneuver, params: ContactParams, odict: Mapping[str, Any], slip_threshold: float
-) -> np.ndarray:
-    """Samples of a maneuver where the online observer (run per segment, as in the cost) clips
-    the CoR at c_max while the ground truth slides (|omega| > slip_threshold)."""
+def _clipped_sliding(m: _Maneuver, observer: Observer, slip_threshold: float) -> np.ndarray:
+    """Samples of a maneuver where the online observer (restarted per segment, as in the cost)
+    clips the CoR at c_max while the ground truth slides (|omega| > slip_threshold)."""
     mask = np.zeros(m.n, dtype=bool)
     for a, b in zip(m.starts[:-1], m.starts[1:]):
-        run = Observer(params, **odict).run(
-            {"f_n": m.f_n[a:b], "f_t": m.f_t[a:b], "tau": m.tau[a:b], "t": m.t[a:b]}
-        )
+        run = observer.run({"f_n": m.f_n[a:b], "f_t": m.f_t[a:b], "tau": m.tau[a:b], "t": m.t[a:b]})
         mask[a:b] = np.asarray(run.saturated, dtype=bool)
     with np.errstate(invalid="ignore"):
         return mask & (np.abs(m.omega) > slip_threshold)
@@ -1542,45 +1538,35 @@ def _clipped_sliding(
 @functools.wraps(_identify_pass)
 def identify(logs, params0=None, **kwargs) -> IdentificationResult:
     # Without score_saturated the clipped-CoR samples are found at fixed parameters: the start
-    # for the first pass, then the previous pass's result (each pass starts from the same
-    # point), until the set and the estimates settle (at most 4 passes).
+    # for the first fit, then each fit's result; the fit is repeated (from the same start) while
+    # the set located at its result differs from the one it used (at most 4 fits).
     if "clip_params" in kwargs:
         raise TypeError("identify() got an unexpected keyword argument 'clip_params'")
     t0 = time.perf_counter()
     r = _identify_pass(logs, params0, **kwargs)
     if kwargs.get("score_saturated", False):
         return r
-    passes, fit_time = 1, r.fit_time
-    if r.samples_saturated == 0:
-        # nothing clipped at the start: check the result without refitting (no iteration)
-        probe_kw = {**kwargs, "max_iterations": 0, "progress": None, "uncertainty": "gauss-newton"}
+    probe_kw = {**kwargs, "max_iterations": 0, "progress": None, "uncertainty": "gauss-newton"}
+    fits, fit_time = 1, r.fit_time
+    for _ in range(3):
+        # the set at the result, without fitting (no iteration)
         with warnings.catch_warnings():
             warnings.simplefilter("ignore")
             probe = _identify_pass(logs, r.params, clip_params=r.params, **probe_kw)
-        if probe.samples_saturated == 0:
-            return dataclasses.replace(r, wall_time=time.perf_counter() - t0)
-    for _ in range(3):
-        nxt = _identify_pass(logs, params0, clip_params=r.params, **kwargs)
-        passes += 1
-        fit_time += nxt.fit_time
-        same_set = nxt.samples_saturated == r.samples_saturated
-        change = (
-            max(abs(math.log(getattr(nxt.params, n) / getattr(r.params, n))) for n in nxt.free)
-            if nxt.free
-            else 0.0
-        )
-        r = nxt
-        if same_set and change < 1e-3:
+        if probe.samples_saturated == r.samples_saturated:
             break
-    note = (
-        f"{passes} fits: the clipped-CoR samples were located at the previous fit's result "
-        "until the set settled"
-    )
+        r = _identify_pass(logs, params0, clip_params=r.params, **kwargs)
+        fits += 1
+        fit_time += r.fit_time
+    notes = r.identifiability
+    if fits > 1:
+        note = (
+            f"{fits} fits: the clipped-CoR samples were located again at each fit's result "
+            "until the set settled"
+        )
+        notes = (*notes, note)
     return dataclasses.replace(
-        r,
-        identifiability=(*r.identifiability, note) if r.samples_saturated else r.identifiability,
-        wall_time=time.perf_counter() - t0,
-        fit_time=fit_time,
+        r, identifiability=notes, wall_time=time.perf_counter() - t0, fit_time=fit_time
     )
 
 
