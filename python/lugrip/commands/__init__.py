@@ -20,7 +20,15 @@ from __future__ import annotations
 import argparse
 import math
 
-__all__ = ["COMMANDS", "CliError", "HelpFormatter", "k_label", "parse_k", "positive_float"]
+__all__ = [
+    "COMMANDS",
+    "CliError",
+    "HelpFormatter",
+    "k_label",
+    "observer_options",
+    "parse_k",
+    "positive_float",
+]
 
 COMMANDS: list[str] = [
     "ls",
@@ -88,3 +96,20 @@ def k_label(k: float) -> str:
     if math.isinf(k):
         return "inf"
     return f"{k:g}"
+
+
+def observer_options(block, args) -> dict:
+    """Observer keywords: a parameter file's ``observer:`` block (without its ``dt``: the
+    nominal sample period is the log's) with the command's --integrator and --gain or
+    --bandwidth (a mutually exclusive pair: either one sets the gain mode) on top."""
+    kwargs = dict(block or {})
+    kwargs.pop("dt", None)
+    if args.integrator is not None:
+        kwargs["integrator"] = args.integrator
+    if args.gain is not None:
+        kwargs["gain"] = args.gain
+        kwargs["gain_mode"] = "fixed"
+    if args.bandwidth is not None:
+        kwargs["bandwidth"] = args.bandwidth
+        kwargs["gain_mode"] = "bandwidth"
+    return kwargs

@@ -9,7 +9,7 @@ import sys
 import time
 from pathlib import Path
 
-from . import CliError, positive_float
+from . import CliError, observer_options, positive_float
 
 __all__ = ["ProgressBar", "register", "run", "write_report"]
 
@@ -323,25 +323,17 @@ def run(args) -> int:
         print(f"wrote {args.out}")
         return 0
 
-    observer = {}
+    block = None
     if args.params0 is not None and args.params0.suffix in (".yaml", ".yml"):
         from .._params import read_observer_settings
 
         if not args.params0.exists():
             raise CliError(f"argument --params0: {args.params0}: no such file")
         try:
-            observer = dict(read_observer_settings(args.params0) or {})
+            block = read_observer_settings(args.params0)
         except ValueError as err:
             raise CliError(f"argument --params0: {err}") from None
-        observer.pop("dt", None)  # the nominal sample period is the logs'
-    if args.integrator is not None:
-        observer["integrator"] = args.integrator
-    if args.bandwidth is not None:
-        observer["bandwidth"] = args.bandwidth
-        observer["gain_mode"] = "bandwidth"
-    if args.gain is not None:
-        observer["gain"] = args.gain
-        observer["gain_mode"] = "fixed"
+    observer = observer_options(block, args)
     if args.free is not None and args.params0 is None:
         raise CliError("--free needs --params0 for the values of the fixed parameters")
     bar = None if args.quiet else ProgressBar(args.max_iterations)

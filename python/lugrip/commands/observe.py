@@ -13,7 +13,7 @@ import textwrap
 import time
 from pathlib import Path
 
-from . import CliError, positive_float
+from . import CliError, observer_options, positive_float
 from .simulate_sliding import add_params_arguments, load_params
 
 __all__ = ["OUTPUT_COLUMNS", "demo_section", "register", "run", "write_estimates"]
@@ -256,16 +256,7 @@ def observer_block(args) -> dict | None:
 def _observer(params, args, dt: float, block: dict | None = None):
     from .. import Observer
 
-    kwargs = dict(block or {})
-    kwargs.pop("dt", None)  # the nominal sample period is the log's
-    if args.integrator is not None:
-        kwargs["integrator"] = args.integrator
-    if args.gain is not None:
-        kwargs["gain"] = args.gain
-        kwargs["gain_mode"] = "fixed"
-    if args.bandwidth is not None:
-        kwargs["bandwidth"] = args.bandwidth
-        kwargs["gain_mode"] = "bandwidth"
+    kwargs = observer_options(block, args)
     if args.torque_noise is not None:
         kwargs["torque_noise"] = args.torque_noise
     if args.torque_cutoff is not None:
