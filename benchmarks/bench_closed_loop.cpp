@@ -16,37 +16,21 @@
 // allocation count of the timed loops is reported. --markdown prints the issue-5 section of
 // BENCHMARKS.md (between <!-- issue5:begin --> and <!-- issue5:end -->, which it replaces).
 #include <algorithm>
-#include <atomic>
-#include <chrono>
-#include <cmath>
 #include <cstdio>
-#include <cstdlib>
 #include <cstring>
-#include <new>
 #include <string>
 #include <vector>
 
+#include "bench_timing.hpp"  // timing helpers; includes the allocation counter (counting_new.hpp)
 #include "lugrip/closed_loop.hpp"
-
-#ifndef LUGRIP_BENCH_CXX_FLAGS
-#define LUGRIP_BENCH_CXX_FLAGS "unknown"
-#endif
-#ifndef LUGRIP_BENCH_BUILD_TYPE
-#define LUGRIP_BENCH_BUILD_TYPE "unknown"
-#endif
-
-#include "counting_new.hpp"
 
 using namespace lugrip;
 
 namespace {
 
-using Clock = std::chrono::steady_clock;
+using lugrip_bench::Clock;
+using lugrip_bench::seconds_between;
 volatile double g_sink = 0.0;
-
-double seconds_between(Clock::time_point a, Clock::time_point b) {
-  return std::chrono::duration<double>(b - a).count();
-}
 
 ClosedLoopConfig scenario(PlantModel model, double plant_rate) {
   ClosedLoopConfig c;
@@ -72,13 +56,6 @@ struct Result {
   long steps = 0, allocations = 0;
   int cells = 0;
 };
-
-double percentile(std::vector<double>& v, double q) {
-  if (v.empty()) return 0.0;
-  const size_t i = std::min(v.size() - 1, static_cast<size_t>(q * (v.size() - 1) + 0.5));
-  std::nth_element(v.begin(), v.begin() + static_cast<long>(i), v.end());
-  return v[i];
-}
 
 // Whole runs of `samples` closed-loop steps from reset(), repeated `reps` times.
 Result bench_loop(const char* name, const ClosedLoopConfig& cfg, long samples, int reps) {
@@ -109,24 +86,12 @@ Result bench_loop(const char* name, const ClosedLoopConfig& cfg, long samples, i
   r.realtime_best = r.steps_per_s_best * loop.sample_period();
   r.realtime_median = r.steps_per_s_median * loop.sample_period();
   // per-step pass: every step timed alone (overhead of an empty timed region subtracted)
-  std::vector<double> empty(2000);
-  for (double& e : empty) {
-    const auto a = Clock::now();
-    const auto b = Clock::now();
-    e = std::chrono::duration<double, std::nano>(b - a).count();
-  }
-  const double overhead = percentile(empty, 0.5);
-  std::vector<double> each(static_cast<size_t>(samples));
-  loop.reset();
-  for (long n = 0; n < samples; ++n) {
-    const auto a = Clock::now();
-    loop.step(s);
-    const auto b = Clock::now();
-    each[static_cast<size_t>(n)] = std::max(0.0, std::chrono::duration<double, std::nano>(b - a).count() - overhead);
-  }
+  const double overhead = lugrip_bench::timer_overhead_ns(2000);
+  std::vector<double> each = lugrip_bench::time_each_ns(
+      static_cast<int>(samples), 1, overhead, false, [&] { loop.reset(); }, [&](int) { loop.step(s); });
   r.worst_ns = *std::max_element(each.begin(), each.end());
-  r.p99_ns = percentile(each, 0.99);
-  r.p50_ns = percentile(each, 0.5);
+  r.p99_ns = lugrip_bench::percentile_nearest(each, 0.99);
+  r.p50_ns = lugrip_bench::percentile_nearest(each, 0.5);
   return r;
 }
 

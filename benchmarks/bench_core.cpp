@@ -21,123 +21,44 @@
 //
 // Output: a human-readable table, or JSON on stdout with --json (for run_benchmarks.py).
 // Benchmarks are not tests: nothing here asserts a timing.
-#include <algorithm>
-#include <atomic>
-#include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
 #include <limits>
-#include <new>
 #include <random>
 #include <string>
 #include <vector>
 
+#include "bench_timing.hpp"  // timing helpers; includes the allocation counter (counting_new.hpp)
 #include "lugrip/contact.hpp"
 #include "lugrip/limit_surface.hpp"
 #include "lugrip/params.hpp"
 
-#ifndef LUGRIP_BENCH_CXX_FLAGS
-#define LUGRIP_BENCH_CXX_FLAGS "unknown"
-#endif
-#ifndef LUGRIP_BENCH_BUILD_TYPE
-#define LUGRIP_BENCH_BUILD_TYPE "unknown"
-#endif
-
-// ---- allocation counter: the timed loops must not allocate ---------------------------------
-#include "counting_new.hpp"
-
 namespace {
 
-using Clock = std::chrono::steady_clock;
-constexpr int kBatch = 16;
+using lugrip_bench::Clock;
+using lugrip_bench::compiler_string;
+using lugrip_bench::json_escape;
+using lugrip_bench::kBatch;
+using lugrip_bench::macro_flags;
+using lugrip_bench::ns_between;
+using lugrip_bench::Stats;
+using lugrip_bench::summarize;
+
 volatile double g_sink = 0.0;  // keeps results observable
-
-double ns_between(Clock::time_point a, Clock::time_point b) {
-  return std::chrono::duration<double, std::nano>(b - a).count();
-}
-
-struct Stats {
-  double median = 0, p99 = 0, worst = 0, mean = 0, best = 0;
-  long calls = 0;
-  long allocations = 0;
-};
-
-double percentile(std::vector<double>& v, double q) {  // v is sorted
-  if (v.empty()) return 0.0;
-  const double pos = q * (v.size() - 1);
-  const size_t i = static_cast<size_t>(pos);
-  const double f = pos - i;
-  return i + 1 < v.size() ? v[i] * (1 - f) + v[i + 1] * f : v[i];
-}
-
-Stats summarize(std::vector<double> per_call, long calls) {
-  Stats s;
-  std::sort(per_call.begin(), per_call.end());
-  s.median = percentile(per_call, 0.5);
-  s.p99 = percentile(per_call, 0.99);
-  s.worst = per_call.back();
-  s.best = per_call.front();
-  double sum = 0;
-  for (double x : per_call) sum += x;
-  s.mean = sum / per_call.size();
-  s.calls = calls;
-  return s;
-}
-
-// Median cost of an empty timed region (two clock reads), subtracted from every batch.
-double timer_overhead_ns() {
-  std::vector<double> v(20000);
-  for (auto& x : v) {
-    const auto t0 = Clock::now();
-    const auto t1 = Clock::now();
-    x = ns_between(t0, t1);
-  }
-  std::sort(v.begin(), v.end());
-  return v[v.size() / 2];
-}
-
-double g_overhead = 0.0;
+double g_overhead = 0.0;       // timer overhead, subtracted from every timed batch / call
 
 // Calls fn(i) for i over `n_inputs` precomputed inputs, `rounds` times, in batches of kBatch.
 template <class Fn>
 Stats time_batched(Fn&& fn, int n_inputs, int rounds) {
-  const int batches = n_inputs / kBatch;
-  std::vector<double> per_call;
-  per_call.reserve(static_cast<size_t>(batches) * rounds);
-  for (int i = 0; i < n_inputs; ++i) fn(i);  // warm-up: caches, branch predictors
-  const long alloc0 = lugrip_support::g_allocations.load();
-  for (int r = 0; r < rounds; ++r) {
-    for (int b = 0; b < batches; ++b) {
-      const int i0 = b * kBatch;
-      const auto t0 = Clock::now();
-      for (int i = i0; i < i0 + kBatch; ++i) fn(i);
-      const auto t1 = Clock::now();
-      per_call.push_back(std::max(0.0, ns_between(t0, t1) - g_overhead) / kBatch);
-    }
-  }
-  const long alloc1 = lugrip_support::g_allocations.load();
-  Stats s = summarize(std::move(per_call), static_cast<long>(batches) * kBatch * rounds);
-  // the vector push_back above reserved its storage first, so any count is the callee's
-  s.allocations = alloc1 - alloc0;
-  return s;
+  return lugrip_bench::time_batched(n_inputs, rounds, g_overhead, [] {}, fn);
 }
 
+// Every call timed alone, after a warm-up pass.
 template <class Fn>
 Stats time_single(Fn&& fn, int n_inputs, int rounds) {
-  std::vector<double> per_call;
-  per_call.reserve(static_cast<size_t>(n_inputs) * rounds);
-  for (int i = 0; i < n_inputs; ++i) fn(i);
-  for (int r = 0; r < rounds; ++r) {
-    for (int i = 0; i < n_inputs; ++i) {
-      const auto t0 = Clock::now();
-      fn(i);
-      const auto t1 = Clock::now();
-      per_call.push_back(std::max(0.0, ns_between(t0, t1) - g_overhead));
-    }
-  }
-  return summarize(std::move(per_call), static_cast<long>(n_inputs) * rounds);
+  return lugrip_bench::time_each(n_inputs, rounds, g_overhead, true, [] {}, fn);
 }
 
 // ---- inputs ----------------------------------------------------------------------------------
@@ -189,15 +110,6 @@ struct Row {
   bool ms = false;           // construction rows are in milliseconds
 };
 
-std::string json_escape(const std::string& s) {
-  std::string r;
-  for (char c : s) {
-    if (c == '"' || c == '\\') r += '\\';
-    r += c;
-  }
-  return r;
-}
-
 std::string num(double x) {
   char buf[64];
   std::snprintf(buf, sizeof buf, "%.6g", x);
@@ -210,54 +122,6 @@ std::string stats_json(const Stats& s, const char* unit) {
          ", \"worst_" + u + "\": " + num(s.worst) + ", \"mean_" + u + "\": " + num(s.mean) +
          ", \"best_" + u + "\": " + num(s.best) + ", \"calls\": " + std::to_string(s.calls) +
          ", \"allocations\": " + std::to_string(s.allocations) + "}";
-}
-
-std::string compiler_string() {
-#if defined(__clang__)
-  return std::string("clang ") + __clang_version__;
-#elif defined(__GNUC__)
-  return std::string("gcc ") + __VERSION__;
-#elif defined(_MSC_VER)
-  return "msvc " + std::to_string(_MSC_VER);
-#else
-  return "unknown";
-#endif
-}
-
-std::string macro_flags() {
-  std::string f;
-#if defined(__OPTIMIZE__)
-  f += "__OPTIMIZE__ ";
-#endif
-#if defined(__OPTIMIZE_SIZE__)
-  f += "__OPTIMIZE_SIZE__ ";
-#endif
-#if defined(__NO_INLINE__)
-  f += "__NO_INLINE__ ";
-#endif
-#if defined(NDEBUG)
-  f += "NDEBUG ";
-#endif
-#if defined(__FAST_MATH__)
-  f += "__FAST_MATH__ ";
-#endif
-#if defined(__SSE2__)
-  f += "__SSE2__ ";
-#endif
-#if defined(__AVX__)
-  f += "__AVX__ ";
-#endif
-#if defined(__AVX2__)
-  f += "__AVX2__ ";
-#endif
-#if defined(__FMA__)
-  f += "__FMA__ ";
-#endif
-#if defined(__SANITIZE_ADDRESS__)
-  f += "__SANITIZE_ADDRESS__ ";
-#endif
-  f += "__cplusplus=" + std::to_string(__cplusplus);
-  return f;
 }
 
 void print_text(const std::vector<Row>& rows) {
@@ -451,7 +315,7 @@ int main(int argc, char** argv) {
     }
   }
   std::mt19937 rng(seed);
-  g_overhead = timer_overhead_ns();
+  g_overhead = lugrip_bench::timer_overhead_ns();
   std::vector<Row> rows;
   bench_ls_eval(rows, rng, quick);
   bench_cor(rows, rng, quick, "table1");

@@ -26,117 +26,41 @@
 // timed loops are counted (global operator new replaced): they must be 0.
 // Output: a table, or JSON with --json (for benchmarks/observer_report.py). No assertion on times.
 #include <algorithm>
-#include <atomic>
-#include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
-#include <new>
 #include <random>
 #include <string>
 #include <vector>
 
+#include "bench_timing.hpp"  // timing helpers; includes the allocation counter (counting_new.hpp)
 #include "lugrip/contact.hpp"
 #include "lugrip/observer.hpp"
 #include "lugrip/params.hpp"
 #include "lugrip/slider_model.hpp"
 
-#ifndef LUGRIP_BENCH_CXX_FLAGS
-#define LUGRIP_BENCH_CXX_FLAGS "unknown"
-#endif
-#ifndef LUGRIP_BENCH_BUILD_TYPE
-#define LUGRIP_BENCH_BUILD_TYPE "unknown"
-#endif
-
-#include "counting_new.hpp"
-
 namespace {
 
-using Clock = std::chrono::steady_clock;
-constexpr int kBatch = 16;
+using lugrip_bench::compiler_string;
+using lugrip_bench::json_escape;
+using lugrip_bench::kBatch;
+using lugrip_bench::Stats;
+
 constexpr double kDt = 0.002;
 volatile double g_sink = 0.0;
-
-double elapsed_ns(Clock::time_point a, Clock::time_point b) {
-  return std::chrono::duration<double, std::nano>(b - a).count();
-}
-
-struct Summary {
-  double median = 0, p99 = 0, mean = 0, worst = 0;
-  long calls = 0, allocations = 0;
-};
-
-double quantile(const std::vector<double>& sorted, double q) {
-  if (sorted.empty()) return 0.0;
-  const double pos = q * static_cast<double>(sorted.size() - 1);
-  const size_t i = static_cast<size_t>(pos);
-  const double frac = pos - static_cast<double>(i);
-  return i + 1 < sorted.size() ? sorted[i] + frac * (sorted[i + 1] - sorted[i]) : sorted[i];
-}
-
-Summary summarise(std::vector<double> v, long calls) {
-  Summary s;
-  std::sort(v.begin(), v.end());
-  s.median = quantile(v, 0.5);
-  s.p99 = quantile(v, 0.99);
-  s.worst = v.empty() ? 0.0 : v.back();
-  double total = 0.0;
-  for (double x : v) total += x;
-  s.mean = v.empty() ? 0.0 : total / static_cast<double>(v.size());
-  s.calls = calls;
-  return s;
-}
-
-double empty_timer_ns() {
-  std::vector<double> v(20000);
-  for (double& x : v) {
-    const auto a = Clock::now();
-    const auto b = Clock::now();
-    x = elapsed_ns(a, b);
-  }
-  std::sort(v.begin(), v.end());
-  return v[v.size() / 2];
-}
-
-double g_timer = 0.0;
+double g_timer = 0.0;  // timer overhead, subtracted from every timed batch / step
 
 // One pass over the stream in batches of kBatch (after `prepare()`), `passes` times.
 template <class Prepare, class Step>
-Summary time_stream(int n, int passes, Prepare&& prepare, Step&& step) {
-  const int batches = n / kBatch;
-  std::vector<double> per_step;
-  per_step.reserve(static_cast<size_t>(batches) * passes);
-  prepare();
-  for (int i = 0; i < n; ++i) step(i);  // warm-up
-  const long a0 = lugrip_support::g_allocations.load();
-  for (int p = 0; p < passes; ++p) {
-    prepare();
-    for (int b = 0; b < batches; ++b) {
-      const int i0 = b * kBatch;
-      const auto t0 = Clock::now();
-      for (int i = i0; i < i0 + kBatch; ++i) step(i);
-      const auto t1 = Clock::now();
-      per_step.push_back(std::max(0.0, elapsed_ns(t0, t1) - g_timer) / kBatch);
-    }
-  }
-  Summary s = summarise(std::move(per_step), static_cast<long>(batches) * kBatch * passes);
-  s.allocations = lugrip_support::g_allocations.load() - a0;
-  return s;
+Stats time_stream(int n, int passes, Prepare&& prepare, Step&& step) {
+  return lugrip_bench::time_batched(n, passes, g_timer, prepare, step);
 }
 
+// Every step of one pass timed alone (after `prepare()`, no warm-up).
 template <class Prepare, class Step>
-Summary time_single(int n, Prepare&& prepare, Step&& step) {
-  std::vector<double> per_step;
-  per_step.reserve(static_cast<size_t>(n));
-  prepare();
-  for (int i = 0; i < n; ++i) {
-    const auto t0 = Clock::now();
-    step(i);
-    const auto t1 = Clock::now();
-    per_step.push_back(std::max(0.0, elapsed_ns(t0, t1) - g_timer));
-  }
-  return summarise(std::move(per_step), n);
+Stats time_single(int n, Prepare&& prepare, Step&& step) {
+  return lugrip_bench::time_each(n, 1, g_timer, false, prepare, step);
 }
 
 // ---- input stream ------------------------------------------------------------------------------
@@ -209,23 +133,12 @@ Stream make_stream(const lugrip::ContactParams& p, int n_samples, unsigned seed)
 
 struct Row {
   std::string params, name, detail;
-  Summary batched;
+  Stats batched;
   bool has_single = false;
-  Summary single;
+  Stats single;
   double mean_substeps = 0.0, mean_cor_iterations = 0.0;
   long diverged = 0;
 };
-
-const char* compiler() {
-#if defined(__clang__)
-  static const std::string s = std::string("clang ") + __clang_version__;
-#elif defined(__GNUC__)
-  static const std::string s = std::string("gcc ") + __VERSION__;
-#else
-  static const std::string s = "unknown";
-#endif
-  return s.c_str();
-}
 
 void run_params(const char* label, const lugrip::ContactParams& p, const Stream& stream, int passes,
                 std::vector<Row>& rows) {
@@ -306,16 +219,7 @@ void run_params(const char* label, const lugrip::ContactParams& p, const Stream&
   rows.push_back(r);
 }
 
-std::string escape(const std::string& s) {
-  std::string o;
-  for (char c : s) {
-    if (c == '"' || c == '\\') o += '\\';
-    o += c;
-  }
-  return o;
-}
-
-void print_summary_json(const Summary& s) {
+void print_stats_json(const Stats& s) {
   std::printf("{\"median_ns\": %.3f, \"p99_ns\": %.3f, \"mean_ns\": %.3f, \"worst_ns\": %.3f, "
               "\"calls\": %ld, \"allocations\": %ld}",
               s.median, s.p99, s.mean, s.worst, s.calls, s.allocations);
@@ -340,7 +244,7 @@ int main(int argc, char** argv) {
   }
   const int n_samples = quick ? 20000 : 100000;
   const int passes = quick ? 2 : 5;
-  g_timer = empty_timer_ns();
+  g_timer = lugrip_bench::timer_overhead_ns();
   struct Named {
     const char* label;
     lugrip::ContactParams params;
@@ -354,9 +258,10 @@ int main(int argc, char** argv) {
     run_params(s.label, s.params, streams.back(), passes, rows);
   }
   if (json) {
-    std::printf("{\n  \"benchmark\": \"bench_observer\",\n  \"compiler\": \"%s\",\n", escape(compiler()).c_str());
-    std::printf("  \"build_type\": \"%s\",\n  \"cxx_flags\": \"%s\",\n", escape(LUGRIP_BENCH_BUILD_TYPE).c_str(),
-                escape(LUGRIP_BENCH_CXX_FLAGS).c_str());
+    std::printf("{\n  \"benchmark\": \"bench_observer\",\n  \"compiler\": \"%s\",\n",
+                json_escape(compiler_string()).c_str());
+    std::printf("  \"build_type\": \"%s\",\n  \"cxx_flags\": \"%s\",\n", json_escape(LUGRIP_BENCH_BUILD_TYPE).c_str(),
+                json_escape(LUGRIP_BENCH_CXX_FLAGS).c_str());
     std::printf("  \"seed\": %u,\n  \"quick\": %s,\n  \"samples\": %d,\n  \"passes\": %d,\n  \"batch\": %d,\n",
                 seed, quick ? "true" : "false", n_samples, passes, kBatch);
     std::printf("  \"timer_overhead_ns\": %.3f,\n  \"streams\": [", g_timer);
@@ -367,11 +272,11 @@ int main(int argc, char** argv) {
     for (size_t i = 0; i < rows.size(); ++i) {
       const Row& r = rows[i];
       std::printf("    {\"params\": \"%s\", \"name\": \"%s\", \"detail\": \"%s\", \"batched\": ", r.params.c_str(),
-                  r.name.c_str(), escape(r.detail).c_str());
-      print_summary_json(r.batched);
+                  r.name.c_str(), json_escape(r.detail).c_str());
+      print_stats_json(r.batched);
       if (r.has_single) {
         std::printf(", \"single\": ");
-        print_summary_json(r.single);
+        print_stats_json(r.single);
       }
       std::printf(", \"mean_substeps\": %.4f, \"mean_cor_iterations\": %.4f, \"diverged\": %ld}%s\n",
                   r.mean_substeps, r.mean_cor_iterations, r.diverged, i + 1 < rows.size() ? "," : "");
@@ -379,8 +284,8 @@ int main(int argc, char** argv) {
     std::printf("  ]\n}\n");
     return 0;
   }
-  std::printf("lugrip bench_observer — %s; build %s; flags \"%s\"\n", compiler(), LUGRIP_BENCH_BUILD_TYPE,
-              LUGRIP_BENCH_CXX_FLAGS);
+  std::printf("lugrip bench_observer — %s; build %s; flags \"%s\"\n", compiler_string().c_str(),
+              LUGRIP_BENCH_BUILD_TYPE, LUGRIP_BENCH_CXX_FLAGS);
   std::printf("stream: %d samples at 500 Hz per parameter set, %d timed passes, batches of %d, timer %.1f ns\n\n",
               n_samples, passes, kBatch, g_timer);
   std::printf("%-16s %-22s %9s %9s %9s %9s %8s %7s %6s  %s\n", "params", "case", "median", "p99", "mean", "worst",
