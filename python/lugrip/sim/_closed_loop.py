@@ -20,7 +20,7 @@ from .._contact import _params_path
 from .._controller import _core_settings
 from .._observer import Observer
 from .._params import ContactParams
-from ._plant import PlantConfig
+from ._plant import PlantConfig, _Columns
 
 __all__ = [
     "CONTROLLER_KINDS",
@@ -48,7 +48,7 @@ MODE_ACTIONS = {
 }
 
 
-class ClosedLoopRun(dict):
+class ClosedLoopRun(_Columns):
     """Arrays of a closed-loop run, one row per sensor sample (500 Hz), readable as attributes.
 
     Columns (SI units; per-finger columns end in ``_0`` / ``_1``):
@@ -71,17 +71,6 @@ class ClosedLoopRun(dict):
     Derived: ``S`` = max(S_0, S_1) (what the controller regulates), ``slip_mm``,
     ``rotation_deg``, ``hang_deg`` (angle of grasp point -> CoG from the downward vertical).
     """
-
-    def __getattr__(self, name):
-        try:
-            return self[name]
-        except KeyError:
-            raise AttributeError(name) from None
-
-    def finger(self, i: int) -> dict[str, np.ndarray]:
-        """Per-finger columns of finger i without the suffix."""
-        suffix = f"_{i}"
-        return {k[: -len(suffix)]: v for k, v in self.items() if k.endswith(suffix)}
 
     @property
     def S(self) -> np.ndarray:

@@ -391,15 +391,8 @@ class PlantConfig:
         return c
 
 
-class PlantLog(dict):
-    """Arrays of a batch run, one row per sensor sample (also readable as attributes).
-
-    Per finger i: ``f_n_i, f_x_i, f_y_i, tau_i`` (measured), ``true_*_i``, ``slip_x_i, slip_y_i,
-    slip_angle_i, slip_vx_i, slip_vy_i, omega_i, c_tilde_i, rho_i`` (ground truth in the sensor
-    frame). Plant: ``t, f_cmd, f_held, f_act, gripper_x, gripper_y, gripper_vy, x, y, vx, vy, theta,
-    object_omega, max_slip, max_rotation, contact_fx, contact_fy, contact_tau, ext_fx, ext_fy,
-    ext_tau, energy, supported, dropped``.
-    """
+class _Columns(dict):
+    """Named arrays of a run: items are also attributes; per-finger columns end in _0 / _1."""
 
     def __getattr__(self, name):
         try:
@@ -408,9 +401,20 @@ class PlantLog(dict):
             raise AttributeError(name) from None
 
     def finger(self, i: int) -> dict[str, np.ndarray]:
-        """The quantities of finger i without the suffix."""
+        """The columns of finger i without the suffix."""
         suffix = f"_{i}"
         return {k[: -len(suffix)]: v for k, v in self.items() if k.endswith(suffix)}
+
+
+class PlantLog(_Columns):
+    """Arrays of a batch run, one row per sensor sample (also readable as attributes).
+
+    Per finger i: ``f_n_i, f_x_i, f_y_i, tau_i`` (measured), ``true_*_i``, ``slip_x_i, slip_y_i,
+    slip_angle_i, slip_vx_i, slip_vy_i, omega_i, c_tilde_i, rho_i`` (ground truth in the sensor
+    frame). Plant: ``t, f_cmd, f_held, f_act, gripper_x, gripper_y, gripper_vy, x, y, vx, vy, theta,
+    object_omega, max_slip, max_rotation, contact_fx, contact_fy, contact_tau, ext_fx, ext_fy,
+    ext_tau, energy, supported, dropped``.
+    """
 
 
 class GraspPlant:
