@@ -272,7 +272,7 @@ def _estimator_block(value: Any, where: str) -> dict:
     if value is None:
         return {}
     if not isinstance(value, Mapping) or not set(value) <= {"patch", "lumped"}:
-        raise ValueError(  # noqa: TRY004 (file content)
+        raise ValueError(
             f"{where}: estimator: expected a mapping with keys 'patch' and/or 'lumped'"
         )
     return {str(k): copy.deepcopy(v) for k, v in value.items()}
