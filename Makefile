@@ -53,8 +53,7 @@ bench: install
 	$(VPY) benchmarks/observer_report.py --cpp-dir $(CPP_BUILD)/benchmarks --out BENCHMARKS.md
 	$(VPY) benchmarks/bench_identify.py --out BENCHMARKS.md
 	$(CPP_BUILD)/benchmarks/bench_closed_loop --markdown > build/issue5.md
-	$(VPY) -c "import re,pathlib; b=pathlib.Path('BENCHMARKS.md'); n=pathlib.Path('build/issue5.md').read_text().strip(); \
-	  b.write_text(re.sub(r'<!-- issue5:begin -->.*?<!-- issue5:end -->', lambda m: n, b.read_text(), flags=re.S))"
+	$(VPY) benchmarks/sections.py BENCHMARKS.md issue5 build/issue5.md
 
 clean:
 	rm -rf build $(OUT)

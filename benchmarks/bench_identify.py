@@ -41,8 +41,9 @@ from lugrip.identify import PARAMETERS, IdentificationWarning, initial_guess
 from lugrip.io import SlidingLog
 from lugrip.sim import PatchContact, PatchSettings
 from lugrip.sliding import PAPER_NOISE, evaluate, simulate_maneuvers, simulate_sliding
+from sections import markers, write_section
 
-BEGIN, END = "<!-- issue4:begin -->", "<!-- issue4:end -->"
+BEGIN, END = markers("issue4")
 TABLE1 = ContactParams.table1()
 RESIN = ContactParams.preset("big_resin_block")
 OFF = {"mu": 2.0, "beta_a": 0.4, "sigma0": 2.5, "sigma_z": 0.4, "delta": 2.0, "gamma": 0.5}
@@ -937,19 +938,6 @@ def section(R: dict) -> str:
     return "\n".join(L) + "\n"
 
 
-def write_section(path: Path, text: str) -> None:
-    old = path.read_text() if path.exists() else "# Benchmarks\n"
-    if BEGIN in old and END in old:
-        head, rest = old.split(BEGIN, 1)
-        _, tail = rest.split(END, 1)
-        new = head + text.rstrip("\n") + tail
-    else:
-        new = old.rstrip("\n") + "\n\n" + text
-    tmp = path.with_name(f".{path.name}.part")
-    tmp.write_text(new)
-    os.replace(tmp, path)
-
-
 def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("--out", type=Path, default=Path("BENCHMARKS.md"))
@@ -961,7 +949,7 @@ def main(argv=None) -> int:
     args.json.write_text(
         json.dumps(R, indent=1, default=lambda o: o.to_dict() if hasattr(o, "to_dict") else str(o))
     )
-    write_section(args.out, section(R))
+    write_section(args.out, section(R), "issue4")
     print(f"wrote {args.out} (issue4 section) and {args.json}", file=sys.stderr)
     return 0
 

@@ -35,8 +35,9 @@ import scipy
 from lugrip import ContactParams, Observer
 from lugrip.sliding import DEFAULT_NOISE, PAPER_NOISE, REGIMES, evaluate, simulate_maneuvers
 from scipy.optimize import brentq
+from sections import markers, write_section
 
-BEGIN, END = "<!-- issue3:begin -->", "<!-- issue3:end -->"
+BEGIN, END = markers("issue3")
 PAPER_RMSE = 0.0222
 DEFAULT_B = Observer("table1").settings["bandwidth"]  # ObserverSettings::bandwidth [1/s]
 BL = f"l = {DEFAULT_B:g}/sigma_1"  # the default gain rule, for labels
@@ -631,7 +632,10 @@ def render(R) -> str:
         "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|",
     ]
     for name in TABLE2:
-        for label, key in ((f"l = {DEFAULT_B:g}/σ1 (default)", "default"), ("l = 200 fixed", "fixed_l200")):
+        for label, key in (
+            (f"l = {DEFAULT_B:g}/σ1 (default)", "default"),
+            ("l = 200 fixed", "fixed_l200"),
+        ):
             s = R["table2"][name][key]
             L.append(
                 f"| {name.replace('_', ' ')} | {R['table2'][name]['load_ratio_median']:.3f} | "
@@ -800,19 +804,6 @@ def render(R) -> str:
     return "\n".join(L) + "\n"
 
 
-def write_section(path: Path, section: str) -> None:
-    text = path.read_text() if path.exists() else "# Benchmarks\n"
-    if BEGIN in text and END in text:
-        head, rest = text.split(BEGIN, 1)
-        _, tail = rest.split(END, 1)
-        text = head + section.rstrip("\n") + tail
-    else:
-        text = text.rstrip("\n") + "\n\n" + section
-    tmp = path.with_name(f".{path.name}.part")
-    tmp.write_text(text)
-    os.replace(tmp, path)
-
-
 def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("--cpp-dir", type=Path, default=Path("build/cpp/benchmarks"))
@@ -870,7 +861,7 @@ def main(argv=None) -> int:
         "command": cmd,
         "seconds": time.perf_counter() - t_start,
     }
-    write_section(args.out, render(R))
+    write_section(args.out, render(R), "issue3")
     if args.json:
         args.json.write_text(json.dumps(R, indent=1, default=float))
     d1 = R["table1"]["default"]
