@@ -37,21 +37,32 @@ double rotor_stiffness(double omega, const RotorCoefficients& c) noexcept {
   return std::max(c.gain * (c.sigma_z + c.sigma_1), c.sigma0 * std::fabs(omega) / c.g);
 }
 
+double rosenbrock_rate(double z, double omega, double h, const RotorCoefficients& c) noexcept {
+  const double a = c.sigma0 * std::fabs(omega) / c.g;  // bristle rate -d zdot / dz
+  if (h * a >= kRosenbrockStiff) return 0.0;           // transient over within 1/50 of h
+  const double sgn = omega > 0.0 ? 1.0 : (omega < 0.0 ? -1.0 : 0.0);
+  // Distance of z from its sliding steady state sgn g / sigma0, in units of g / sigma0 (0..2).
+  const double b = std::min(2.0, std::max(0.0, 1.0 - c.sigma0 * z * sgn / c.g));
+  return a * b;
+}
+
 namespace {
 // Substeps that keep h_sub * rate <= target; the sample is redone with more substeps when the
 // largest rate seen during it violates h_sub * rate <= limit (the rate grows at slip onset).
-template <class Step, class Rate>
+template <class Step, class Rate, class StartRate, class OnN>
 int adaptive(double& z, double& omega, double h, const RotorCoefficients& c, int n_min, int max_substeps,
-             double target, double limit, Step step, Rate rate, bool& projected, bool& cap_hit) noexcept {
+             double target, double limit, Step step, Rate rate, StartRate start_rate, OnN on_n, bool& projected,
+             bool& cap_hit) noexcept {
   const double z0 = z, w0 = omega;
   auto needed = [&](double r) {
     const double m = std::ceil(h * r / target);
     return m < static_cast<double>(max_substeps) ? std::max(n_min, static_cast<int>(m)) : max_substeps;
   };
-  int n = needed(rate(omega));
+  int n = needed(start_rate(z, omega));
   for (int attempt = 0; attempt < 8; ++attempt) {
     z = z0;
     omega = w0;
+    on_n(n);
     double r_max = 0.0;
     detail::rotor_substeps(z, omega, h, n, c, step, rate, projected, r_max);
     const double hs = h / n;
@@ -71,14 +82,34 @@ bool rotor_advance(double& z, double& omega, double h, const RotorCoefficients& 
   int n = n_min;
   if (scheme == Integrator::Rk4Adaptive) {
     // MODEL.md 7.4: n = ceil(h Lambda / 2), re-checked against the RK4 stability limit.
-    n = adaptive(z, omega, h, c, n_min, max_substeps, 2.0, kRk4StabilityLimit, detail::RotorRk4(),
-                 [&](double w) { return rotor_stiffness(w, c); }, projected, cap_hit);
+    const auto stiffness = [&](double, double w) { return rotor_stiffness(w, c); };
+    n = adaptive(z, omega, h, c, n_min, max_substeps, 2.0, kRk4StabilityLimit, detail::RotorRk4(), stiffness,
+                 stiffness, [](int) {}, projected, cap_hit);
   } else if (scheme == Integrator::Rosenbrock) {
-    // L-stable: the linear modes need no substeps; the nonlinear bristle rate a = sigma0 |w| / g
-    // (the Jacobian changes within the step) is resolved for accuracy.
-    n = adaptive(z, omega, h, c, n_min, max_substeps, kRosenbrockRate, 2.0 * kRosenbrockRate,
-                 detail::RotorRosenbrock(), [&](double w) { return c.sigma0 * std::fabs(w) / c.g; },
-                 projected, cap_hit);
+    // L-stable: the linear modes need no substeps; the bristle transient is resolved where one
+    // step would not (rosenbrock_rate). A substep whose stage or end omega has another sign than
+    // at its start crossed the kink of |omega|, where the linearisation does not hold: it is
+    // rated at the full reversal rate 2 sigma0 |omega|max / g, which refines it.
+    struct Probe {
+      double w_start = 0.0, w_stage = 0.0;
+    } probe;
+    const auto step = [&probe](double& zz, double& w, double hs, const RotorCoefficients& cc) {
+      probe.w_start = w;
+      detail::rotor_rosenbrock(zz, w, hs, cc, &probe.w_stage);
+    };
+    const auto sign = [](double x) { return x > 0.0 ? 1.0 : (x < 0.0 ? -1.0 : 0.0); };
+    double hs_now = h / n;
+    const auto rate = [&](double zz, double w) {
+      const double s0 = sign(probe.w_start);
+      if (sign(probe.w_stage) != s0 || sign(w) != s0) {
+        const double wm = std::max(std::fabs(probe.w_start), std::max(std::fabs(probe.w_stage), std::fabs(w)));
+        return 2.0 * c.sigma0 * wm / c.g;
+      }
+      return rosenbrock_rate(zz, w, hs_now, c);
+    };
+    n = adaptive(z, omega, h, c, n_min, max_substeps, kRosenbrockRate, 2.0 * kRosenbrockRate, step, rate,
+                 [&](double zz, double w) { return rosenbrock_rate(zz, w, h, c); },
+                 [&](int m) { hs_now = h / m; }, projected, cap_hit);
   } else {
     detail::rotor_fixed_pass(z, omega, h, n, c, scheme, projected);
   }

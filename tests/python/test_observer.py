@@ -125,7 +125,7 @@ def _ros2(z, w, h, s0, sz, s1, g, l, y):
     k1 = np.linalg.solve(m, f(z, w))
     k2 = np.linalg.solve(m, f(z + h * k1[0], w + h * k1[1]) - 2.0 * k1)
     step = h * (1.5 * k1 + 0.5 * k2)
-    return z + step[0], w + step[1]
+    return z + step[0], w + step[1], w + h * k1[1]  # new z, new w, stage w
 
 
 def reference_observer(p, f_n, f_t, tau, s):
@@ -166,22 +166,33 @@ def reference_observer(p, f_n, f_t, tau, s):
         z = min(max(z, -bound), bound)
         g_i = g[i]
 
-        def rate(w, g_i=g_i):
-            return s0 * abs(w) / g_i
+        def rate(z, w, hs, g_i=g_i):
+            # bristle rate times the distance of z from its sliding steady state; 0 when the
+            # transient is over within 1/50 of the step (one L-stable step resolves it)
+            a = s0 * abs(w) / g_i
+            if hs * a >= 50.0:
+                return 0.0
+            return a * min(2.0, max(0.0, 1.0 - s0 * z * np.sign(w) / g_i))
 
         def needed(r):
             m = math.ceil(h * r / 2.0)
             return max(1, int(m)) if m < cap else cap
 
         z0, w0 = z, w
-        n = needed(rate(w))
+        n = needed(rate(z, w, h))
         for _ in range(8):
             z, w = z0, w0
             hs, r_max = h / n, 0.0
             for _ in range(n):
-                z, w = _ros2(z, w, hs, s0, sz, s1[i], g[i], gain[i], y[i])
+                w_start = w
+                z, w, w_stage = _ros2(z, w, hs, s0, sz, s1[i], g[i], gain[i], y[i])
                 z = min(max(z, -bound), bound)
-                r_max = max(r_max, rate(w))
+                if np.sign(w_stage) != np.sign(w_start) or np.sign(w) != np.sign(w_start):
+                    # crossed the kink of |w|: rated at the full reversal rate
+                    r = 2.0 * s0 * max(abs(w_start), abs(w_stage), abs(w)) / g_i
+                else:
+                    r = rate(z, w, hs)
+                r_max = max(r_max, r)
             if hs * r_max <= 4.0 or n >= cap:
                 break
             n = max(n + 1, needed(r_max))

@@ -76,9 +76,10 @@ inline void rotor_rk4(T& z, T& omega, double h, const C& c) noexcept {
   omega += h / 6.0 * (k1w + 2.0 * k2w + 2.0 * k3w + k4w);
 }
 
-//! Integrator::Rosenbrock, one ROS2 step of length h.
+//! Integrator::Rosenbrock, one ROS2 step of length h; *stage_omega (when given) receives the
+//! omega of the second stage's evaluation point (the adaptive rule checks its sign).
 template <class T, class C>
-inline void rotor_rosenbrock(T& z, T& omega, double h, const C& c) noexcept {
+inline void rotor_rosenbrock(T& z, T& omega, double h, const C& c, double* stage_omega = nullptr) noexcept {
   // ROS2 (Verwer et al. 1999): (I - gamma h J) k1 = f(x); (I - gamma h J) k2 = f(x + h k1) - 2 k1;
   // x += h (3 k1 + k2) / 2. J is exact (sign(0) = 0); det(I - gamma h J) >= 1 for |z| <= g/sigma0.
   constexpr double gam = 1.7071067811865475244;
@@ -94,7 +95,9 @@ inline void rotor_rosenbrock(T& z, T& omega, double h, const C& c) noexcept {
   const T k1z = (m22 * f1z - m12 * f1w) * inv_det;
   const T k1w = (m11 * f1w - m21 * f1z) * inv_det;
   T f2z, f2w;
-  rotor_rhs(z + h * k1z, omega + h * k1w, c, f2z, f2w);
+  const T w_stage = omega + h * k1w;
+  if (stage_omega) *stage_omega = scalar_value(w_stage);
+  rotor_rhs(z + h * k1z, w_stage, c, f2z, f2w);
   f2z -= 2.0 * k1z;
   f2w -= 2.0 * k1w;
   const T k2z = (m22 * f2z - m12 * f2w) * inv_det;
@@ -119,11 +122,11 @@ struct RotorRosenbrock {
 //! Rate that is never tracked (the fixed-substep passes).
 struct NoRate {
   template <class T>
-  double operator()(const T&) const noexcept { return 0.0; }
+  double operator()(const T&, const T&) const noexcept { return 0.0; }
 };
 
 //! n equal substeps of h / n with `step`, each followed by the projection, whose activity is
-//! written to `projected` (untouched when n < 1); after each, r_max = max(r_max, rate(omega)).
+//! written to `projected` (untouched when n < 1); after each, r_max = max(r_max, rate(z, omega)).
 template <class T, class C, class Step, class Rate>
 inline void rotor_substeps(T& z, T& omega, double h, int n, const C& c, Step step, Rate rate, bool& projected,
                            double& r_max) noexcept {
@@ -131,7 +134,7 @@ inline void rotor_substeps(T& z, T& omega, double h, int n, const C& c, Step ste
   for (int i = 0; i < n; ++i) {
     step(z, omega, hs, c);
     projected = rotor_project(z, c);
-    r_max = std::max(r_max, rate(omega));
+    r_max = std::max(r_max, rate(z, omega));
   }
 }
 
