@@ -252,7 +252,7 @@ void ClosedLoop::step(ClosedLoopSample& out) noexcept {
     out.f_n_meas[i] = s.f_n;
     out.f_t_meas[i] = in.f_t;
     out.tau_meas[i] = s.tau;
-    out.f_t_true[i] = std::hypot(s.true_f_x, s.true_f_y);
+    out.f_t_true[i] = planar_norm(s.true_f_x, s.true_f_y);
     out.tau_true[i] = s.true_tau;
     out.omega_hat[i] = o.omega_hat;
     out.slippage[i] = o.S;
@@ -306,7 +306,7 @@ void ClosedLoop::step(ClosedLoopSample& out) noexcept {
   out.f_n = st.f_n;
   out.slip_x = st.slip_x;
   out.slip_y = st.slip_y;
-  out.slip = cfg_.plant.model == PlantModel::Patch ? std::hypot(st.slip_x, st.slip_y) : st.max_slip;
+  out.slip = cfg_.plant.model == PlantModel::Patch ? planar_norm(st.slip_x, st.slip_y) : st.max_slip;
   out.rotation = st.slip_angle;
   out.theta = st.theta;
   out.cog_x = st.x;

@@ -77,6 +77,14 @@ struct ObserverSettings {
 //! naming field and value. Returns true when valid.
 bool validate(const ObserverSettings& s, std::string* message);
 
+//! sqrt(x^2 + y^2), within an ulp of std::hypot (which is several times slower), falling back
+//! to std::hypot where the squares would overflow or underflow; NaN and Inf as std::hypot.
+inline double planar_norm(double x, double y) noexcept {
+  const double s = x * x + y * y;
+  if (s < 1e300 && s > 1e-300) return std::sqrt(s);
+  return std::hypot(x, y);
+}
+
 //! One fingertip sample: the wrench the OBJECT exerts on the FINGERTIP, i.e. what a fingertip
 //! force/torque sensor reads (MODEL.md 7.2), in a frame with z along the contact normal.
 //! With this wrench y = tau - c f_t has the sign of the slip velocity and omega_hat is the
@@ -88,10 +96,10 @@ struct ObserverInput {
   double tau = 0.0;  //!< torsional moment about the contact normal [N m], signed
   double dt = 0.0;   //!< time since the previous sample [s]; 0 means the nominal settings.dt
 
-  //! Builds the input from the in-plane force vector (f_t = hypot(f_x, f_y)).
+  //! Builds the input from the in-plane force vector (f_t = planar_norm(f_x, f_y)).
   static ObserverInput from_force_vector(double f_n, double f_x, double f_y, double tau,
                                          double dt = 0.0) noexcept {
-    return ObserverInput{f_n, std::hypot(f_x, f_y), tau, dt};
+    return ObserverInput{f_n, planar_norm(f_x, f_y), tau, dt};
   }
 };
 

@@ -129,6 +129,32 @@ Wrench patch_wrench(const ContactParams& p, double f_n, double c, double phi, do
 // Steady states
 // ---------------------------------------------------------------------------------------------
 
+TEST(PlanarNorm, WithinAnUlpOfHypotOverEveryScale) {
+  // log-uniform magnitudes from 1e-320 (denormal) to 1e307, random signs: at most one ulp from
+  // std::hypot (its own error is below one ulp), exact special values.
+  std::mt19937_64 rng(7);
+  std::uniform_real_distribution<double> e(-320.0, 307.0), sgn(-1.0, 1.0);
+  int worst = 0;
+  for (int k = 0; k < 1000000; ++k) {
+    const double x = std::copysign(std::pow(10.0, e(rng)), sgn(rng));
+    const double y = k % 4 == 0 ? x * sgn(rng) : std::copysign(std::pow(10.0, e(rng)), sgn(rng));
+    const double a = planar_norm(x, y), b = std::hypot(x, y);
+    ASSERT_TRUE(std::isfinite(a)) << x << " " << y;
+    int ulps = 0;
+    for (double v = std::min(a, b); v < std::max(a, b) && ulps < 10; v = std::nextafter(v, 1e308)) ++ulps;
+    worst = std::max(worst, ulps);
+  }
+  EXPECT_LE(worst, 1);
+  const double inf = std::numeric_limits<double>::infinity(), nan = std::nan("");
+  EXPECT_EQ(planar_norm(0.0, 0.0), 0.0);
+  EXPECT_EQ(planar_norm(-3.0, 4.0), 5.0);
+  EXPECT_EQ(planar_norm(1e200, 1e200), std::hypot(1e200, 1e200));
+  EXPECT_EQ(planar_norm(inf, nan), inf);
+  EXPECT_TRUE(std::isnan(planar_norm(nan, 1.0)));
+  EXPECT_EQ(planar_norm(-inf, 0.0), inf);
+  EXPECT_EQ(ObserverInput::from_force_vector(2.0, 0.3, -0.4, 0.01).f_t, planar_norm(0.3, -0.4));
+}
+
 TEST(Observer, SteadySlidingOnTheStaticFrictionCurve) {
   // Constant slip speed w0: the sensor reads y = sign(w0) g + sigma_1 w0 (LuGre steady state).
   // Expected: z_hat -> sign(w0) g/sigma0 (S -> 1), omega_hat -> w0 (sigma_1 significant).
