@@ -7,6 +7,7 @@
 #include <string>
 
 #include "format.hpp"
+#include "lugrip/detail/fast_math.hpp"
 
 namespace lugrip {
 
@@ -85,7 +86,7 @@ ContactModel::ContactModel(const ContactParams& params) : p_(checked(params)), l
   }
 }
 
-double ContactModel::rho(double f_n) const noexcept { return p_.delta * std::pow(f_n, p_.gamma); }
+double ContactModel::rho(double f_n) const noexcept { return p_.delta * detail::fast_pow_pos(f_n, p_.gamma); }
 double ContactModel::ft_max(double f_n) const noexcept { return p_.mu * f_n; }
 double ContactModel::tau_max(double f_n) const noexcept {
   return p_.mu * ls_.xi() * p_.delta * std::pow(f_n, p_.gamma + 1.0);
@@ -107,7 +108,7 @@ double ContactModel::invert_sigma(double s, int* iterations) const noexcept {
   if (!(s > 0.0)) return std::isnan(s) ? s : 0.0;
   if (std::isinf(s)) return s;
   const double gp1 = p_.gamma + 1.0;
-  const double target = std::log(s);
+  const double target = detail::fast_log(s);
   if (target >= inv_s1_) return ls_.tail_torque() * s;  // sigma_LS ~ a / A_tau (a > 1e4)
   double lo, hi, a;
   if (target <= inv_s0_) {  // a < 1e-4: sigma_LS ~ (s_k a)^(gamma+1)
@@ -124,7 +125,7 @@ double ContactModel::invert_sigma(double s, int* iterations) const noexcept {
     const double la = h00 * r[0] + h10 * r[1] + (1.0 - h00) * r[3] + h11 * r[4];
     lo = r[2];
     hi = r[5];
-    a = std::min(std::max(std::exp(la), lo), hi);
+    a = std::min(std::max(detail::fast_exp(la), lo), hi);
   }
   // The Hermite table alone is accurate to ~3e-10 relative except in the intervals around the
   // rim (a ~ 1), where the curves have a curvature feature (measured 2e-7): polish there, and
@@ -262,7 +263,7 @@ Status CorEstimator::step(const CorInput& in, CorOutput& out) noexcept {
 
   // The result is assembled in locals and written field by field to last_ and out (no
   // zero-initialised temporary, no struct copy through the stack).
-  const double f_pow = f * std::pow(f, p.gamma);  // |f~_t|^(gamma+1)
+  const double f_pow = f * detail::fast_pow_pos(f, p.gamma);  // |f~_t|^(gamma+1)
   // |sigma| overflows for a denormal torque: report it as the largest finite value, like t = 0.
   const double sigma = t > 0.0 ? std::copysign(std::fmin(f_pow / t, std::numeric_limits<double>::max()), in.tau)
                                : (f > 0.0 ? std::numeric_limits<double>::max() : 0.0);

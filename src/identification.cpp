@@ -216,7 +216,7 @@ void run_segment(Observer& obs, const SegmentWork& w, int64_t begin, int64_t end
         const double a = std::fabs(o.c_tilde);
         const double sgn = o.c_tilde < 0.0 ? -1.0 : 1.0;
         const double ln_fn = std::log(f_n);
-        const double rho = p.delta * std::pow(f_n, p.gamma);
+        const double rho = obs.model().rho(f_n);  // bit for bit the CorEstimator's rho
         const double f = std::fabs(o.ft_cor) / (p.mu * f_n);
         const double t = std::fabs(o.tau_cor) / (p.mu * xi * rho * f_n);
         std::array<double, N> da{};
