@@ -6,7 +6,7 @@
 // One closed-loop step = one sensor sample (500 Hz): the plant advanced by one sample period
 // (two 1 kHz plant steps, or one with the 500 Hz lumped variant), both fingertip observers and
 // the grasp controller (MODEL.md 9.7). "x real time" = simulated seconds per wall-clock second.
-// The scenario is a lift of a 0.5 kg block grasped beside its CoG with a push (every branch:
+// The scenario is a lift of a 0.3 kg block grasped 3 mm beside its CoG with a push (every branch:
 // support, lift-off transient, hold, disturbance), repeated from reset() until the time budget
 // is spent. Components are timed alone with the same inputs (plant open loop at a constant
 // command; one observer replaying the recorded sensor samples; the controller replaying the
@@ -176,6 +176,7 @@ int main(int argc, char** argv) {
       return 2;
     }
   }
+  const std::string load_before = lugrip_bench::load_average_string();
   const long samples = 3000;  // 6 s simulated per run
   const int reps_lumped = quick ? 5 : 30, reps_patch = quick ? 2 : 8;
   const int plant_rate_default = 1000;
@@ -221,6 +222,10 @@ int main(int argc, char** argv) {
                 "build %s, `%s`, sizeof(ClosedLoop) = %zu B. Median of the runs; p50/p99/worst from a pass that "
                 "times every step alone (worst includes preemption on this shared machine).\n\n",
                 LUGRIP_BENCH_BUILD_TYPE, LUGRIP_BENCH_CXX_FLAGS, sizeof(ClosedLoop));
+    std::printf("- Measured %s on %s (one core); %s; load average (1/5/15 min) before / after: %s -> %s.\n\n",
+                lugrip_bench::utc_now_string().c_str(), lugrip_bench::cpu_model_string().c_str(),
+                lugrip_bench::compiler_string().c_str(), load_before.c_str(),
+                lugrip_bench::load_average_string().c_str());
     std::printf("| target (issue 5) | measured | status |\n|---|---|---|\n");
     std::printf("| >= 1e6 plant+observer+controller steps/s, lumped plant | %.2e closed-loop steps/s (plant 1 kHz), "
                 "%.2e (plant 500 Hz); counting the component steps (2 plant + 2 observer + 1 controller per sample at "
@@ -238,22 +243,23 @@ int main(int argc, char** argv) {
                   parts[i].controller_ns, rs[i].allocations);
     std::printf("\nWhere the time goes (lumped plant, 1 kHz): per sample the plant takes two steps (%.0f ns together, "
                 "each with a CoR estimate of the quasi-static load and an implicit rotor step, plus the sensor sample "
-                "with its 8 normal random numbers), each of the two observers one CoR estimate and one Rosenbrock "
-                "sample (%.0f ns each), the controller %.0f ns. Four CoR estimates per sample (two pow, a log and an "
-                "exp, LS table evaluations each; per-call time in the issue-2 table). The replayed observer (finger 0) "
-                "averages %.2f Rosenbrock substeps per sample, but %ld of its %ld samples hit the cap of %d "
-                "substeps (samples where the measured normal force is far below what the load needs, so the "
-                "estimated slip rate sigma0 |omega| / g is large); at about 40 ns per substep (measured "
-                "separately) those few samples cost a large share of the observer time. The plant already reuses what is exactly "
-                "reusable: the CoR estimate's rho, g and sigma_1 (bit-identical to the model functions), cos/sin of "
-                "the object angle from the previous step, rho at an unchanged actuator force, run-time constants; "
-                "its CoR inputs change at every step (the actuator force follows a first-order lag, the load turns "
-                "with the object), so no estimate can be reused exactly. These reuses left the closed-loop "
-                "trajectories bit-identical (checked on this scenario and two variants, all three plants). Reaching 1e6 would need approximations (e.g. a cheaper CoR inversion or "
-                "pow) or fewer observer substeps, i.e. different results, which are not made here. The component "
-                "times come from separate replays and vary by +-30 %% with the load of this shared machine.\n\n",
+                "with its 8 normal random numbers from a ziggurat), each of the two observers one CoR estimate and its "
+                "Rosenbrock update (%.0f ns each), the controller %.0f ns. The four CoR estimates per sample (two pow, a "
+                "log and an exp each, from include/lugrip/detail/fast_math.hpp, and LS table evaluations; per-call "
+                "time in the issue-2 table) are the largest share. The replayed observer (finger 0) averages %.2f "
+                "Rosenbrock substeps per sample and %s of its %ld samples reached the cap of %d substeps: the "
+                "substeps resolve the bristle transient, not the bristle rate (slider_model.hpp, rosenbrock_rate), "
+                "so a sliding sample whose z already sits at its steady state takes one L-stable step even where "
+                "sigma0 |omega| / g is large (lift-off with the force at its floor). The plant reuses what is "
+                "exactly reusable: the CoR estimate's rho, g and sigma_1 (bit-identical to the model functions), "
+                "cos/sin of the object angle from the previous step, rho at an unchanged actuator force, run-time "
+                "constants; its CoR inputs change at every step (the actuator force follows a first-order lag, the "
+                "load turns with the object), so no estimate can be reused exactly. Absolute rates scale with the "
+                "load of this shared machine (stated above); the component times come from separate replays and "
+                "vary by +-30 %% between runs.\n\n",
                 parts[0].plant_ns, parts[0].observer_ns, parts[0].controller_ns, parts[0].observer_substeps,
-                parts[0].capped, samples, lumped.observer.max_substeps);
+                parts[0].capped == 0 ? "none" : std::to_string(parts[0].capped).c_str(), samples,
+                lumped.observer.max_substeps);
     std::printf("<!-- issue5:end -->\n");
     return 0;
   }

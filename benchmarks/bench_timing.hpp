@@ -14,6 +14,9 @@
 #include <algorithm>
 #include <chrono>
 #include <cstddef>
+#include <cstdio>
+#include <ctime>
+#include <fstream>
 #include <string>
 #include <utility>
 #include <vector>
@@ -199,6 +202,40 @@ inline std::string macro_flags() {
 #endif
   f += "__cplusplus=" + std::to_string(__cplusplus);
   return f;
+}
+
+// "YYYY-MM-DD HH:MM UTC" now.
+inline std::string utc_now_string() {
+  const std::time_t t = std::time(nullptr);
+  std::tm tm{};
+  gmtime_r(&t, &tm);
+  char buf[32];
+  std::strftime(buf, sizeof buf, "%Y-%m-%d %H:%M UTC", &tm);
+  return buf;
+}
+
+// The first "model name" of /proc/cpuinfo ("unknown CPU" where there is none).
+inline std::string cpu_model_string() {
+  std::ifstream f("/proc/cpuinfo");
+  std::string line;
+  while (std::getline(f, line)) {
+    if (line.rfind("model name", 0) == 0) {
+      const size_t colon = line.find(':');
+      if (colon != std::string::npos) return line.substr(line.find_first_not_of(' ', colon + 1));
+    }
+  }
+  return "unknown CPU";
+}
+
+// The 1/5/15-minute load averages as "a / b / c" (from /proc/loadavg; "n/a" where unreadable):
+// the machines are shared, so a report states the load it was measured under.
+inline std::string load_average_string() {
+  std::ifstream f("/proc/loadavg");
+  double a = 0, b = 0, c = 0;
+  if (!(f >> a >> b >> c)) return "n/a";
+  char buf[64];
+  std::snprintf(buf, sizeof buf, "%.2f / %.2f / %.2f", a, b, c);
+  return buf;
 }
 
 // Backslash-escapes '"' and '\' for a JSON string.
