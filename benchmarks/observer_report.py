@@ -190,14 +190,16 @@ class NumpyObserver:
         else:
             z0, w0 = float(np.clip(self.z, -bound, bound)), self.w
 
-            def rate(z, w, hs):  # bristle rate x distance of z from its sliding steady state
+            def rate(z, w, hs):  # lugrip::rosenbrock_rate
                 a = p.sigma0 * abs(w) / g
-                if hs * a >= 50.0:  # stiff: one L-stable step resolves the transient
-                    return 0.0
-                return a * min(2.0, max(0.0, 1.0 - p.sigma0 * z * float(np.sign(w)) / g))
+                r_omega = 2.0 * l * s1 * min(1.0, hs * a)  # omega mode while sliding
+                if hs * a >= 50.0:  # stiff: one L-stable step resolves the z transient
+                    return r_omega
+                # bristle rate x distance of z from its sliding steady state
+                return max(a * min(2.0, max(0.0, 1.0 - p.sigma0 * z * float(np.sign(w)) / g)), r_omega)
 
-            n = min(500, max(1, math.ceil(h * rate(z0, w0, h) / 2.0)))
-            while True:  # substeps resolve the bristle transient; redo when it grew too much
+            n = min(500, max(1, math.ceil(h * rate(z0, w0, h) / 2.0 * (1.0 - 1e-9))))
+            while True:  # substeps resolve the transients; redo when the rate grew too much
                 z, w, r_max = z0, w0, 0.0
                 for _ in range(n):
                     w_start = w
@@ -206,12 +208,13 @@ class NumpyObserver:
                     if np.sign(w_stage) != np.sign(w_start) or np.sign(w) != np.sign(w_start):
                         # crossed the kink of |omega|: rated at the full reversal rate
                         r = 2.0 * p.sigma0 * max(abs(w_start), abs(w_stage), abs(w)) / g
+                        r = max(r, rate(z, w, h / n))
                     else:
                         r = rate(z, w, h / n)
                     r_max = max(r_max, r)
                 if h / n * r_max <= 4.0 or n >= 500:
                     break
-                n = min(500, max(n + 1, math.ceil(h * r_max / 2.0)))
+                n = min(500, max(n + 1, math.ceil(h * r_max / 2.0 * (1.0 - 1e-9))))
             self.z, self.w = z, w
         return self.w, min(p.sigma0 * abs(self.z) / g, 1.0), c_t
 

@@ -39,11 +39,14 @@ double rotor_stiffness(double omega, const RotorCoefficients& c) noexcept {
 
 double rosenbrock_rate(double z, double omega, double h, const RotorCoefficients& c) noexcept {
   const double a = c.sigma0 * std::fabs(omega) / c.g;  // bristle rate -d zdot / dz
-  if (h * a >= kRosenbrockStiff) return 0.0;           // transient over within 1/50 of h
+  // The omega mode: decoupled at the rate gain sigma_1 once z saturates, weighted by the share
+  // min(1, h a) of the step in that regime; scaled so that h_sub gain sigma_1 <= kRosenbrockOmegaStep.
+  const double r_omega = (kRosenbrockRate / kRosenbrockOmegaStep) * c.gain * c.sigma_1 * std::min(1.0, h * a);
+  if (h * a >= kRosenbrockStiff) return r_omega;  // z transient over within 1/50 of h
   const double sgn = omega > 0.0 ? 1.0 : (omega < 0.0 ? -1.0 : 0.0);
   // Distance of z from its sliding steady state sgn g / sigma0, in units of g / sigma0 (0..2).
   const double b = std::min(2.0, std::max(0.0, 1.0 - c.sigma0 * z * sgn / c.g));
-  return a * b;
+  return std::max(a * b, r_omega);
 }
 
 namespace {
@@ -54,8 +57,12 @@ int adaptive(double& z, double& omega, double h, const RotorCoefficients& c, int
              double target, double limit, Step step, Rate rate, StartRate start_rate, OnN on_n, bool& projected,
              bool& cap_hit) noexcept {
   const double z0 = z, w0 = omega;
+  // A rate that puts h r / target on a whole number (the omega mode at the bandwidth gain: h B
+  // = 6) must not flip between n and n + 1 with the rounding of h or of the parameters (a time
+  // stamp near 8 s carries 1e-12 relative error in its difference): the identification's
+  // derivative holds each sample's substep count fixed, and equal data must give equal counts.
   auto needed = [&](double r) {
-    const double m = std::ceil(h * r / target);
+    const double m = std::ceil(h * r / target * (1.0 - 1e-9));
     return m < static_cast<double>(max_substeps) ? std::max(n_min, static_cast<int>(m)) : max_substeps;
   };
   int n = needed(start_rate(z, omega));
@@ -86,8 +93,8 @@ bool rotor_advance(double& z, double& omega, double h, const RotorCoefficients& 
     n = adaptive(z, omega, h, c, n_min, max_substeps, 2.0, kRk4StabilityLimit, detail::RotorRk4(), stiffness,
                  stiffness, [](int) {}, projected, cap_hit);
   } else if (scheme == Integrator::Rosenbrock) {
-    // L-stable: the linear modes need no substeps; the bristle transient is resolved where one
-    // step would not (rosenbrock_rate). A substep whose stage or end omega has another sign than
+    // L-stable: no substeps for stability; the bristle transient and, while sliding, the omega
+    // mode are resolved where one step would not (rosenbrock_rate). A substep whose stage or end omega has another sign than
     // at its start crossed the kink of |omega|, where the linearisation does not hold: it is
     // rated at the full reversal rate 2 sigma0 |omega|max / g, which refines it.
     struct Probe {
@@ -103,7 +110,7 @@ bool rotor_advance(double& z, double& omega, double h, const RotorCoefficients& 
       const double s0 = sign(probe.w_start);
       if (sign(probe.w_stage) != s0 || sign(w) != s0) {
         const double wm = std::max(std::fabs(probe.w_start), std::max(std::fabs(probe.w_stage), std::fabs(w)));
-        return 2.0 * c.sigma0 * wm / c.g;
+        return std::max(2.0 * c.sigma0 * wm / c.g, rosenbrock_rate(zz, w, hs_now, c));
       }
       return rosenbrock_rate(zz, w, hs_now, c);
     };
