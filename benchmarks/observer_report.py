@@ -196,7 +196,8 @@ class NumpyObserver:
                 if hs * a >= 50.0:  # stiff: one L-stable step resolves the z transient
                     return r_omega
                 # bristle rate x distance of z from its sliding steady state
-                return max(a * min(2.0, max(0.0, 1.0 - p.sigma0 * z * float(np.sign(w)) / g)), r_omega)
+                b = min(2.0, max(0.0, 1.0 - p.sigma0 * z * float(np.sign(w)) / g))
+                return max(a * b, r_omega)
 
             n = min(500, max(1, math.ceil(h * rate(z0, w0, h) / 2.0 * (1.0 - 1e-9))))
             while True:  # substeps resolve the transients; redo when the rate grew too much

@@ -178,7 +178,8 @@ def reference_observer(p, f_n, f_t, tau, s):
             return max(a * min(2.0, max(0.0, 1.0 - s0 * z * np.sign(w) / g_i)), r_omega)
 
         def needed(r):
-            m = math.ceil(h * r / 2.0 * (1.0 - 1e-9))  # as slider_model.cpp: no flip at whole numbers
+            # as slider_model.cpp: no flip between n and n + 1 at whole numbers
+            m = math.ceil(h * r / 2.0 * (1.0 - 1e-9))
             return max(1, int(m)) if m < cap else cap
 
         z0, w0 = z, w
@@ -192,7 +193,8 @@ def reference_observer(p, f_n, f_t, tau, s):
                 z = min(max(z, -bound), bound)
                 if np.sign(w_stage) != np.sign(w_start) or np.sign(w) != np.sign(w_start):
                     # crossed the kink of |w|: rated at the full reversal rate
-                    r = max(2.0 * s0 * max(abs(w_start), abs(w_stage), abs(w)) / g_i, rate(z, w, hs))
+                    r_rev = 2.0 * s0 * max(abs(w_start), abs(w_stage), abs(w)) / g_i
+                    r = max(r_rev, rate(z, w, hs))
                 else:
                     r = rate(z, w, hs)
                 r_max = max(r_max, r)
@@ -779,9 +781,8 @@ def test_rosenbrock_sample_update_matches_exact_flow_while_sliding():
     ms = maneuvers(p, 3, seed=5, f_range=(1.0, 4.0), peak_range=(1.5, 4.0))
     run = Observer(p).run(concat(ms))
     s0, sz, h = p.sigma0, p.sigma_z, DT
-    sliding = np.flatnonzero(
-        (run.S[1:] > 0.999) & (run.S[:-1] > 0.999) & (np.abs(run.omega_hat[1:]) > 0.05)
-    ) + 1
+    both = (run.S[1:] > 0.999) & (run.S[:-1] > 0.999) & (np.abs(run.omega_hat[1:]) > 0.05)
+    sliding = np.flatnonzero(both) + 1
     assert sliding.size > 200
     assert np.mean(run.substeps[sliding]) > 3  # the omega mode is resolved while sliding
     rel, rel_one_step = [], []
