@@ -8,7 +8,7 @@ OUT    ?= out
 
 SOURCES := $(shell find src include bindings python -type f \( -name '*.cpp' -o -name '*.hpp' -o -name '*.py' \)) pyproject.toml CMakeLists.txt
 
-.PHONY: all install demo test test-cpp test-python bench sanitize clean
+.PHONY: all install demo test test-cpp test-python validate bench sanitize clean
 
 all: install
 
@@ -29,6 +29,10 @@ demo: install
 	$(VENV)/bin/lugrip demo --out $(OUT)
 
 test: test-cpp test-python
+
+# lugrip in closed loop on MuJoCo (validation/mujoco/README.md): out/mujoco_grasp.{json,png}
+validate: install
+	$(VPY) validation/mujoco/grasp.py --out $(OUT)
 
 test-cpp:
 	cmake -S . -B $(CPP_BUILD) -DCMAKE_BUILD_TYPE=Release -DLUGRIP_BUILD_TESTS=ON -DLUGRIP_BUILD_BENCHMARKS=ON > /dev/null
