@@ -178,7 +178,7 @@ def run(s: GraspSetup) -> dict[str, np.ndarray]:
         "box": mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_GEOM, "box"),
         "block": mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_BODY, "block"),
     }
-    jy, jz, jth = (m.joint(name).qposadr[0] for name in ("by", "bz", "btheta"))
+    jy, jz, jth, jlift = (m.joint(j).qposadr[0] for j in ("by", "bz", "btheta", "lift"))
     est = _contact_params(s).replace(sigma_z=s.estimator_sigma_z)
     observers = [Observer(est, torque_noise=s.torque_noise, dt=0.002) for _ in range(2)]
     ctrl = GraspController(est)
@@ -254,7 +254,7 @@ def run(s: GraspSetup) -> dict[str, np.ndarray]:
         log["f_t"].append(np.hypot(w[:, 1], w[:, 2]))
         log["tau"].append(w[:, 3].copy())
         log["slip_y"].append(d.qpos[jy])
-        log["slip_z"].append(d.qpos[jz] - (d.qpos[m.joint("lift").qposadr[0]]))
+        log["slip_z"].append(d.qpos[jz] - d.qpos[jlift])  # the block's height above the hand's
         log["theta"].append(d.qpos[jth])
         log["status"].append([int(o.status) for o in samples])
     return {k: np.asarray(v) for k, v in log.items()}
