@@ -41,7 +41,8 @@ double rosenbrock_rate(double z, double omega, double h, const RotorCoefficients
   const double a = c.sigma0 * std::fabs(omega) / c.g;  // bristle rate -d zdot / dz
   // The omega mode: decoupled at the rate gain sigma_1 once z saturates, weighted by the share
   // min(1, h a) of the step in that regime; scaled so that h_sub gain sigma_1 <= kRosenbrockOmegaStep.
-  const double r_omega = (kRosenbrockRate / kRosenbrockOmegaStep) * c.gain * c.sigma_1 * std::min(1.0, h * a);
+  const double r_omega =
+      (kRosenbrockRate / kRosenbrockOmegaStep) * c.gain * c.sigma_1 * std::min(1.0, h * a);
   if (h * a >= kRosenbrockStiff) return r_omega;  // z transient over within 1/50 of h
   const double sgn = omega > 0.0 ? 1.0 : (omega < 0.0 ? -1.0 : 0.0);
   // Distance of z from its sliding steady state sgn g / sigma0, in units of g / sigma0 (0..2).
@@ -94,9 +95,10 @@ bool rotor_advance(double& z, double& omega, double h, const RotorCoefficients& 
                  stiffness, [](int) {}, projected, cap_hit);
   } else if (scheme == Integrator::Rosenbrock) {
     // L-stable: no substeps for stability; the bristle transient and, while sliding, the omega
-    // mode are resolved where one step would not (rosenbrock_rate). A substep whose stage or end omega has another sign than
-    // at its start crossed the kink of |omega|, where the linearisation does not hold: it is
-    // rated at the full reversal rate 2 sigma0 |omega|max / g, which refines it.
+    // mode are resolved where one step would not (rosenbrock_rate). A substep whose stage or end
+    // omega has another sign than at its start crossed the kink of |omega|, where the
+    // linearisation does not hold: it is rated at the full reversal rate 2 sigma0 |omega|max / g
+    // (or the omega mode's, if larger), which refines it.
     struct Probe {
       double w_start = 0.0, w_stage = 0.0;
     } probe;

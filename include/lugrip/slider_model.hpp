@@ -104,7 +104,11 @@ constexpr double kRosenbrockStiff = 50.0;
 //! (kRosenbrockRate / kRosenbrockOmegaStep) gain sigma_1 min(1, h a), i.e. substeps with
 //! h_sub gain sigma_1 <= kRosenbrockOmegaStep while sliding; min(1, h a) is the share of the step
 //! in that regime (pre-sliding, h a << 1, keeps one step: there the stiff modes are the
-//! bristle spring and damper, which L-stability handles).
+//! bristle spring and damper, which L-stability handles). Not resolved: just short of
+//! saturation (z within a few 1e-3 of g / sigma0, e.g. while g grows along a slip ramp) a large
+//! sigma_z couples the modes through sigma_z dz/dt, whose rate gain (sigma_1 + sigma_z (1 - u)),
+//! u = sigma0 z sign(omega) / g, is several times the bandwidth with Table 1's sigma_z = 2 and
+//! Table 2's sigma_1; resolving it would cost tens of substeps per sliding sample.
 double rosenbrock_rate(double z, double omega, double h, const RotorCoefficients& c) noexcept;
 //! Rosenbrock substeps keep h_sub rosenbrock_rate <= this (redone above twice this).
 constexpr double kRosenbrockRate = 2.0;
