@@ -278,6 +278,8 @@ def evaluate(s: GraspSetup, r: dict[str, np.ndarray]) -> dict:
     first_push = min((p[0] for p in s.pushes), default=s.duration)
     steady = (t >= lift_end + 1.0) & (t < first_push)
     S = np.max(r["S"], axis=1)
+    limits = lugrip.controller_settings()  # the GraspController's defaults, used by run()
+    f_min, f_max = limits["f_min"], limits["f_max"]
     finite = all(np.all(np.isfinite(v)) for v in r.values())
     dropped = bool(
         np.max(slip) > 0.02
@@ -299,9 +301,7 @@ def evaluate(s: GraspSetup, r: dict[str, np.ndarray]) -> dict:
         "steady_f_t_per_finger": [float(x) for x in np.mean(r["f_t"][steady], axis=0)],
         "steady_tau_per_finger": [float(x) for x in np.mean(np.abs(r["tau"][steady]), axis=0)],
         "finite": finite,
-        "command_in_limits": bool(
-            np.all((r["command"] >= 0.1 - 1e-12) & (r["command"] <= 20.0 + 1e-12))
-        ),
+        "command_in_limits": bool(np.all((r["command"] >= f_min) & (r["command"] <= f_max))),
     }
     if steady.any():
         # the force each model asks for at the steady loads of the more loaded finger (the
@@ -330,6 +330,7 @@ def evaluate(s: GraspSetup, r: dict[str, np.ndarray]) -> dict:
 
 
 def plot(s: GraspSetup, r: dict[str, np.ndarray], path: Path, baseline=None) -> None:
+    """The run's figure; `baseline` = (label, run) of a comparison, drawn in the rotation panel."""
     import matplotlib
 
     matplotlib.use("Agg")
@@ -356,10 +357,9 @@ def plot(s: GraspSetup, r: dict[str, np.ndarray], path: Path, baseline=None) -> 
     ax[2].legend(loc="upper right", fontsize=8)
     ax[3].plot(t, np.degrees(r["theta"] - r["theta"][0]), label="lugrip: rotation [deg]")
     if baseline is not None:
+        label, rb = baseline
         ax[3].plot(
-            baseline["t"],
-            np.degrees(baseline["theta"] - baseline["theta"][0]),
-            label=f"constant {s.constant_force:g} N: rotation [deg]",
+            rb["t"], np.degrees(rb["theta"] - rb["theta"][0]), label=f"{label}: rotation [deg]"
         )
     ax[3].set_ylabel("block rotation [deg]")
     ax[3].set_xlabel("time $t$ [s]")
@@ -445,8 +445,7 @@ def main(argv=None) -> int:
         "constant_force": dict(res_b, force=f_const),
     }
     (args.out / "mujoco_grasp.json").write_text(json.dumps(doc, indent=2))
-    s.constant_force = f_const
-    plot(s, r, args.out / "mujoco_grasp.png", baseline=rb)
+    plot(s, r, args.out / "mujoco_grasp.png", baseline=(f"constant {f_const:.2f} N", rb))
     m = res["metrics"]
     print(
         f"lugrip on MuJoCo {mujoco.__version__}: {'pass' if res['pass'] else 'FAIL'}; "
