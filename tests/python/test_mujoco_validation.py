@@ -8,6 +8,7 @@ import math
 import sys
 from pathlib import Path
 
+import lugrip
 import numpy as np
 import pytest
 
@@ -31,8 +32,6 @@ def test_model_has_the_settings_that_stop_creep():
     assert m.npair == 2 and all(m.pair_dim == 4)
     # torsional coefficient: MuJoCo's capacity mu_spin f_n equals lugrip's tau_max at spin_force
     p = grasp._contact_params(s)
-    import lugrip
-
     tau_max = p.mu * lugrip.LimitSurface(p.k).xi * p.delta * s.spin_force ** (p.gamma + 1)
     assert m.pair_friction[0, 2] * s.spin_force == pytest.approx(tau_max, rel=1e-9)
 
