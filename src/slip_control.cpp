@@ -55,7 +55,8 @@ SlipControl::SlipControl(const ContactModel& model, const SlipControlSettings& s
   for (int i = 0; i < kMaxFingers; ++i) cin_.fingers[i].present = i < s_.fingers;
 }
 
-Status SlipControl::step(const SlipControlInput& in, SlipControlOutput& out) noexcept {
+Status SlipControl::observe(const SlipControlInput& in, SlipControlOutput& out) noexcept {
+  Status worst = Status::Ok;
   for (int i = 0; i < s_.fingers; ++i) {
     const FingerWrench& w = in.fingers[i];
     const ObserverInput oin = ObserverInput::from_force_vector(w.f_n, w.f_x, w.f_y, w.tau, in.dt);
@@ -68,7 +69,14 @@ Status SlipControl::step(const SlipControlInput& in, SlipControlOutput& out) noe
     f.c_tilde = o.c_tilde;
     f.f_t = oin.f_t;
     f.status = o.status;
+    if (!is_valid(o.status) && (worst == Status::Ok || static_cast<int>(o.status) > static_cast<int>(worst)))
+      worst = o.status;
   }
+  return worst;
+}
+
+Status SlipControl::step(const SlipControlInput& in, SlipControlOutput& out) noexcept {
+  observe(in, out);
   ctrl_.step(cin_, out.controller);
   out.force = out.controller.force;
   out.status = out.controller.status;

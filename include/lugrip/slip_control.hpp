@@ -72,6 +72,10 @@ class SlipControl {
   //! One cycle at the sensor rate. Never throws, never allocates; out.force is finite and in
   //! [f_min, f_max]. Returns out.status.
   Status step(const SlipControlInput& in, SlipControlOutput& out) noexcept;
+  //! Runs the observers only (fills out.fingers; the controller is not stepped and out.force
+  //! keeps its value), e.g. while another law commands the gripper. Returns the worst finger
+  //! status (Ok when every present finger carries an estimate).
+  Status observe(const SlipControlInput& in, SlipControlOutput& out) noexcept;
 
   //! Observers forgotten, controller back to slipping avoidance; `force` [N] (clipped to the
   //! range, f_min if not finite) is held until the next step(), which starts from it.
