@@ -359,7 +359,7 @@ TEST(Observer, StableSchemesAgreeOnPlantData) {
   ObserverSettings ref_s;
   ref_s.integrator = Integrator::Rk4Adaptive;
   ref_s.substeps = 200;
-  ref_s.max_substeps = 200000;
+  ref_s.max_substeps = kMaxObserverSubsteps;
   Observer ref(p, ref_s);
   const auto r = observe(ref, s);
   for (Integrator scheme : {Integrator::Rosenbrock, Integrator::Implicit, Integrator::Rk4Adaptive}) {
