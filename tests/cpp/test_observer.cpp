@@ -583,7 +583,8 @@ TEST(Observer, BoundedUnderAMillionRandomInputs) {
       ASSERT_TRUE(std::isfinite(out.omega_hat) && std::isfinite(out.z_hat) && std::isfinite(out.S) &&
                   std::isfinite(out.c_tilde) && std::isfinite(out.c) && std::isfinite(out.g) &&
                   std::isfinite(out.sigma_1) && std::isfinite(out.y) && std::isfinite(out.gain) &&
-                  std::isfinite(out.omega_resolution) && std::isfinite(out.tau_cor) && std::isfinite(out.ft_cor))
+                  std::isfinite(out.omega_resolution) && std::isfinite(out.tau_cor) && std::isfinite(out.ft_cor) &&
+                  std::isfinite(out.c_tilde_unclipped) && std::isfinite(out.omega_object) && std::isfinite(out.v_slip))
           << "run " << run << " sample " << i;
       ASSERT_GE(out.S, 0.0);
       ASSERT_LE(out.S, 1.0);
@@ -759,4 +760,138 @@ TEST(Observer, SettingsValidationNamesEachBadField) {
   s.cor.zero_torque = 0.0;
   EXPECT_FALSE(validate(s, &msg));
   EXPECT_EQ(std::count(msg.begin(), msg.end(), '\n'), 3) << msg;
+}
+
+TEST(Observer, SettingsRangesAtTheirEdges) {
+  // Each bounded field: the edge value is accepted, one step past it is refused with one line
+  // naming the field. The edges are those of the settings table in observer.hpp.
+  struct Edge {
+    const char* field;
+    void (*set)(ObserverSettings&, double);
+    double ok, bad;
+    int lines = 1;  // lines of the refusal (a dt above 10 s also puts max_dt_gap below dt)
+  };
+  const Edge edges[] = {
+      {"dt", [](ObserverSettings& s, double v) { s.dt = v; s.max_dt_gap = std::max(s.max_dt_gap, std::min(v, 10.0)); }, 1e-9, 9e-10},
+      {"dt", [](ObserverSettings& s, double v) { s.dt = v; s.max_dt_gap = 10.0; }, 10.0, 10.5, 2},
+      {"gain", [](ObserverSettings& s, double v) { s.gain = v; }, 1e15, 2e15},
+      {"bandwidth", [](ObserverSettings& s, double v) { s.bandwidth = v; }, 1e9, 2e9},
+      {"gain_max", [](ObserverSettings& s, double v) { s.gain_max = v; }, 1e15, 2e15},
+      {"g_floor", [](ObserverSettings& s, double v) { s.g_floor = v; }, 1.0, 1.5},
+      {"torque_cutoff", [](ObserverSettings& s, double v) { s.torque_cutoff = v; }, 1e9, 2e9},
+      {"cor_sign_sigmas", [](ObserverSettings& s, double v) { s.cor_sign_sigmas = v; }, 1e3, 2e3},
+      {"max_invalid", [](ObserverSettings& s, double v) { s.max_invalid = static_cast<int>(v); }, 1e6, 1e6 + 1},
+      {"max_dt_gap", [](ObserverSettings& s, double v) { s.max_dt_gap = v; }, 10.0, 10.5},
+      {"torque_noise", [](ObserverSettings& s, double v) { s.torque_noise = v; }, 1e3, 2e3},  // cor.torque_limit
+      {"omega_limit", [](ObserverSettings& s, double v) { s.omega_limit = v; }, 1e6, 2e6},
+      {"resolution_max", [](ObserverSettings& s, double v) { s.resolution_max = v; }, 1e3, 2e3},  // omega_limit
+      {"max_substeps", [](ObserverSettings& s, double v) { s.max_substeps = static_cast<int>(v); }, kMaxObserverSubsteps, 1e8},
+      {"max_substeps", [](ObserverSettings& s, double v) { s.substeps = s.max_substeps = static_cast<int>(v); }, kMaxObserverSubsteps, 1e8},
+      {"cor.f_n_min", [](ObserverSettings& s, double v) { s.cor.f_n_min = v; }, kMinContactForce, 1e-300},
+      {"cor.force_limit", [](ObserverSettings& s, double v) { s.cor.force_limit = v; }, kMaxForceLimit, 1e300},
+      {"cor.torque_limit", [](ObserverSettings& s, double v) { s.cor.torque_limit = v; }, kMaxForceLimit, 1e300},
+  };
+  for (const Edge& e : edges) {
+    ObserverSettings ok, bad;
+    e.set(ok, e.ok);
+    e.set(bad, e.bad);
+    std::string msg;
+    EXPECT_TRUE(validate(ok, &msg)) << e.field << " = " << e.ok << ": " << msg;
+    EXPECT_FALSE(validate(bad, &msg)) << e.field << " = " << e.bad;
+    EXPECT_EQ(msg.rfind(std::string(e.field) + " = ", 0), 0u) << msg;
+    EXPECT_EQ(std::count(msg.begin(), msg.end(), '\n'), e.lines) << msg;
+  }
+  // ContactParams: a bristle stiffness that makes g / sigma0 overflow is refused.
+  ContactParams p = table1_params();
+  p.sigma0 = std::numeric_limits<double>::denorm_min();
+  EXPECT_FALSE(validate(p, nullptr));
+  p.sigma0 = 1e-12;
+  EXPECT_TRUE(validate(p, nullptr));
+}
+
+TEST(Observer, EdgeSettingsKeepOutputsFiniteAndTheWorkBounded) {
+  // The cases found with settings that passed validate() before the ranges existed, now at the
+  // edges of the ranges: the smallest sigma0 at the largest sensor range (z_hat was +-inf with a
+  // denormal sigma0), the largest substep counts (minutes per log with 1e8), the shortest and
+  // longest periods.
+  const double f_max = kMaxForceLimit;
+  ContactParams p = table1_params();
+  p.sigma0 = 1e-12;
+  ObserverSettings s;
+  s.cor.force_limit = s.cor.torque_limit = f_max;
+  s.substeps = s.max_substeps = kMaxObserverSubsteps;
+  for (Integrator scheme : {Integrator::Rosenbrock, Integrator::Implicit, Integrator::Rk4, Integrator::Rk4Adaptive}) {
+    s.integrator = scheme;
+    Observer obs(p, s);
+    ObserverOutput out;
+    for (double f_n : {0.5, 1e3, f_max}) {
+      for (int i = 0; i < 20; ++i) {
+        const double load = 0.05 * i;
+        obs.step(ObserverInput{f_n, std::min(f_max, load * obs.model().ft_max(f_n)),
+                               std::min(f_max, load * obs.model().tau_max(f_n)), 0.0}, out);
+        ASSERT_TRUE(std::isfinite(out.z_hat) && std::isfinite(out.omega_hat) && std::isfinite(out.S) &&
+                    std::isfinite(out.y) && std::isfinite(out.v_slip) && std::isfinite(out.omega_object))
+            << to_string(scheme) << " f_n " << f_n;
+        ASSERT_LE(out.substeps, kMaxObserverSubsteps);
+        ASSERT_LE(p.sigma0 * std::fabs(out.z_hat), out.g * (1.0 + 1e-12));
+      }
+    }
+  }
+  for (double dt : {1e-9, 10.0}) {
+    ObserverSettings st;
+    st.dt = dt;
+    st.max_dt_gap = 10.0;
+    Observer obs(table1_params(), st);
+    ObserverOutput out;
+    for (int i = 0; i < 200; ++i) {
+      obs.step(ObserverInput{5.0, 0.01 * i, -1e-4 * i, 0.0}, out);
+      ASSERT_TRUE(std::isfinite(out.omega_hat) && std::isfinite(out.z_hat) && std::isfinite(out.v_slip)) << dt;
+      ASSERT_TRUE(is_valid(out.status)) << dt;
+    }
+  }
+}
+
+TEST(Observer, RejectedSamplesLeaveTheStateAsItWas) {
+  // A sample that passes the input checks but whose CoR cannot be computed (here mu = 1e-300:
+  // f_t / (mu f_n) overflows at large forces) is InvalidSample and must not advance the state:
+  // a twin that never saw it, fed the skipped time with the next sample, agrees exactly.
+  ContactParams p = table1_params();
+  p.mu = 1e-300;
+  p.beta_a = 1e20;
+  ObserverSettings s;
+  s.cor.force_limit = s.cor.torque_limit = kMaxForceLimit;
+  s.filter_force = false;  // the CoR sees the raw f_t
+  Observer a(p, s), twin(p, s);
+  ObserverOutput oa, ob;
+  std::mt19937_64 rng(5);
+  std::uniform_real_distribution<double> u(0.0, 1.0);
+  int rejected = 0, compared = 0;
+  double pending = 0.0;
+  for (int i = 0; i < 3000; ++i) {
+    ObserverInput in{1.0, 1e-301 * u(rng), -1e-304 * u(rng), 0.0};  // tiny loads of a tiny mu
+    if (i % 7 == 3) in.f_t = 1e9;                                     // overflow: rejected
+    const double omega_before = a.omega_hat(), z_before = a.z_hat();
+    const Status st = a.step(in, oa);
+    if (st == Status::InvalidSample) {
+      ++rejected;
+      EXPECT_EQ(a.omega_hat(), omega_before);
+      EXPECT_EQ(a.z_hat(), z_before);
+      pending += s.dt;
+      continue;
+    }
+    twin.step(ObserverInput{in.f_n, in.f_t, in.tau, pending + s.dt}, ob);
+    pending = 0.0;
+    ++compared;
+    ASSERT_EQ(oa.status, ob.status) << i;
+    ASSERT_EQ(oa.omega_hat, ob.omega_hat) << i;
+    ASSERT_EQ(oa.z_hat, ob.z_hat) << i;
+    ASSERT_EQ(oa.c_tilde, ob.c_tilde) << i;
+    ASSERT_EQ(oa.omega_object, ob.omega_object) << i;
+  }
+  EXPECT_GT(rejected, 300);
+  EXPECT_GT(compared, 2000);
+  // f_n_min at 1e-300 is refused outright in an observer (it was accepted, and such samples
+  // returned InvalidSample while still advancing omega_hat).
+  s.cor.f_n_min = 1e-300;
+  EXPECT_THROW(Observer(p, s), std::invalid_argument);
 }
