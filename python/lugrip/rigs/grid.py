@@ -36,40 +36,15 @@ from collections.abc import Sequence
 
 import numpy as np
 
-from ..io import SlidingLog
 from ._data import RigTruth, RubbingData
+from ._run import RigRun, assemble
 from .motion import ManeuverPlan, RubbingDesign, plan_maneuvers, stack_times
 
-__all__ = ["GridContactRig", "GridRun"]
+__all__ = ["GridContactRig"]
 
 _SLIDING_LOAD = 0.95  # gross sliding: this fraction of f_n carried by sliding cells [-]
 _STEADY = 0.9  # a cell slides when its bristle is at >= this fraction of its sliding value [-]
 _BATCH = 48  # maneuvers integrated together (sorted by length, so little padding)
-
-
-@dataclasses.dataclass(frozen=True)
-class GridRun:
-    """Per-sample outputs of :meth:`GridContactRig.run` for one maneuver (true values, no
-    sensor noise). Arrays have the plan's number of samples.
-
-    Attributes:
-        f_n: normal force [N].
-        f_x, f_y: in-plane force the slider exerts on the fingertip [N].
-        tau: moment of those forces about the patch centre [N m].
-        tau_cor: friction torque about the prescribed CoR [N m].
-        capacity_static: full-sliding torque about the CoR at static friction [N m].
-        sliding_load: fraction of f_n carried by sliding cells [-].
-        rho: contact radius [m].
-    """
-
-    f_n: np.ndarray
-    f_x: np.ndarray
-    f_y: np.ndarray
-    tau: np.ndarray
-    tau_cor: np.ndarray
-    capacity_static: np.ndarray
-    sliding_load: np.ndarray
-    rho: np.ndarray
 
 
 @dataclasses.dataclass(frozen=True)
@@ -186,9 +161,9 @@ class GridContactRig:
 
     # -- simulation ---------------------------------------------------------------------------
 
-    def run(self, plans: Sequence[ManeuverPlan], *, substeps: int | None = None) -> list[GridRun]:
+    def run(self, plans: Sequence[ManeuverPlan], *, substeps: int | None = None) -> list[RigRun]:
         """Integrate the plant along the plans (true wrench, no sensor); one
-        :class:`GridRun` per plan, in the plans' order."""
+        :class:`~lugrip.rigs._run.RigRun` per plan, in the plans' order."""
         plans = list(plans)
         if not plans:
             return []
@@ -197,14 +172,14 @@ class GridContactRig:
             raise ValueError("GridContactRig.run: all plans must share one sample period")
         S = int(self.substeps if substeps is None else substeps)
         order = sorted(range(len(plans)), key=lambda i: len(plans[i]))
-        out: list[GridRun | None] = [None] * len(plans)
+        out: list[RigRun | None] = [None] * len(plans)
         for b in range(0, len(order), _BATCH):
             idx = order[b:b + _BATCH]
             for i, res in zip(idx, self._run_batch([plans[i] for i in idx], S)):
                 out[i] = res
         return out  # type: ignore[return-value]
 
-    def _run_batch(self, plans: list[ManeuverPlan], S: int) -> list[GridRun]:
+    def _run_batch(self, plans: list[ManeuverPlan], S: int) -> list[RigRun]:
         u, w, area = self.cells()
         ux, uy = u[:, 0][None, :], u[:, 1][None, :]
         w = w[None, :]
@@ -292,12 +267,13 @@ class GridContactRig:
         runs = []
         for m, p in enumerate(plans):
             n = len(p)
-            runs.append(GridRun(
+            moving = p.commanded_phase() == 1
+            runs.append(RigRun(
                 f_n=fn_s[m, :n].copy(), f_x=res["fx"][m, :n].copy(),
                 f_y=res["fy"][m, :n].copy(), tau=res["tau"][m, :n].copy(),
-                tau_cor=res["tau_cor"][m, :n].copy(),
-                capacity_static=res["cap"][m, :n].copy(),
-                sliding_load=res["slide"][m, :n].copy(), rho=rho_s[m, :n].copy()))
+                load_ratio=np.abs(res["tau_cor"][m, :n]) / res["cap"][m, :n],
+                sliding=moving & (res["slide"][m, :n] >= _SLIDING_LOAD),
+                rho=rho_s[m, :n].copy(), sliding_load=res["slide"][m, :n].copy()))
         return runs
 
     def simulate(self, design: RubbingDesign | None = None, n: int = 12, seed: int = 0, *,
@@ -316,41 +292,3 @@ class GridContactRig:
                     seconds=time.perf_counter() - t0)
         return dataclasses.replace(data, meta=meta)
 
-
-def assemble(plans: Sequence[ManeuverPlan], runs: Sequence[GridRun], design: RubbingDesign,
-             truth: RigTruth, *, source: str) -> RubbingData:
-    """Join per-maneuver plant outputs into one sensor log with labels (maneuvers back to
-    back in time; sensor offsets and noise from each plan)."""
-    dt = 1.0 / design.sample_rate
-    starts = stack_times(list(plans), dt)
-    cols = {k: [] for k in ("t", "f_n", "f_x", "f_y", "tau", "omega", "maneuver", "phase",
-                            "load", "c", "v")}
-    for p, r, t0 in zip(plans, runs, starts):
-        f_n, f_x, f_y, tau = p.sensor(r.f_n, r.f_x, r.f_y, r.tau)
-        phase = p.commanded_phase()
-        moving = phase == 1
-        phase[moving & (r.sliding_load >= _SLIDING_LOAD)] = 2
-        omega = p.omega
-        cols["t"].append(t0 + p.t)
-        cols["f_n"].append(f_n)
-        cols["f_x"].append(f_x)
-        cols["f_y"].append(f_y)
-        cols["tau"].append(tau)
-        cols["omega"].append(omega)
-        cols["maneuver"].append(np.full(len(p), p.index, dtype=np.int64))
-        cols["phase"].append(phase)
-        cols["load"].append(np.abs(r.tau_cor) / r.capacity_static)
-        cols["c"].append(p.c_tilde_signed(r.rho))
-        cols["v"].append(np.abs(omega) * float(np.hypot(*p.cor)))
-    cat = {k: np.concatenate(v) for k, v in cols.items()}
-    log = SlidingLog.from_arrays(
-        cat["t"], cat["f_n"], cat["tau"], f_x=cat["f_x"], f_y=cat["f_y"], omega=cat["omega"],
-        maneuver=cat["maneuver"], source=source, meta={"plant": source})
-    return RubbingData(log=log, phase=cat["phase"], load_ratio=cat["load"],
-                       c_tilde_true=cat["c"], v_true=cat["v"], truth=truth,
-                       meta={"design": design.to_dict(),
-                             "maneuvers": [{"index": p.index, "c_tilde": p.c_tilde,
-                                            "f_n": p.f_n_nominal, "reversals": p.reversals,
-                                            "cor": p.cor.tolist(),
-                                            "omega_peak": float(np.max(np.abs(p.knots_omega)))}
-                                           for p in plans]})
