@@ -161,9 +161,12 @@ class GridContactRig:
 
     # -- simulation ---------------------------------------------------------------------------
 
-    def run(self, plans: Sequence[ManeuverPlan], *, substeps: int | None = None) -> list[RigRun]:
+    def run(self, plans: Sequence[ManeuverPlan], *, substeps: int | None = None,
+            batch: int = _BATCH) -> list[RigRun]:
         """Integrate the plant along the plans (true wrench, no sensor); one
-        :class:`~lugrip.rigs._run.RigRun` per plan, in the plans' order."""
+        :class:`~lugrip.rigs._run.RigRun` per plan, in the plans' order. ``substeps``
+        overrides the rig's internal steps per sample; ``batch`` maneuvers (sorted by length)
+        are integrated together."""
         plans = list(plans)
         if not plans:
             return []
@@ -173,8 +176,9 @@ class GridContactRig:
         S = int(self.substeps if substeps is None else substeps)
         order = sorted(range(len(plans)), key=lambda i: len(plans[i]))
         out: list[RigRun | None] = [None] * len(plans)
-        for b in range(0, len(order), _BATCH):
-            idx = order[b:b + _BATCH]
+        batch = max(1, int(batch))
+        for b in range(0, len(order), batch):
+            idx = order[b:b + batch]
             for i, res in zip(idx, self._run_batch([plans[i] for i in idx], S)):
                 out[i] = res
         return out  # type: ignore[return-value]
