@@ -223,22 +223,15 @@ void ContactModel::wrench_at(double f_n, double c_tilde, double y, double& f_t, 
 
 bool validate(const CorSettings& s, std::string* message) {
   std::string msg;
-  // v in (0, hi] (lo_closed false) or [lo, hi] (lo_closed true), finite
-  auto check = [&](const char* name, double v, double lo, bool lo_closed, double hi, const char* unit) {
-    const bool ok = std::isfinite(v) && (lo_closed ? v >= lo : v > lo) && v <= hi;
-    if (!ok)
-      msg += std::string(name) + " = " + detail::format_number(v) + ": must be finite, " +
-             (lo_closed ? ">= " : "> ") + detail::format_number(lo) + " and <= " + detail::format_number(hi) +
-             unit + "\n";
+  auto positive = [&](const char* name, double v) {
+    if (!(std::isfinite(v) && v > 0.0))
+      msg += std::string(name) + " = " + detail::format_number(v) + ": must be finite and > 0\n";
   };
-  check("f_n_min", s.f_n_min, kMinContactForce, true, kMaxForceLimit, " [N]");
-  check("force_limit", s.force_limit, 0.0, false, kMaxForceLimit, " [N]");
-  check("torque_limit", s.torque_limit, 0.0, false, kMaxForceLimit, " [N m]");
-  if (std::isfinite(s.f_n_min) && std::isfinite(s.force_limit) && s.f_n_min >= s.force_limit &&
-      s.force_limit > 0.0 && s.f_n_min >= kMinContactForce)
-    msg += "f_n_min = " + detail::format_number(s.f_n_min) + ": must be < force_limit\n";
-  check("zero_force", s.zero_force, 0.0, false, 1.0, " (normalized: 1 is the friction limit)");
-  check("zero_torque", s.zero_torque, 0.0, false, 1.0, " (normalized: 1 is the friction limit)");
+  positive("f_n_min", s.f_n_min);
+  positive("force_limit", s.force_limit);
+  positive("torque_limit", s.torque_limit);
+  positive("zero_force", s.zero_force);
+  positive("zero_torque", s.zero_torque);
   if (message) *message = msg;
   return msg.empty();
 }

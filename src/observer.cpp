@@ -84,6 +84,16 @@ bool validate(const ObserverSettings& s, std::string* message) {
       if (end == std::string::npos) break;
       start = end + 1;
     }
+  } else {
+    // Narrower than the estimator alone accepts: keeps |y|, g / sigma0 and v_slip finite.
+    if (!(s.cor.f_n_min >= kMinContactForce))
+      bad("cor.f_n_min", fmt(s.cor.f_n_min), "must be >= 1e-06 [N] in an observer");
+    if (!(s.cor.force_limit <= kMaxForceLimit))
+      bad("cor.force_limit", fmt(s.cor.force_limit), "must be <= 1e+09 [N] in an observer");
+    if (!(s.cor.torque_limit <= kMaxForceLimit))
+      bad("cor.torque_limit", fmt(s.cor.torque_limit), "must be <= 1e+09 [N m] in an observer");
+    if (s.cor.f_n_min >= kMinContactForce && s.cor.force_limit <= kMaxForceLimit && !(s.cor.f_n_min < s.cor.force_limit))
+      bad("cor.f_n_min", fmt(s.cor.f_n_min), "must be < cor.force_limit");
   }
   if (message) *message = msg;
   return msg.empty();

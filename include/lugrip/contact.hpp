@@ -68,19 +68,18 @@ class ContactModel {
 //! translation whose torque is too small to place the CoR closer reads as this.
 constexpr double kCTildeUnclippedMax = 1.0e6;
 
-//! Per-sample settings of the CoR estimator (defaults in one place). The ranges keep every
-//! product finite for every ContactParams that passes validation: rho = delta f_n^gamma <
-//! max(1, f_n^(1/3)) m and |c| <= c_max rho, so with forces up to kMaxForceLimit = 1e9 N,
-//! rho < 1e3 m, |c| < 1e6 m and the torque about the CoR |tau| + |c| f_t < 1e16 N m. A sample
-//! whose normalisation still overflows (mu or delta near 0) is InvalidSample.
+//! Per-sample settings of the CoR estimator (defaults in one place). Every field must be finite
+//! and > 0; a sample whose normalisation or CoR quantities overflow (forces near the largest
+//! double, mu or delta near 0) is InvalidSample. Inside an Observer the sensor range and the
+//! contact threshold are narrower (ObserverSettings).
 //!
 //! | field | meaning | unit | range | default |
 //! |---|---|---|---|---|
-//! | f_n_min | below this normal force: NoContact (paper's code: 0.03) | N | [1e-6, force_limit) | 0.03 |
-//! | force_limit | |f_n| or |f_t| above: InvalidSample (sensor range) | N | (0, 1e9] | 1e4 |
-//! | torque_limit | |tau| above: InvalidSample (sensor range) | N m | (0, 1e9] | 1e3 |
-//! | zero_force | f~_t below this counts as zero (pure rotation) | - | (0, 1] | 1e-4 |
-//! | zero_torque | |tau~| below this counts as zero: |c~| = c_max, sign held | - | (0, 1] | 1e-4 |
+//! | f_n_min | below this normal force: NoContact (paper's code: 0.03) | N | > 0 | 0.03 |
+//! | force_limit | |f_n| or |f_t| above: InvalidSample (sensor range) | N | > 0 | 1e4 |
+//! | torque_limit | |tau| above: InvalidSample (sensor range) | N m | > 0 | 1e3 |
+//! | zero_force | f~_t below this counts as zero (pure rotation) | - | > 0 | 1e-4 |
+//! | zero_torque | |tau~| below this counts as zero: |c~| = c_max, sign held | - | > 0 | 1e-4 |
 struct CorSettings {
   double f_n_min = 0.03;         //!< [N] below this normal force: NoContact (paper's code: 0.03)
   double force_limit = 1.0e4;    //!< [N] |f_n| or |f_t| above: InvalidSample (sensor range)
@@ -89,9 +88,10 @@ struct CorSettings {
   double zero_torque = 1.0e-4;   //!< |tau~| below this counts as zero: |c~| = c_max, sign held
 };
 
-//! Upper bound of CorSettings::force_limit and torque_limit [N], [N m].
+//! Largest cor.force_limit [N] and cor.torque_limit [N m] an Observer accepts.
 constexpr double kMaxForceLimit = 1.0e9;
-//! Lower bound of CorSettings::f_n_min [N] (a micronewton: below any force sensor's resolution).
+//! Smallest cor.f_n_min [N] an Observer accepts (a micronewton: below any force sensor's
+//! resolution).
 constexpr double kMinContactForce = 1.0e-6;
 
 //! Checks the settings; one line per bad field in *message. Returns true when valid.
