@@ -38,7 +38,7 @@ import lugrip  # noqa: E402
 from lugrip.rigs import GridContactRig, RubbingDesign, make_rig  # noqa: E402
 
 SECTION = "observer-clip"
-REGIMES = (("|c~| <= 1.5", 0.0, 1.5), ("1.5 < |c~| <= 3", 1.5, 3.0), ("|c~| > 3", 3.0, np.inf))
+REGIMES = (("c~ <= 1.5", 0.0, 1.5), ("1.5 < c~ <= 3", 1.5, 3.0), ("c~ > 3", 3.0, np.inf))  # abs(c~)
 
 
 def _params(rig, truth) -> lugrip.ContactParams:
@@ -78,12 +78,16 @@ def _rig_rows(plant: str, seed: int, n: int) -> tuple[list[str], str]:
     sat = run.saturated & run.valid
     free = ~run.saturated & run.valid
     cost = []
+    o = lugrip.Observer(_params(rig, data.truth))
     for sel in (free, sat):
         idx = np.flatnonzero(sel)
-        o = lugrip.Observer(_params(rig, data.truth))
-        t0 = time.perf_counter()
-        o.run({"f_n": data.log.f_n[idx], "f_t": f_t[idx], "tau": data.log.tau[idx]})
-        cost.append(1e9 * (time.perf_counter() - t0) / max(idx.size, 1))
+        sub = {"f_n": data.log.f_n[idx], "f_t": f_t[idx], "tau": data.log.tau[idx]}
+        best = np.inf
+        for _ in range(5):  # the fastest of five runs (shared machine)
+            t0 = time.perf_counter()
+            o.run(sub)
+            best = min(best, time.perf_counter() - t0)
+        cost.append(1e9 * best / max(idx.size, 1))
     iters = run.cor_iterations
     timing = (f"| {plant} | {seed} | {cost[0]:.0f} | {cost[1]:.0f} | {iters[free].mean():.1f} | "
               f"{iters[sat].mean():.1f} | {int(iters.max())} |")
@@ -137,7 +141,7 @@ def main(argv=None) -> int:
         "up to 2 rad/s, presliding, loaded rest, noise 0.01 N / 2e-5 N m and per-maneuver offsets), "
         "the observer with each plant's true contact law (grid: mu = mu_k, beta_A, delta, gamma, "
         "k = 2; grid-stribeck has no viscous term, beta_A set to 1e3 so its speed is unobservable; "
-        "lumped: its own aluminium_can contact). Gross-sliding samples by the prescribed |c~|. "
+        "lumped: its own contact). Gross-sliding samples by the prescribed abs(c~). "
         "omega_hat is the slip about the clipped CoR (what the controller's C_d uses); "
         "omega_object re-expresses it about the unclipped CoR estimate; v in mm/s. Seed 0 was "
         "looked at while writing the outputs, seed 1 is held out (no constant was tuned). Where "
@@ -150,8 +154,9 @@ def main(argv=None) -> int:
         "|---|---|---|---|---|---|---|---|---|---|---|---|",
         *rows,
         "",
-        "Cost of `Observer.run` per sample on the same logs, samples whose CoR is not clipped "
-        "against those where it is (the clipped ones also solve for the CoR past c_max):",
+        "Cost of `Observer.run` per sample on the same logs (fastest of five runs), samples whose "
+        "CoR is not clipped against those where it is (the clipped ones also solve for the CoR "
+        "past c_max):",
         "",
         "| plant | seed | ns/sample, CoR free | ns/sample, clipped | CoR iterations, free | clipped | max |",
         "|---|---|---|---|---|---|---|",
