@@ -163,7 +163,7 @@ struct ObserverOutput {
   int cor_iterations = 0;   //!< root-finding iterations of the CoR estimate
   Status status = Status::NoContact;
   double c_tilde_unclipped = 0.0;  //!< normalized CoR before the clip [-], signed like c_tilde, |c~u| >= |c~|
-  double omega_object = 0.0;  //!< slip velocity about the unclipped CoR [rad/s] (= omega_hat unless saturated)
+  double omega_object = 0.0;  //!< slip velocity about the unclipped CoR [rad/s] (= omega_hat where c~u = c~)
   double v_slip = 0.0;        //!< slip speed of the patch centre [m/s], >= 0
 };
 

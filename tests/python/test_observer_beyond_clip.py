@@ -23,12 +23,12 @@ from lugrip.rigs import GridContactRig, RubbingDesign, make_rig
 FAR = RubbingDesign(c_tilde_range=(3.0, 20.0))  # translation-dominated rubs, beyond c_max = 1.5
 
 
-def _observer_for(plant: str, truth) -> lugrip.Observer:
-    if plant == "grid-viscous":
+def _observer_for(rig, truth) -> lugrip.Observer:
+    if isinstance(rig, GridContactRig):
         p = lugrip.ContactParams.table1().replace(
             mu=truth.mu, beta_a=truth.beta_a, delta=truth.delta, gamma=truth.gamma, k=2.0)
-    else:  # the lumped rig's own contact (aluminium_can preset)
-        p = lugrip.ContactParams.preset("aluminium_can")
+    else:  # the lumped rig's own contact
+        p = rig.contact()
     return lugrip.Observer(p)
 
 
@@ -38,7 +38,7 @@ def far_run(request):
     plant, seed = request.param
     rig = GridContactRig.viscous() if plant == "grid-viscous" else make_rig("lumped")
     data = rig.simulate(FAR, 6, seed=seed)
-    run = _observer_for(plant, data.truth).run(data.log)
+    run = _observer_for(rig, data.truth).run(data.log)
     return plant, data, run
 
 
@@ -48,7 +48,7 @@ def _rmse(x, ref, mask):
 
 def test_omega_object_beats_predicting_zero_beyond_the_clip(far_run):
     """Gross sliding with |c~| > 3: the |omega| error of omega_object is below that of
-    predicting zero (measured 0.33-0.47 of it), while omega_hat -- the slip about the clipped
+    predicting zero (measured 0.11-0.45 of it), while omega_hat -- the slip about the clipped
     CoR -- is 2-3 times worse than zero."""
     plant, data, run = far_run
     w = data.log.omega
@@ -96,7 +96,8 @@ def test_nothing_changes_below_the_clip():
     omega_hat is what it was (lumped sliding log with |c~| mostly below c_max; consistency)."""
     log = lugrip.simulate_sliding("aluminium_can", 12, seed=3)
     run = lugrip.Observer("aluminium_can").run(log)
-    free = ~run.saturated & run.valid
+    # not clipped on this sample (a zero wrench, Degenerate, holds the previous estimate, clipped or not)
+    free = ~run.saturated & run.valid & (run.status != lugrip.Status.DEGENERATE)
     assert free.sum() > 1000 and run.saturated.sum() > 0
     np.testing.assert_array_equal(run.omega_object[free], run.omega_hat[free])
     np.testing.assert_array_equal(run.c_tilde_unclipped[free], run.c_tilde[free])
