@@ -30,5 +30,6 @@ if [ -n "$bad" ]; then
 fi
 grep -q "lugrip::SlipControl::step" <<< "$syms" || { echo "FAIL: SlipControl::step not in the binary"; exit 1; }
 # control: the same patterns do find the simulator in the installed lugrip::sim archive
-nm -C "$out"/prefix/lib*/liblugrip_sim.a 2>/dev/null | grep -q "GraspPlant::step" || { echo "FAIL: control pattern"; exit 1; }
+sim_syms=$(nm -C "$out"/prefix/lib*/liblugrip_sim.a 2>/dev/null)
+grep -q "GraspPlant::step" <<< "$sim_syms" || { echo "FAIL: control pattern"; exit 1; }
 echo "OK: installed lugrip::core, lugrip::sim, lugrip::identification exported; example_04_robot_loop links the core only ($(grep -c 'lugrip::' <<< "$syms") lugrip symbols, none of the simulator, identification or threads)"
