@@ -13,7 +13,7 @@ from . import CliError
 __all__ = ["MAX_MANEUVERS", "register", "run"]
 
 MAX_MANEUVERS = 2000
-"""Largest --maneuvers accepted (about 1.3 million samples; the grid plant needs minutes)."""
+"""Largest --maneuvers accepted (about 1.3 million samples, about a minute for the grid plant)."""
 
 _EPILOG = """\
 examples:
