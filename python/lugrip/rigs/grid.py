@@ -38,7 +38,7 @@ import numpy as np
 
 from ._data import RigTruth, RubbingData
 from ._run import RigRun, assemble
-from .motion import ManeuverPlan, RubbingDesign, plan_maneuvers, stack_times
+from .motion import ManeuverPlan, RubbingDesign, plan_maneuvers
 
 __all__ = ["GridContactRig"]
 
@@ -237,7 +237,7 @@ class GridContactRig:
         def sample(k, geo):
             fn, omega = fn_s[:, k], w_s[:, k][:, None]
             rho = rho_s[:, k]
-            dx, dy, dn, ex, ey = geo
+            _, _, dn, ex, ey = geo
             stribeck(omega, dn)
             # bristle force per unit cell load: sigma0 z + sigma1 dz/dt + sigma2 v
             vx, vy = omega * dn * ex, omega * dn * ey
