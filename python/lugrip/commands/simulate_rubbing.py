@@ -6,6 +6,7 @@ from __future__ import annotations
 
 import argparse
 import textwrap
+import time
 from pathlib import Path
 
 from . import CliError
@@ -99,14 +100,16 @@ def run(args) -> int:
         rig = make_rig(args.plant, params=params)
     except ImportError as err:
         raise CliError(f"--plant {args.plant}: {err}") from None
+    t0 = time.perf_counter()
     data = rig.simulate(RubbingDesign(), args.maneuvers, args.seed)
+    seconds = time.perf_counter() - t0
     data.save(out, overwrite=bool(args.force), format=args.format)
     ph = data.phase
     n = len(data)
     tr = data.truth
     print(f"wrote {out}: {args.plant}, {args.maneuvers} maneuvers, {n} samples "
           f"({data.log.t[-1]:.1f} s at {RubbingDesign().sample_rate:g} Hz) in "
-          f"{data.meta.get('seconds', float('nan')):.1f} s")
+          f"{seconds:.1f} s")
     print("phases: " + ", ".join(f"{name} {100.0 * (ph == k).mean():.1f} %"
                                  for k, name in enumerate(("approach", "presliding",
                                                            "sliding", "rest"))))
