@@ -23,8 +23,11 @@ equations (docs/rigs.md):
 * the sensor reads the sum of the cell forces and their moment about the patch centre.
 
 The bristles are stiff, so every internal step uses the exact solution of the bristle
-equation for the velocity frozen at the step's midpoint. All maneuvers and cells are
-integrated together as (maneuvers x cells) numpy arrays.
+equation for the velocity frozen at the step's midpoint; the cell positions are held over
+each sample interval (radius at the interval's mean force). All maneuvers of a batch and all
+cells are integrated together as (maneuvers x cells) numpy arrays; the sums over cells are
+matrix-vector products, and the uniform viscous shear, linear in position, is summed over
+the cells in closed form.
 """
 
 from __future__ import annotations
