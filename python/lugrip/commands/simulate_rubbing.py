@@ -47,7 +47,9 @@ def _count(text: str) -> int:
 def register(subparsers) -> None:
     from ..rigs.registry import PLANTS
 
-    plants = "\n".join(f"  {k:14s} {v}" for k, v in PLANTS.items())
+    plants = "\n".join(textwrap.fill(v, 78, initial_indent=f"  {k:15s}",
+                                      subsequent_indent=" " * 17)
+                        for k, v in PLANTS.items())
     p = subparsers.add_parser(
         "simulate-rubbing",
         help="rubbing data with ground truth from a prescribed-motion plant (grid, patch, "
