@@ -96,13 +96,15 @@ class PadSpec:
     k_slide: float = 2000.0  #: in-plane stiffness of each slide joint [N/m]
     d_slide: float = 4.0  #: in-plane damping [N s/m]
     k_twist: float = 0.1  #: twist stiffness about the pad normal [N m/rad]
-    d_twist: float = 1e-4  #: twist damping [N m s/rad]
+    d_twist: float = 2.5e-4  #: twist damping [N m s/rad]
     mu: float = 0.7  #: Coulomb friction coefficient of the pad pairs [-]
     delta: float = 1.8e-3  #: contact radius law rho = delta f_n^gamma [m / N^gamma]
     gamma: float = 0.254  #: contact radius exponent [-]
     xi: float = 0.6354098135954843  #: torsional shape factor, tau_max = mu xi rho f_n [-] (k = 4)
     f_n_floor: float = 0.05  #: the law is evaluated at max(f_n, f_n_floor) [N]
-    solref: tuple[float, float] = (0.004, 1.0)  #: pair solref: time constant [s], damping ratio
+    #: pair solref: time constant [s] (>= 2 MuJoCo steps), damping ratio; a soft normal lets
+    #: the stuck pad creep tangentially
+    solref: tuple[float, float] = (0.002, 1.0)
     solimp: tuple[float, ...] = (0.95, 0.99, 0.001, 0.5, 2.0)  #: pair solimp (MuJoCo's meaning)
     rgba: tuple[float, float, float, float] = (0.2, 0.2, 0.2, 1.0)  #: display colour
 
@@ -188,12 +190,9 @@ def pad_body_xml(spec: PadSpec, pos: Sequence[float] = (0.0, 0.0, 0.0), quat=Non
         geom = f'type="cylinder" size="{spec.radius:.10g} {0.5 * spec.thickness:.10g}"'
     return (
         f'<body name="{spec.body_name}" pos="{_fmt(pos)}"{q}>'
-        f'<joint name="{jx}" type="slide" axis="1 0 0" stiffness="{spec.k_slide:.10g}" '
-        f'damping="{spec.d_slide:.10g}"/>'
-        f'<joint name="{jy}" type="slide" axis="0 1 0" stiffness="{spec.k_slide:.10g}" '
-        f'damping="{spec.d_slide:.10g}"/>'
-        f'<joint name="{jt}" type="hinge" axis="0 0 1" stiffness="{spec.k_twist:.10g}" '
-        f'damping="{spec.d_twist:.10g}"/>'
+        f'<joint name="{jx}" type="slide" axis="1 0 0" stiffness="{spec.k_slide:.10g}"/>'
+        f'<joint name="{jy}" type="slide" axis="0 1 0" stiffness="{spec.k_slide:.10g}"/>'
+        f'<joint name="{jt}" type="hinge" axis="0 0 1" stiffness="{spec.k_twist:.10g}"/>'
         f'<inertial pos="{_fmt(centre)}" mass="{spec.mass:.10g}" '
         f'diaginertia="{ixx:.10g} {iyy:.10g} {izz:.10g}"/>'
         f'<geom name="{spec.geom_name}" {geom} pos="{_fmt(centre)}" contype="0" '
@@ -259,7 +258,7 @@ class Pad:
 
     ``Pad(model, spec)`` finds the pad's body, geom and pairs by their names. Each step::
 
-        pad.update(model, data)     # torsional coefficient from the last normal force
+        pad.update(model, data)     # torsional coefficient, the springs' damping
         mujoco.mj_step(model, data)
         w = pad.wrench(model, data) # (f_n, f_x, f_y, tau) on the pad, pad frame
     """
@@ -289,19 +288,40 @@ class Pad:
             raise ValueError("pad contacts need noslip_iterations >= 5")
         self.joint_qpos = np.array([model.joint(j).qposadr[0] for j in spec.joint_names], dtype=int)
         self.joint_dof = np.array([model.joint(j).dofadr[0] for j in spec.joint_names], dtype=int)
+        self._damping = np.array([spec.d_slide, spec.d_slide, spec.d_twist])
+        # explicit damping is stable while d h / m < 2 for each dof (checked with margin)
+        h = float(model.opt.timestep)
+        m_dof = model.dof_M0[self.joint_dof] if hasattr(model, "dof_M0") else None
+        mass = np.array([spec.mass, spec.mass, spec.inertia()[2]])
+        if m_dof is not None and np.all(m_dof > 0):
+            mass = np.minimum(mass, m_dof)
+        if np.any(self._damping * h / mass > 1.5):
+            raise ValueError(
+                f"pad {spec.name!r}: damping too large for explicit integration at "
+                f"{h:g} s (d h / m = {np.max(self._damping * h / mass):.2f} > 1.5)"
+            )
         self._f6 = np.zeros(6)
         self.f_n_last = 0.0  #: normal force of the last wrench() call [N]
         self._spin_set = float("nan")
+        self._jac: tuple[np.ndarray, np.ndarray] | None = None
 
     def update(self, model, data=None, f_n: float | None = None) -> float:
-        """Set the pairs' torsional coefficient from ``f_n`` (default: the pad's normal force
-        in ``data``'s present contacts). Returns the coefficient [m]."""
+        """Before each ``mj_step``: set the pairs' torsional coefficient from ``f_n`` (default:
+        the pad's normal force in ``data``'s present contacts) and apply the pad springs'
+        damping as explicit joint forces (``data.qfrc_applied`` of the pad's three dofs).
+        Returns the coefficient [m].
+
+        The damping is explicit because MuJoCo integrates joint damping implicitly after the
+        constraint solve, which gives a stuck pad a small slip velocity (a creep of tens of
+        micrometres per second under load, even with noslip)."""
         if f_n is None:
             f_n = self._normal_force(model, data) if data is not None else self.f_n_last
         spin = float(self.spec.spin_coefficient(f_n))
         if spin != self._spin_set:
             model.pair_friction[self.pair_ids, 2] = spin
             self._spin_set = spin
+        if data is not None:
+            data.qfrc_applied[self.joint_dof] = -self._damping * data.qvel[self.joint_dof]
         return spin
 
     def frame(self, data) -> tuple[np.ndarray, np.ndarray]:
@@ -363,7 +383,13 @@ class Pad:
     def slip_velocity(self, model, data) -> np.ndarray:
         """(v_x, v_y, omega) of the object relative to the pad at the pad frame's origin, in
         the pad frame [m/s, m/s, rad/s]; NaN without contact. The object is the other geom of
-        the first present contact."""
+        the first present contact.
+
+        Called after ``mj_step``: the present ``qvel`` (the velocity the step's contact forces
+        produced) through the body Jacobians of the step's own forward pass, i.e. the slip
+        velocity that the step's constraint solve acted on (``mj_objectVelocity`` would give
+        the velocity before the step).
+        """
         idx = self.contacts(data)
         if not idx:
             return np.full(3, np.nan)
@@ -371,14 +397,17 @@ class Pad:
         other = c.geom2 if c.geom1 == self.geom_id else c.geom1
         other_body = int(model.geom_bodyid[other])
         o, R = self.frame(data)
-        v_pad = np.zeros(6)
-        v_obj = np.zeros(6)
         mj = self._mj
-        mj.mj_objectVelocity(model, data, mj.mjtObj.mjOBJ_BODY, self.body_id, v_pad, 0)
-        # the object's velocity at the pad origin: its spatial velocity moved to that point
-        mj.mj_objectVelocity(model, data, mj.mjtObj.mjOBJ_BODY, other_body, v_obj, 0)
-        w_obj = v_obj[:3]
-        v_obj_at = v_obj[3:] + np.cross(w_obj, o - data.xpos[other_body])
-        rel_v = R.T @ (v_obj_at - v_pad[3:])
-        rel_w = R.T @ (w_obj - v_pad[:3])
+        if self._jac is None or self._jac[0].shape[1] != model.nv:
+            self._jac = (np.zeros((3, model.nv)), np.zeros((3, model.nv)))
+        jp, jr = self._jac
+        mj.mj_jac(model, data, jp, jr, o, self.body_id)
+        v_pad, w_pad = jp @ data.qvel, jr @ data.qvel
+        if other_body == 0:
+            v_obj = w_obj = np.zeros(3)
+        else:
+            mj.mj_jac(model, data, jp, jr, o, other_body)  # the object's point at the pad origin
+            v_obj, w_obj = jp @ data.qvel, jr @ data.qvel
+        rel_v = R.T @ (v_obj - v_pad)
+        rel_w = R.T @ (w_obj - w_pad)
         return np.array([rel_v[0], rel_v[1], rel_w[2]])
