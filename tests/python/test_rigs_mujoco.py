@@ -213,8 +213,29 @@ def test_simulate_is_reproducible_and_labelled(rig):
     assert (t.mu, t.mu_static, t.viscous, t.beta_a) == (0.7, 0.7, False, None)
     assert t.tau_max(2.0) == pytest.approx(float(rig.pad.tau_max(2.0)), rel=1e-9)
     assert a.meta["plant"] == "mujoco"
+    # in gross sliding c~ is the actual slip CoR: its sign is -sign(omega)
+    g = a.phase == 2
+    assert np.all(np.sign(a.c_tilde_true[g]) == -np.sign(a.log.omega[g]))
 
 
 def test_rig_rejects_settings_that_allow_creep():
     with pytest.raises(ValueError, match="noslip"):
         MujocoRubbingRig(settings=RigSettings(noslip_iterations=2)).build()
+
+
+@pytest.mark.parametrize("c_tilde", [0.5, 2.0])
+def test_sliding_wrench_is_the_ellipse_maximum_dissipation_point(rig, built, c_tilde):
+    """MuJoCo's elliptic cone with noslip picks, for the pad's actual slip (its CoR at
+    c~_slip), the point of the ellipse whose normal is the slip twist: f~_t = a / sqrt(1 + a^2),
+    tau~ = 1 / sqrt(1 + a^2), a = c~_slip / xi. This is the limit surface MuJoCo implies."""
+    plan = _plan(rig, c_tilde, 4.0, omega=1.0, hold=2.5)
+    r = rig.run_maneuver(plan, built)
+    late = _sliding(plan, r) & _hold(plan, 0.4)
+    a = np.abs(r["c_tilde_slip"][late]) / rig.pad.xi
+    ft = np.hypot(r["f_x"], r["f_y"])[late] / (rig.pad.mu * r["f_n"][late])
+    tq = np.abs(r["tau"][late]) / rig.pad.tau_max(r["f_n"][late])
+    assert np.allclose(ft, a / np.sqrt(1 + a * a), atol=5e-3)
+    assert np.allclose(tq, 1 / np.sqrt(1 + a * a), atol=5e-3)
+    # the slip CoR settles on the prescribed one seen from the displaced contact point
+    c_true = r["cor_distance"][late] / rig.radius(r["f_n"][late])
+    assert np.abs(np.abs(r["c_tilde_slip"][late][-1]) / c_true[-1] - 1.0) < 0.03

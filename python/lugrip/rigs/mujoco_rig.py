@@ -188,6 +188,8 @@ class MujocoRubbingRig:
         1 ms steps): true wrench ``f_n, f_x, f_y, tau`` on the pad [N, N m], ``omega`` of the
         slider relative to the pad [rad/s], ``v`` slip speed of the contact [m/s],
         ``sliding`` (bool: every step of the sample at the cone limit and slipping),
+        ``cor_distance`` from the contact point (the pad origin, displaced from the mount
+        frame's origin by the pad springs) to the prescribed CoR [m],
         ``utilisation`` of the cone (its maximum over the sample) [-], ``load_ratio`` (the same:
         the plant's friction utilisation) [-], ``c_tilde_slip`` (the CoR of the actual slip
         over rho, signed as ``c_tilde_true``) [-]."""
@@ -211,10 +213,12 @@ class MujocoRubbingRig:
         n_settle = round(s.settle / h)
         n_steps = n_settle + (n_samples - 1) * ratio + ratio
         t0 = -(n_settle + ratio) * h  # the first logged sample averages the steps ending at 0
-        out = {k: np.zeros(n_samples) for k in ("f_n", "f_x", "f_y", "tau", "omega", "v")}
+        keys = ("f_n", "f_x", "f_y", "tau", "omega", "v", "cor_distance")
+        out = {k: np.zeros(n_samples) for k in keys}
+        qx, qy = int(pad.joint_qpos[0]), int(pad.joint_qpos[1])
         util = np.zeros(n_samples)
         sliding = np.zeros(n_samples, dtype=bool)
-        acc = np.zeros(6)
+        acc = np.zeros(7)
         slide_all = True
         util_max = 0.0
         pad.update(m, f_n=float(plan.f_n_at(0.0)))
@@ -250,12 +254,15 @@ class MujocoRubbingRig:
             acc[:4] += w
             acc[4] += rel[2] if np.isfinite(rel[2]) else 0.0
             acc[5] += math.hypot(rel[0], rel[1]) if np.isfinite(rel[0]) else 0.0
+            # the CoR seen from the contact point: the pad's springs shift the pad (and its
+            # contact) from the mount-frame origin by their deflection
+            acc[6] += math.hypot(cor[0] - d.qpos[qx], cor[1] - d.qpos[qy])
             slide_all = slide_all and slipping
             util_max = max(util_max, u)
             if (i_rel + ratio) % ratio == ratio - 1:
                 k = (i_rel + ratio) // ratio
                 a = acc / ratio
-                for j, key in enumerate(("f_n", "f_x", "f_y", "tau", "omega", "v")):
+                for j, key in enumerate(keys):
                     out[key][k] = a[j]
                 sliding[k] = slide_all
                 util[k] = util_max
@@ -285,7 +292,14 @@ class MujocoRubbingRig:
         """Run ``n`` maneuvers of ``design`` (default :class:`RubbingDesign`) drawn from
         ``seed``; the sensor log (the plan's noise and offsets on the true wrench) with its
         labels. Gross sliding (phase 2) is where MuJoCo's contact is at its cone limit and
-        slipping for the whole sample while the motion runs."""
+        slipping for the whole sample while the motion runs. ``load_ratio`` is the cone
+        utilisation; ``c_tilde_true`` in gross sliding the CoR of the pad's actual slip over
+        rho(f_n) (from MuJoCo's state), elsewhere the distance from the contact point to the
+        prescribed CoR over rho(f_n), signed -sign(omega) (the two agree once the pad's slip
+        has settled; at small c~ that takes about a second, longer than most legs);
+        ``v_true`` the contact's slip speed and the
+        log's ``omega`` the slider's angular velocity relative to the pad, both from MuJoCo's
+        state (averages over each sample period)."""
         import mujoco
 
         design = design if design is not None else RubbingDesign()
@@ -312,7 +326,12 @@ class MujocoRubbingRig:
             ph[(ph == 1) & r["sliding"]] = 2
             phase.append(ph)
             load.append(r["load_ratio"])
-            c_tilde.append(plan.c_tilde_signed(self.radius(np.maximum(r["f_n"], 1e-9))))
+            # in gross sliding the CoR of the pad's actual slip; elsewhere (no slip) that of the
+            # prescribed motion seen from the contact point
+            sign = np.sign(plan.c_tilde_signed(1.0))
+            c_geom = sign * r["cor_distance"] / self.radius(np.maximum(r["f_n"], 1e-9))
+            slip_ok = (ph == 2) & np.isfinite(r["c_tilde_slip"])
+            c_tilde.append(np.where(slip_ok, r["c_tilde_slip"], c_geom))
             v_true.append(r["v"])
         cat = {k: np.concatenate(v) for k, v in cols.items()}
         log = SlidingLog.from_arrays(
