@@ -404,3 +404,101 @@ class MujocoRubbingRig:
             truth=self.truth(),
             meta=meta,
         )
+
+
+def _sweep_plan(rig: MujocoRubbingRig, c_tilde: float, f_n: float) -> ManeuverPlan:
+    """A rub about a CoR at c_tilde rho at 3 mm/s contact speed (1 rad/s at most), 0.4 s of
+    sliding, then 0.4 s of loaded rest; no sensor noise."""
+    rho = float(rig.radius(f_n))
+    omega = min(1.0, 3e-3 / (c_tilde * rho)) if c_tilde > 0 else 1.0
+    kt = np.array([0.0, 0.1, 0.15, 0.55, 0.6])
+    kw = np.array([0.0, 0.0, omega, omega, 0.0])
+    t = np.arange(int(1.0 / 0.002) + 1) * 0.002
+    c = c_tilde * rho
+    return ManeuverPlan(
+        index=0, t=t, knots_t=kt, knots_omega=kw, cor=np.array([c, 0.0]), c_tilde=c_tilde,
+        rho_nominal=rho, f_n_nominal=f_n, approach=0.1, motion_end=0.6, f_n_start=1.0,
+        ripple=0.0, ripple_freq=1.0, ripple_phase=0.0, reversals=0, offset=np.zeros(4),
+        noise=(0.0, 0.0), noise_seed=0,
+    )  # fmt: skip
+
+
+#: (label, changes to the rig's model after it is built) compared by :func:`settings_sweep`
+SWEEP_SETTINGS = (
+    ("rig defaults: elliptic, noslip 10, impratio 10, solref 2 ms, explicit pad damping", {}),
+    ("noslip 5", {"noslip_iterations": 5}),
+    ("noslip 0", {"noslip_iterations": 0}),
+    ("pad damping as MuJoCo joint damping (implicit)", {"implicit_damping": True}),
+    ("contact solref 4 ms", {"solref": 0.004}),
+    ("impratio 1", {"impratio": 1.0}),
+)
+
+
+def settings_sweep(c_tilde: float = 1.0, f_n: float = 4.0) -> list[dict]:
+    """Stick, creep and sliding of the rig under each MuJoCo setting of
+    :data:`SWEEP_SETTINGS`, on one rub (:func:`_sweep_plan`). Per row: slip of the stuck pad
+    while its load builds [um], creep at the loaded rest [um/s], the load left at the end of
+    the rest, and the largest departure of the sliding wrench from the elliptic cone."""
+    rows = []
+    for label, change in SWEEP_SETTINGS:
+        pad = MujocoRubbingRig().pad
+        if "solref" in change:
+            pad = dataclasses.replace(pad, solref=(change["solref"], 1.0))
+        rig = MujocoRubbingRig(pad=pad)
+        m, d, p = rig.build()
+        if "noslip_iterations" in change:
+            m.opt.noslip_iterations = change["noslip_iterations"]
+        if "impratio" in change:
+            m.opt.impratio = change["impratio"]
+        if change.get("implicit_damping"):
+            m.dof_damping[p.joint_dof] = p._damping
+            p._damping = np.zeros(3)
+        plan = _sweep_plan(rig, c_tilde, f_n)
+        r = rig.run_maneuver(plan, (m, d, p))
+        ph = plan.commanded_phase()
+        dt = float(plan.t[1] - plan.t[0])
+        rho = rig.radius(r["f_n"])
+        speed = r["v"] + np.abs(r["omega"]) * rho
+        first = int(np.argmax((ph == 1) & r["sliding"])) if np.any(r["sliding"]) else len(ph)
+        build = (ph == 1) & (np.arange(len(ph)) < first) & (r["utilisation"] < 0.9)
+        rest = (ph == 3) & (plan.t > plan.motion_end + 0.05)
+        slide = (ph == 1) & r["sliding"]
+        rows.append(
+            {
+                "setting": label,
+                "onset_slip_um": 1e6 * float(np.sum(speed[build]) * dt),
+                "rest_creep_um_s": 1e6 * float(np.mean(speed[rest])),
+                "rest_load_end": float(r["load_ratio"][-1]),
+                "rest_load_start": float(r["load_ratio"][rest][0]),
+                "sliding_off_cone": float(np.max(np.abs(r["utilisation"][slide] - 1.0)))
+                if slide.any()
+                else float("nan"),
+            }
+        )
+    return rows
+
+
+def main(argv=None) -> int:
+    """``python -m lugrip.rigs.mujoco_rig [--c-tilde C] [--f-n F]``: the settings table."""
+    import argparse
+
+    ap = argparse.ArgumentParser(description=main.__doc__)
+    ap.add_argument("--c-tilde", type=float, default=1.0)
+    ap.add_argument("--f-n", type=float, default=4.0)
+    args = ap.parse_args(argv)
+    print(
+        "| MuJoCo setting | slip while the load builds [um] | creep at loaded rest [um/s] "
+        "| load at rest start -> end | sliding wrench off the cone |"
+    )
+    print("|---|---|---|---|---|")
+    for row in settings_sweep(args.c_tilde, args.f_n):
+        print(
+            f"| {row['setting']} | {row['onset_slip_um']:.2f} | {row['rest_creep_um_s']:.3g} "
+            f"| {row['rest_load_start']:.3f} -> {row['rest_load_end']:.3f} "
+            f"| {row['sliding_off_cone']:.1e} |"
+        )
+    return 0
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())
