@@ -324,7 +324,7 @@ class MujocoRubbingRig:
         utilisation; ``c_tilde_true`` in gross sliding the CoR of the pad's actual slip over
         rho(f_n) (from MuJoCo's state), elsewhere the distance from the contact point to the
         prescribed CoR over rho(f_n), signed -sign(omega) (the two agree once the pad's slip
-        has settled; at small c~ that takes about a second, longer than most legs);
+        has settled, about 0.2 s into a leg);
         ``v_true`` the contact's slip speed and the
         log's ``omega`` the slider's angular velocity relative to the pad, both from MuJoCo's
         state (averages over each sample period)."""
