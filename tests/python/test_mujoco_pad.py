@@ -82,6 +82,21 @@ def test_statics_pressing_force_is_the_normal_force(force):
 
 
 @pytest.mark.parametrize("force", [2.0, 8.0])
+def test_flat_pad_touches_at_one_point_and_follows_the_law(force):
+    """The flat round pad (an oblate ellipsoid through MuJoCo's convex collision) has one
+    contact, so its torsional capacity is the law's; its contact point wanders a little on
+    the flat face, which leaves an in-plane force of about 1 % of f_n."""
+    spec = PadSpec(shape="disc", radius=0.008, thickness=0.004)
+    m, d, pad = _bench(spec)
+    w, v = _run(m, d, pad, force, theta_of_t=lambda t: max(t - 0.2, 0.0), steps=900)
+    assert d.ncon == 1
+    assert v[-1, 2] == pytest.approx(-1.0, rel=1e-2)  # it turns over the slider
+    assert abs(w[-1, 3]) == pytest.approx(float(spec.tau_max(force)), rel=2e-3)
+    assert np.hypot(w[-1, 1], w[-1, 2]) < 0.02 * force
+    assert w[-1, 0] == pytest.approx(force, rel=2e-3)
+
+
+@pytest.mark.parametrize("force", [2.0, 8.0])
 def test_torsional_capacity_follows_the_pad_law(force):
     spec = PadSpec()
     m, d, pad = _bench(spec)

@@ -94,7 +94,9 @@ class PadSpec:
     """Geometry, compliance and friction law of one fingertip pad."""
 
     name: str = "pad"  #: prefix of the pad's MJCF names (body, joints, geom, pairs)
-    shape: str = "sphere"  #: "sphere" (hemispherical pad) or "disc" (flat round pad)
+    #: "sphere" (hemispherical pad) or "disc" (flat round pad: an oblate ellipsoid, radius by
+    #: thickness / 2, whose face touches at one point)
+    shape: str = "sphere"
     radius: float = 0.012  #: sphere radius or disc radius [m]
     thickness: float = 0.004  #: disc thickness [m] (sphere: unused)
     mass: float = 0.04  #: pad body mass [kg] (with k_slide: 1 ms steps resolve its mode)
@@ -168,9 +170,9 @@ class PadSpec:
         if self.shape == "sphere":
             i = 0.4 * m * r * r
             return (i, i, i)
-        h = self.thickness
-        ixy = m * (3 * r * r + h * h) / 12.0
-        return (ixy, ixy, 0.5 * m * r * r)
+        c = 0.5 * self.thickness  # ellipsoid semi-axes r, r, c
+        ixy = 0.2 * m * (r * r + c * c)
+        return (ixy, ixy, 0.4 * m * r * r)
 
 
 def _fmt(v: Iterable[float]) -> str:
@@ -191,8 +193,14 @@ def pad_body_xml(spec: PadSpec, pos: Sequence[float] = (0.0, 0.0, 0.0), quat=Non
         centre = (0.0, 0.0, spec.radius)
         geom = f'type="sphere" size="{spec.radius:.10g}"'
     else:
+        # an oblate ellipsoid: a round, nearly flat face (curvature radius radius^2 / (thickness
+        # / 2) at its centre) that touches at one point, so the torsional law holds (a cylinder
+        # would touch at several rim points, each with its own torsional friction)
         centre = (0.0, 0.0, 0.5 * spec.thickness)
-        geom = f'type="cylinder" size="{spec.radius:.10g} {0.5 * spec.thickness:.10g}"'
+        geom = (
+            f'type="ellipsoid" size="{spec.radius:.10g} {spec.radius:.10g} '
+            f'{0.5 * spec.thickness:.10g}"'
+        )
     return (
         f'<body name="{spec.body_name}" pos="{_fmt(pos)}"{q}>'
         f'<joint name="{jx}" type="slide" axis="1 0 0" stiffness="{spec.k_slide:.10g}"/>'
