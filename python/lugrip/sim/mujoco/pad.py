@@ -179,14 +179,19 @@ def _fmt(v: Iterable[float]) -> str:
     return " ".join(f"{x:.10g}" for x in v)
 
 
-def pad_body_xml(spec: PadSpec, pos: Sequence[float] = (0.0, 0.0, 0.0), quat=None) -> str:
+def pad_body_xml(
+    spec: PadSpec, pos: Sequence[float] = (0.0, 0.0, 0.0), quat=None, gravcomp: float = 0.0
+) -> str:
     """The MJCF ``<body>`` of the pad, to be placed inside its finger's body.
 
     ``pos``/``quat`` place the pad frame in the finger's frame; the pad frame's -z points out
     of the face toward the object. The geom's face (its front-most point) is at the pad
-    frame's origin, the geom extends toward +z (into the finger).
+    frame's origin, the geom extends toward +z (into the finger). ``gravcomp`` is MuJoCo's
+    gravity compensation of the pad body (1: its weight does not load its springs).
     """
     q = "" if quat is None else f' quat="{_fmt(quat)}"'
+    if gravcomp:
+        q += f' gravcomp="{float(gravcomp):.10g}"'
     jx, jy, jt = spec.joint_names
     ixx, iyy, izz = spec.inertia()
     if spec.shape == "sphere":
@@ -269,7 +274,9 @@ class FingertipSensor:
 class Pad:
     """One pad in a compiled MuJoCo model: its torsional law and its sensor wrench.
 
-    ``Pad(model, spec)`` finds the pad's body, geom and pairs by their names. Each step::
+    ``Pad(model, spec)`` finds the pad's body, geom and pairs by their names. :meth:`update`
+    writes the pairs' torsional coefficient into ``model.pair_friction``: one model per
+    simulation (a model shared by several ``MjData`` shares that coefficient). Each step::
 
         pad.update(model, data)     # torsional coefficient, the springs' damping
         mujoco.mj_step(model, data)
