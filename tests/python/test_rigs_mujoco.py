@@ -178,9 +178,9 @@ def test_signs_follow_the_sliding_log_convention(rig, built):
 
 @pytest.mark.parametrize("c_tilde", [0.0, 1.0, 20.0])
 def test_noslip_holds_the_loaded_rest(rig, c_tilde):
-    """Why the rig needs the noslip solver: after the motion stops with the pad loaded at its
-    limit, MuJoCo's soft friction without noslip lets the contact creep and the load relax;
-    with noslip it stays put and loaded."""
+    """Why the rig needs the noslip solver: with it the pad stays put and loaded at its limit
+    after the motion stops; without it MuJoCo's soft friction lets the contact slip (while
+    loading and at rest) and the rest ends with most of the load gone."""
     plan = _plan(
         rig, c_tilde, 3.0, omega=1.0 if c_tilde < 10 else 0.2, ramp=0.02, hold=0.2, rest=0.4
     )
@@ -194,9 +194,8 @@ def test_noslip_holds_the_loaded_rest(rig, c_tilde):
     load, omega, v = out[10]
     assert load[0] > 0.99 and load[-1] > 0.99  # the rest stays loaded at the limit
     assert np.max(np.abs(omega)) < 1e-6 and np.max(v) < 1e-6  # and does not slip
-    load0, omega0, v0 = out[0]
-    assert load0[-1] < 0.75  # without noslip the load relaxes by creep
-    assert np.max(np.abs(omega0)) > 1e-2 or np.max(v0) > 1e-4  # it creeps while relaxing
+    load0 = out[0][0]
+    assert load0[-1] < 0.75  # without noslip the soft friction lets the load slip away
 
 
 def test_simulate_is_reproducible_and_labelled(rig):
@@ -259,3 +258,4 @@ def test_simulate_warns_when_fast_sliding_bounces_the_pad(rig):
     with pytest.warns(UserWarning, match="bounce"):
         data = rig.simulate(design, n=1, seed=0)
     assert data.meta["normal_force_deviation_max"] > 0.1
+    assert data.meta["normal_force_deviation_share"] > 0.1

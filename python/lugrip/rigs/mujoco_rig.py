@@ -36,9 +36,11 @@ from .motion import ManeuverPlan, RubbingDesign, plan_maneuvers, stack_times
 
 __all__ = ["MujocoRubbingRig", "RigSettings", "mount_pose", "mount_poses"]
 
-#: largest relative departure of the true normal force from the plan while the pad moves
-#: before :meth:`MujocoRubbingRig.simulate` warns
+#: :meth:`MujocoRubbingRig.simulate` warns when the true normal force departs from the plan
+#: by more than _BOUNCE (relative) on more than _BOUNCE_SHARE of a maneuver's moving samples
+#: (a stick-slip transition alone kicks it for a sample or two)
 _BOUNCE = 0.1
+_BOUNCE_SHARE = 0.02
 
 
 def _default_pad() -> PadSpec:
@@ -58,7 +60,10 @@ class RigSettings:
     cone_tolerance: float = 1e-3  #: gross sliding: cone utilisation >= 1 - this [-]
     slip_speed: float = 1e-4  #: gross sliding: slip speed |v| + |omega| rho above this [m/s]
     noslip_iterations: int = int(CONTACT_OPTIONS["noslip_iterations"])  #: MuJoCo noslip
-    impratio: float = float(CONTACT_OPTIONS["impratio"])  #: MuJoCo impratio
+    #: MuJoCo impratio: 1, not the fingertip models' 10: with noslip holding the stuck pad,
+    #: a stiffer friction row only couples the sliding pad's friction into its normal force
+    #: (stick-slip and normal kicks at low f_n; validation/mujoco/README.md)
+    impratio: float = 1.0
     timestep: float = float(CONTACT_OPTIONS["timestep"])  #: MuJoCo step [s]
 
 
@@ -344,7 +349,8 @@ class MujocoRubbingRig:
         for plan, t_start in zip(plans, starts):
             r = self.run_maneuver(plan, built)
             moving = plan.commanded_phase() >= 1
-            f_n_dev.append(float(np.max(np.abs(r["f_n"][moving] / plan.f_n[moving] - 1.0))))
+            dev = np.abs(r["f_n"][moving] / plan.f_n[moving] - 1.0)
+            f_n_dev.append((float(np.max(dev)), float(np.mean(dev > _BOUNCE))))
             f_n, f_x, f_y, tau = plan.sensor(r["f_n"], r["f_x"], r["f_y"], r["tau"])
             cols["t"].append(t_start + plan.t)
             cols["f_n"].append(f_n)
@@ -364,12 +370,13 @@ class MujocoRubbingRig:
             slip_ok = (ph == 2) & np.isfinite(r["c_tilde_slip"])
             c_tilde.append(np.where(slip_ok, r["c_tilde_slip"], c_geom))
             v_true.append(r["v"])
-        bounced = [i for i, dev in enumerate(f_n_dev) if dev > _BOUNCE]
+        bounced = [i for i, (_, share) in enumerate(f_n_dev) if share > _BOUNCE_SHARE]
         if bounced:
             warnings.warn(
                 f"MujocoRubbingRig: in maneuvers {bounced[:10]} the true normal force left the "
-                f"plan by more than {100 * _BOUNCE:.0f} % (MuJoCo's soft elliptic cone makes a "
-                "fast-sliding pad bounce; keep contact speeds below about 5 mm/s)",
+                f"plan by more than {100 * _BOUNCE:.0f} % on more than "
+                f"{100 * _BOUNCE_SHARE:.0f} % of the moving samples (MuJoCo's soft elliptic "
+                "cone makes a fast-sliding pad bounce; keep contact speeds below about 5 mm/s)",
                 stacklevel=2,
             )
         cat = {k: np.concatenate(v) for k, v in cols.items()}
@@ -392,7 +399,8 @@ class MujocoRubbingRig:
             "pad": asdict(self.pad),
             "settings": asdict(self.settings),
             "seconds": time.perf_counter() - wall,
-            "normal_force_deviation_max": max(f_n_dev),
+            "normal_force_deviation_max": max(dev for dev, _ in f_n_dev),
+            "normal_force_deviation_share": max(share for _, share in f_n_dev),
             "normal_force_bounce_maneuvers": bounced,
         }
         return RubbingData(
@@ -425,12 +433,13 @@ def _sweep_plan(rig: MujocoRubbingRig, c_tilde: float, f_n: float) -> ManeuverPl
 
 #: (label, changes to the rig's model after it is built) compared by :func:`settings_sweep`
 SWEEP_SETTINGS = (
-    ("rig defaults: elliptic, noslip 10, impratio 10, solref 2 ms, explicit pad damping", {}),
+    ("rig defaults: elliptic, noslip 10, impratio 1, solref 2 ms, explicit pad damping", {}),
     ("noslip 5", {"noslip_iterations": 5}),
     ("noslip 0", {"noslip_iterations": 0}),
+    ("noslip 0, impratio 10", {"noslip_iterations": 0, "impratio": 10.0}),
     ("pad damping as MuJoCo joint damping (implicit)", {"implicit_damping": True}),
     ("contact solref 4 ms", {"solref": 0.004}),
-    ("impratio 1", {"impratio": 1.0}),
+    ("impratio 10", {"impratio": 10.0}),
 )
 
 

@@ -379,6 +379,19 @@ class Pad:
         R = data.xmat[self.body_id].reshape(3, 3)
         con = data.contact
         f6 = self._f6
+        if idx.size == 1:  # one contact: its point is the centre of pressure
+            i = int(idx[0])
+            self._mj.mj_contactForce(model, data, i, f6)
+            # rows of M: the contact's normal and tangents in pad coordinates
+            M = con.frame[i].reshape(3, 3) @ R
+            sign = -1.0 if con.geom[i, 0] == self.geom_id else 1.0
+            local = (sign * f6[:3]) @ M
+            out[0] = local[2]
+            out[1] = local[0]
+            out[2] = local[1]
+            out[3] = sign * f6[3] * M[0, 2]
+            self.f_n_last = float(out[0])
+            return out
         forces = np.empty((idx.size, 3))
         moment = np.zeros(3)
         for j, i in enumerate(idx):
@@ -426,13 +439,13 @@ class Pad:
         if self._jac is None or self._jac[0].shape[1] != model.nv:
             self._jac = (np.zeros((3, model.nv)), np.zeros((3, model.nv)))
         jp, jr = self._jac
+        qvel = data.qvel
         mj.mj_jac(model, data, jp, jr, o, self.body_id)
-        v_pad, w_pad = jp @ data.qvel, jr @ data.qvel
-        if other_body == 0:
-            v_obj = w_obj = np.zeros(3)
-        else:
+        rel_v = -(jp @ qvel)
+        rel_wz = -float(R[:, 2] @ (jr @ qvel))
+        if other_body != 0:
             mj.mj_jac(model, data, jp, jr, o, other_body)  # the object's point at the pad origin
-            v_obj, w_obj = jp @ data.qvel, jr @ data.qvel
-        rel_v = R.T @ (v_obj - v_pad)
-        rel_w = R.T @ (w_obj - w_pad)
-        return np.array([rel_v[0], rel_v[1], rel_w[2]])
+            rel_v += jp @ qvel
+            rel_wz += float(R[:, 2] @ (jr @ qvel))
+        local = rel_v @ R
+        return np.array([local[0], local[1], rel_wz])
