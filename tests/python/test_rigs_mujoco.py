@@ -226,6 +226,22 @@ def test_rig_rejects_settings_that_allow_creep():
         MujocoRubbingRig(settings=RigSettings(noslip_iterations=2)).build()
 
 
+@pytest.mark.parametrize(
+    "kw",
+    [
+        {"mount_mass": 0.0},
+        {"slip_speed": -1e-4},
+        {"cone_tolerance": 0.0},
+        {"timestep": math.nan},
+        {"timestep": 0.01},
+        {"settle": -0.1},
+    ],
+)
+def test_rig_settings_reject_bad_values(kw):
+    with pytest.raises(ValueError, match="RigSettings"):
+        RigSettings(**kw)
+
+
 @pytest.mark.parametrize("c_tilde", [0.5, 2.0])
 def test_sliding_wrench_is_the_ellipse_maximum_dissipation_point(rig, built, c_tilde):
     """MuJoCo's elliptic cone with noslip picks, for the pad's actual slip (its CoR at

@@ -66,6 +66,22 @@ class RigSettings:
     impratio: float = 1.0
     timestep: float = float(CONTACT_OPTIONS["timestep"])  #: MuJoCo step [s]
 
+    def __post_init__(self) -> None:
+        for name in ("finger_mass", "mount_mass", "slip_speed", "timestep", "impratio"):
+            v = getattr(self, name)
+            if not (isinstance(v, (int, float)) and math.isfinite(v) and v > 0):
+                raise ValueError(f"RigSettings.{name} must be finite and > 0, got {v!r}")
+        for name in ("normal_damping", "settle"):
+            v = getattr(self, name)
+            if not (isinstance(v, (int, float)) and math.isfinite(v) and v >= 0):
+                raise ValueError(f"RigSettings.{name} must be finite and >= 0, got {v!r}")
+        if not (0.0 < self.cone_tolerance < 0.5):
+            raise ValueError(
+                f"RigSettings.cone_tolerance must be in (0, 0.5), got {self.cone_tolerance!r}"
+            )
+        if self.timestep > 0.002:
+            raise ValueError(f"RigSettings.timestep must be <= 2 ms, got {self.timestep!r}")
+
 
 def _theta_segments(plan: ManeuverPlan):
     """Cumulative pad angle at the knots of the plan's angular-velocity profile [rad]."""
