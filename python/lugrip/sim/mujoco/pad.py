@@ -362,7 +362,7 @@ class Pad:
 
     def _normal_force(self, model, data) -> float:
         total = 0.0
-        for i in self.contacts(data):
+        for i in np.asarray(self.contacts(data), dtype=int):
             self._mj.mj_contactForce(model, data, int(i), self._f6)
             total += self._f6[0]
         return total
@@ -372,7 +372,7 @@ class Pad:
         [N, N, N, N m], its moment taken about the centre of pressure of the pad's contacts
         (with one contact: the contact point). Zero without contact."""
         out = np.zeros(4)
-        idx = self.contacts(data)
+        idx = np.asarray(self.contacts(data), dtype=int)  # a subclass may return a list
         if idx.size == 0:
             self.f_n_last = 0.0
             return out
@@ -427,7 +427,7 @@ class Pad:
         velocity that the step's constraint solve acted on (``mj_objectVelocity`` would give
         the velocity before the step).
         """
-        idx = self.contacts(data)
+        idx = np.asarray(self.contacts(data), dtype=int)  # a subclass may return a list
         if idx.size == 0:
             return np.full(3, np.nan)
         g1, g2 = data.contact.geom[idx[0]]
