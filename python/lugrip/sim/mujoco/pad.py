@@ -2,8 +2,9 @@
 
 The pad is a body of its own, attached to the finger body that carries it by three spring
 joints: two slides in the pad plane and a twist hinge about the pad normal. Its geom (a sphere
-whose front hemisphere touches, or a flat round disc) collides only through explicit contact
-pairs with condim 4 (tangential and torsional friction) on an elliptic cone.
+whose front hemisphere touches, or a flat round face: an oblate ellipsoid) collides only
+through explicit contact pairs with condim 4 (tangential and torsional friction) on an elliptic
+cone.
 
 MuJoCo's torsional capacity of a point contact is mu_spin f_n with a constant coefficient
 mu_spin [m]. :class:`Pad` updates that coefficient before every step from the normal force of
