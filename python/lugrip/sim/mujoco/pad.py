@@ -391,6 +391,7 @@ class Pad:
             out[1] = local[0]
             out[2] = local[1]
             out[3] = sign * f6[3] * M[0, 2]
+            out += 0.0  # no negative zeros
             self.f_n_last = float(out[0])
             return out
         forces = np.empty((idx.size, 3))
