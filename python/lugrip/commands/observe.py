@@ -281,7 +281,7 @@ def run(args) -> int:
     _check_target(out, "--out", args.force)
     fig_path = None
     if args.plot is not None:
-        from ..plot_observer import FIG5_NAME
+        from ..plot.observer import FIG5_NAME
 
         if args.plot.exists() and not args.plot.is_dir():
             raise CliError(f"argument --plot: {args.plot} exists and is not a directory")
@@ -338,7 +338,7 @@ def run(args) -> int:
     else:
         print("  no ground-truth omega in the log: RMSE not computed")
     if fig_path is not None:
-        from ..plot_observer import write_figure5
+        from ..plot.observer import write_figure5
 
         args.plot.mkdir(parents=True, exist_ok=True)
         path = write_figure5(
@@ -358,7 +358,7 @@ def demo_section(out_dir: Path) -> str:
     """Demo step "observer replay": 40 synthetic Table 1 maneuvers through the observer with
     the default settings, Figure 5 and the scores (Markdown)."""
     from .. import ContactParams, Observer
-    from ..plot_observer import write_figure5
+    from ..plot.observer import write_figure5
     from ..sliding import score, simulate_maneuvers
 
     params = ContactParams.table1()

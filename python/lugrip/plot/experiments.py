@@ -19,7 +19,7 @@ from pathlib import Path
 
 import numpy as np
 
-from . import plot
+from .. import plot
 
 __all__ = [
     "FIGURES",
