@@ -132,7 +132,7 @@ def find_maneuvers(log: SlidingLog, *, min_rest: float = 0.1,
         return ids
     tau = np.asarray(log.tau, dtype=np.float64)
     finite = np.isfinite(tau)
-    level = 0.02 * float(np.percentile(np.abs(tau[finite]), 99)) if finite.any() else 0.0
+    level = 1e-3 * float(np.percentile(np.abs(tau[finite]), 99)) if finite.any() else 0.0
     thr = max(5.0 * _noise_std(tau), level)
     rest = finite & (np.abs(tau) <= thr)
     if log.omega is not None:
