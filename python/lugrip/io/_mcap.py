@@ -20,6 +20,7 @@ from ._ros import (
     _DEFAULT_WRENCH_TOPIC,
     _MCAP_META,
     _TYPES,
+    MAX_MESSAGES,
     RosSource,
     full_type,
     short_type,
@@ -94,7 +95,8 @@ class McapSource(RosSource):
                     if isinstance(rec, records.Message):
                         topic, typ, _enc, _schema = channels[rec.channel_id]
                         counts[topic] += 1
-                        if typ in _TYPES:
+                        # past MAX_MESSAGES only count: read() refuses the topic then
+                        if typ in _TYPES and counts[topic] <= MAX_MESSAGES:
                             self._raw[topic].append((rec.log_time, rec.data))
                     elif isinstance(rec, records.Schema):
                         schemas[rec.id] = rec

@@ -40,6 +40,8 @@ OMEGA_TYPES = ("geometry_msgs/TwistStamped", "geometry_msgs/Twist",
                "geometry_msgs/Vector3Stamped", "geometry_msgs/Vector3") + _FLOAT_TYPES
 ID_TYPES = _INT_TYPES + _FLOAT_TYPES  # maneuver ids (floats must hold integers)
 SCALAR_TYPES = _FLOAT_TYPES + _INT_TYPES  # recorded commands and similar scalars
+#: Most messages read from one topic (about 330 bytes each in memory: 2e6 = 66 min at 500 Hz).
+MAX_MESSAGES = 2_000_000
 
 
 def short_type(name: str) -> str:
@@ -116,10 +118,21 @@ class RosSource:
     def _messages(self, names: list[str]) -> Iterator[tuple[str, int, Any]]:
         raise NotImplementedError
 
+    def _too_many(self, name: str, count: int) -> LogError:
+        return LogError(self.file, f"topic '{name}' has {count} messages or more, over the "
+                        f"{MAX_MESSAGES} one log may hold in memory; cut the recording into "
+                        "pieces (e.g. rosbags-convert or mcap filter with a time range)")
+
     def read(self, names: list[str]) -> dict[str, Topic]:
+        for name in names:
+            count = self.topics[name][2]
+            if count is not None and count > MAX_MESSAGES:
+                raise self._too_many(name, count)
         out = {name: Topic(name, self.topics[name][0]) for name in names}
         for name, log_ns, msg in self._messages(names):
             topic = out[name]
+            if len(topic.values) >= MAX_MESSAGES:
+                raise self._too_many(name, MAX_MESSAGES + 1)
             try:
                 topic.add(log_ns, msg)
             except (AttributeError, TypeError, ValueError) as exc:
