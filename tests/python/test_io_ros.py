@@ -46,9 +46,10 @@ def _header(ts, ros1, stamp_ns, frame):
 
 
 def write_two_finger_bag(path, log, *, ros1, with_maneuvers=True, torque_xy=None,
-                         stamps=None):
-    """Two WrenchStamped topics (finger 0 = the log, finger 1 its mirror), a TwistStamped
-    ground truth and, optionally, the maneuver ids as std_msgs/Int32 at each change."""
+                         stamps=None, command=None, finger1_delay_ns=0):
+    """Two WrenchStamped topics (finger 0 = the log, finger 1 its mirror, stamped
+    ``finger1_delay_ns`` later), a TwistStamped ground truth, optionally the maneuver ids as
+    std_msgs/Int32 at each change and a std_msgs/Float64 command per sample."""
     ts = _store(ros1)
     T = ts.types
     if ros1:
@@ -74,14 +75,19 @@ def write_two_finger_bag(path, log, *, ros1, with_maneuvers=True, torque_xy=None
         c1 = writer.add_connection("/finger1/wrench", wt, typestore=ts)
         ct = writer.add_connection("/truth/twist", tt, typestore=ts)
         cm = writer.add_connection("/maneuver", it, typestore=ts) if with_maneuvers else None
+        ft = "std_msgs/msg/Float64"
+        cc = writer.add_connection("/gripper/command", ft, typestore=ts) if command is not None \
+            else None
         for i, s in enumerate(stamps.tolist()):
             if cm is not None and (i == 0 or log.maneuver[i] != log.maneuver[i - 1]):
                 writer.write(cm, s, ser(I32(data=int(log.maneuver[i])), it))
-            for conn, sign in ((c0, 1.0), (c1, -1.0)):
-                msg = WS(header=_header(ts, ros1, s, "pad"), wrench=W(
+            for conn, sign, delay in ((c0, 1.0, 0), (c1, -1.0, finger1_delay_ns)):
+                msg = WS(header=_header(ts, ros1, s + delay, "pad"), wrench=W(
                     force=V(float(log.f_x[i]), sign * float(log.f_y[i]), float(log.f_n[i])),
                     torque=V(float(mx[i]), float(my[i]), sign * float(log.tau[i]))))
-                writer.write(conn, s + 20_000, ser(msg, wt))  # log time: 20 us after stamp
+                writer.write(conn, s + delay + 20_000, ser(msg, wt))  # log: 20 us after stamp
+            if cc is not None:
+                writer.write(cc, s + 10_000, ser(T[ft](data=float(command[i])), ft))
             tw = TWS(header=_header(ts, ros1, s, "pad"),
                      twist=TW(linear=V(0.0, 0.0, 0.0), angular=V(0.0, 0.0,
                                                                  float(log.omega[i]))))
@@ -264,3 +270,59 @@ def test_missing_io_extra_is_one_line_exit_2(tmp_path, capsys, monkeypatch, suff
     assert rc == 2, err
     assert len(err.strip().splitlines()) == 1
     assert "lugrip[io]" in err and "Traceback" not in err
+
+
+# ---------------------------------------------------------------------------------------------
+# Two-finger logs (the input of lugrip replay)
+# ---------------------------------------------------------------------------------------------
+
+def test_two_finger_table_round_trip_and_missing_columns(tmp_path, data):
+    """write_grasp_log / read_grasp_log: per-finger suffixes, command, maneuver, bit-exact;
+    a missing finger-1 column is named with its suffix."""
+    from lugrip.io import GraspLog, read_grasp_log, write_grasp_log
+
+    log = data.log
+    n = len(log)
+    w0 = np.stack([log.f_n, log.f_x, log.f_y, log.tau], axis=1)
+    w1 = w0 * [1.0, 1.0, -1.0, -1.0]
+    command = np.linspace(2.0, 5.0, n)
+    g = GraspLog(t=log.t, wrench=np.stack([w0, w1], axis=1), command=command,
+                 maneuver=log.maneuver, fingers=(log, log))
+    for suffix in (".csv", ".parquet"):
+        path = write_grasp_log(g, tmp_path / f"grasp{suffix}")
+        back = read_grasp_log(path)
+        np.testing.assert_array_equal(back.t, log.t)
+        np.testing.assert_array_equal(back.wrench, g.wrench)
+        np.testing.assert_array_equal(back.command, command)
+        np.testing.assert_array_equal(back.maneuver, log.maneuver)
+    bad = tmp_path / "one_finger.csv"
+    bad.write_text("t,f_n_0,f_x_0,f_y_0,tau_0,f_n_1,f_x_1,f_y_1\n0,2,0,0.1,0.0001,2,0,0.1\n")
+    with pytest.raises(LogError, match=r"missing required column\(s\) 'tau_1'"):
+        read_grasp_log(bad)
+
+
+@pytest.mark.parametrize("ros1", [True, False], ids=["ros1", "ros2"])
+def test_two_finger_bag_on_finger0_clock(tmp_path, data, ros1):
+    """Two wrench topics (finger 1 stamped 0.7 ms after finger 0) and a command topic: finger 1
+    and the command are held at their latest value at or before each finger-0 sample."""
+    from lugrip.io import read_grasp_log
+
+    log = data.log.select(slice(0, 600))
+    command = 3.0 + 0.001 * np.arange(len(log))
+    bag = write_two_finger_bag(tmp_path / ("g.bag" if ros1 else "g"), log, ros1=ros1,
+                               command=command, finger1_delay_ns=700_000)
+    g = read_grasp_log(bag, finger_topics=["/finger0/wrench", "/finger1/wrench"],
+                       command_topic="/gripper/command", maneuver_topic="/maneuver")
+    np.testing.assert_allclose(g.t, log.t, rtol=0, atol=1e-9)
+    np.testing.assert_array_equal(g.wrench[:, 0, 0], log.f_n)
+    # finger 1's sample k arrives 0.7 ms after finger 0's sample k: at finger 0's sample k
+    # the latest finger-1 sample is k - 1 (none before the first)
+    assert np.all(np.isnan(g.wrench[0, 1, :]))
+    np.testing.assert_array_equal(g.wrench[1:, 1, 3], -log.tau[:-1])
+    np.testing.assert_array_equal(g.wrench[1:, 1, 0], log.f_n[:-1])
+    # the command (unstamped) is compared by log time: sent 10 us before finger 0's sample k
+    # is logged, so it is the command of sample k
+    np.testing.assert_array_equal(g.command, command)
+    np.testing.assert_array_equal(g.maneuver, log.maneuver)
+    with pytest.raises(LogError, match="wrench topic of each finger"):
+        read_grasp_log(bag)

@@ -42,6 +42,7 @@ import numpy as np
 
 from ._csv import _read_csv, _write_csv
 from ._extras import MissingExtraError, need
+from ._grasp import GRASP_FIELDS, GraspLog, read_grasp_log, write_grasp_log
 from ._log import (
     COLUMNS,
     UNITS,
@@ -55,6 +56,8 @@ from ._units import _expand_units, _unit_factor
 __all__ = [
     "COLUMNS",
     "FORMATS",
+    "GRASP_FIELDS",
+    "GraspLog",
     "UNITS",
     "LogError",
     "LogWarning",
@@ -62,7 +65,9 @@ __all__ = [
     "SlidingLog",
     "find_maneuvers",
     "maneuvers_from_windows",
+    "read_grasp_log",
     "read_log",
+    "write_grasp_log",
     "write_log",
 ]
 
@@ -228,6 +233,17 @@ def read_log(path: str | os.PathLike, *, format: str | None = None,
             (message names file, row or message, and column).
         MissingExtraError: the format needs a package of the ``[io]`` extra (an ImportError).
     """
+    return _read(path, format=format, wrench_topic=wrench_topic, omega_topic=omega_topic,
+                 maneuver_topic=maneuver_topic, maneuvers=maneuvers, flip_normal=flip_normal,
+                 contact_offset=contact_offset, units=units, check_units=check_units,
+                 max_nan_run=max_nan_run, allow_gaps=allow_gaps, stacklevel=4)[0]
+
+
+def _read(path, *, format, wrench_topic, omega_topic, maneuver_topic, maneuvers, flip_normal,
+          contact_offset, units, check_units, max_nan_run, allow_gaps, stacklevel,
+          finger: int | None = None, scalar_topics: Mapping[str, str] | None = None):
+    """read_log's work; also returns the columns (with a two-finger table's ``command`` when
+    ``finger`` is given, or the ``scalar_topics`` {column: topic} of a ROS source)."""
     path = Path(path)
     file = str(path)
     if not path.exists():
@@ -246,11 +262,11 @@ def read_log(path: str | os.PathLike, *, format: str | None = None,
                                            and contact_offset >= 0.0):
         raise LogError(file, f"contact_offset = {contact_offset!r} m: must be finite and >= 0")
     if fmt == "csv":
-        cols, header_units, loc, meta = _read_csv(path, file)
+        cols, header_units, loc, meta = _read_csv(path, file, finger)
     elif fmt == "parquet":
         from ._parquet import _read_parquet
 
-        cols, header_units, loc, meta = _read_parquet(path, file)
+        cols, header_units, loc, meta = _read_parquet(path, file, finger)
     else:
         from ._ros import read_ros
 
@@ -265,7 +281,8 @@ def read_log(path: str | os.PathLike, *, format: str | None = None,
         cols, header_units, loc, meta = read_ros(
             src, wrench_topic=wrench_topic, omega_topic=omega_topic,
             maneuver_topic=maneuver_topic, flip_normal=flip_normal,
-            contact_offset=contact_offset, stacklevel=3)
+            contact_offset=contact_offset, scalar_topics=scalar_topics,
+            stacklevel=stacklevel)
         meta["format"] = fmt
 
     given = dict(header_units)
@@ -292,7 +309,7 @@ def read_log(path: str | os.PathLike, *, format: str | None = None,
         meta["maneuvers_from"] = "windows"
 
     _validate(cols, loc, max_nan_run=max_nan_run, allow_gaps=allow_gaps,
-              check_units=check_units, explicit=set(given), stacklevel=3)
+              check_units=check_units, explicit=set(given), stacklevel=stacklevel)
     meta["units"] = {c: UNITS[c] for c in COLUMNS if c in cols or c in ("f_t", "maneuver")}
     if converted:
         meta["converted_from"] = converted
@@ -301,7 +318,7 @@ def read_log(path: str | os.PathLike, *, format: str | None = None,
         log = SlidingLog(t=log.t, f_n=log.f_n, f_t=log.f_t, tau=log.tau, f_x=log.f_x,
                          f_y=log.f_y, omega=log.omega, maneuver=find_maneuvers(log),
                          source=log.source, meta={**log.meta, "maneuvers_from": "motion"})
-    return log
+    return log, cols
 
 
 def write_log(log: SlidingLog, path: str | os.PathLike, *, format: str | None = None,

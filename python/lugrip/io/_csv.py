@@ -21,15 +21,39 @@ MAX_CSV_BYTES = 512 * 1024 * 1024
 _HEADER_RE = re.compile(r"^\s*([A-Za-z_][A-Za-z0-9_]*)\s*(?:[\[(]\s*([^\])]*?)\s*[\])])?\s*$")
 
 
-def _parse_header(names: list[str], file: str) -> tuple[dict[str, int], dict[str, str], list[str]]:
-    """Map column name -> position, column -> unit from ``name [unit]``, ignored names."""
+#: Columns of one finger in a two-finger table (suffix _0 or _1); the others are shared.
+FINGER_COLUMNS = ("f_n", "f_x", "f_y", "f_t", "tau", "omega")
+#: Columns a two-finger table may add: the grasp-force command recorded with it [N].
+GRASP_COLUMNS = ("command",)
+
+
+def _column_name(raw: str, finger: int | None) -> str | None:
+    """The format's name of a header cell (lower case, unit stripped), None for other cells;
+    with ``finger`` k, ``f_n_k`` etc. name finger k's columns and other fingers' are None."""
+    m = _HEADER_RE.match(str(raw))
+    name = m.group(1).lower() if m else None
+    if finger is None or name is None:
+        return name
+    if name in GRASP_COLUMNS:
+        return name
+    base, _, k = name.rpartition("_")
+    if base in FINGER_COLUMNS:
+        return base if k == str(finger) else None
+    return None if name in FINGER_COLUMNS else name
+
+
+def _parse_header(names: list[str], file: str, finger: int | None = None
+                  ) -> tuple[dict[str, int], dict[str, str], list[str]]:
+    """Map column name -> position, column -> unit from ``name [unit]``, ignored names
+    (``finger``: see :func:`_column_name`)."""
     index: dict[str, int] = {}
     units: dict[str, str] = {}
     ignored: list[str] = []
+    known = set(UNITS) | (set(GRASP_COLUMNS) if finger is not None else set())
     for pos, raw in enumerate(names):
         m = _HEADER_RE.match(str(raw))
-        name = m.group(1).lower() if m else None
-        if name not in UNITS:
+        name = _column_name(raw, finger)
+        if name not in known:
             ignored.append(str(raw))
             continue
         if name in index:
@@ -42,7 +66,8 @@ def _parse_header(names: list[str], file: str) -> tuple[dict[str, int], dict[str
     return index, units, ignored
 
 
-def _check_required(index: Mapping[str, Any], names: list[str], file: str) -> None:
+def _check_required(index: Mapping[str, Any], names: list[str], file: str,
+                    finger: int | None = None) -> None:
     have = ", ".join(str(n) for n in names) or "(none)"
     expected = ("expected t [s], f_n [N], f_x and f_y [N] (or f_t [N]), tau [N m]; optional "
                 "omega [rad/s], maneuver")
@@ -53,6 +78,12 @@ def _check_required(index: Mapping[str, Any], names: list[str], file: str) -> No
         missing.append("f_x")
     elif not any(c in index for c in ("f_x", "f_y", "f_t")):
         missing.append("f_x/f_y or f_t")
+    if missing and finger is not None:
+        k = finger
+        missing = [f"f_x_{k}/f_y_{k} or f_t_{k}" if m == "f_x/f_y or f_t"
+                   else (f"{m}_{k}" if m in FINGER_COLUMNS else m) for m in missing]
+        expected = ("a two-finger table has t and per finger k = 0, 1: f_n_k, f_x_k and f_y_k "
+                    "(or f_t_k), tau_k; optional omega_k, command, maneuver")
     if missing:
         names_ = ", ".join(f"'{c}'" for c in missing)
         raise LogError(file, f"missing required column(s) {names_}; the file has: {have}; "
@@ -78,7 +109,7 @@ def _cells_to_float(cells, column: str, loc: _Locator) -> np.ndarray:
     raise loc.error("column is not numeric", None, column)  # pragma: no cover
 
 
-def _read_csv(path: Path, file: str) -> tuple[dict[str, np.ndarray], dict[str, str], _Locator,
+def _read_csv(path: Path, file: str, finger: int | None = None) -> tuple[dict[str, np.ndarray], dict[str, str], _Locator,
                                                dict]:
     size = path.stat().st_size
     if size > MAX_CSV_BYTES:
@@ -100,7 +131,7 @@ def _read_csv(path: Path, file: str) -> tuple[dict[str, np.ndarray], dict[str, s
         raise LogError(file, "empty file (expected a header row and data rows)")
     first = next(line for line in text.splitlines() if line.strip())
     delim = next((d for d in (",", ";", "\t") if d in first), ",")
-    fast = _read_csv_fast(text, delim, file)
+    fast = _read_csv_fast(text, delim, file, finger)
     if fast is not None:
         return fast
     reader = csv.reader(io.StringIO(text, newline=""), delimiter=delim,
@@ -126,12 +157,12 @@ def _read_csv(path: Path, file: str) -> tuple[dict[str, np.ndarray], dict[str, s
         rows.append(record)
         lines.append(reader.line_num)
     assert header is not None
-    index, units, ignored = _parse_header(header, file)
+    index, units, ignored = _parse_header(header, file, finger)
     if not index and all(_is_number(c) for c in header if c):
         raise LogError(file, f"no header row: row {header_line} holds numbers; the first row "
                        "must name the columns (t, f_n, f_x, f_y or f_t, tau, omega, maneuver)",
                        where=f"row {header_line}", row=header_line)
-    _check_required(index, header, file)
+    _check_required(index, header, file, finger)
     if not rows:
         raise LogError(file, "no data rows (only the header)")
     loc = _Locator(file, rows=np.asarray(lines))
@@ -147,7 +178,7 @@ def _read_csv(path: Path, file: str) -> tuple[dict[str, np.ndarray], dict[str, s
     return cols, units, loc, meta
 
 
-def _read_csv_fast(text: str, delim: str, file: str):
+def _read_csv_fast(text: str, delim: str, file: str, finger: int | None = None):
     """pyarrow's CSV parser for clean files (no blank lines, every cell a number); None to
     fall back to the line-by-line reader, which finds and names any problem."""
     try:
@@ -159,10 +190,10 @@ def _read_csv_fast(text: str, delim: str, file: str):
     if len(lines) < 2 or any(not line.strip() for line in lines):
         return None
     header = [c.strip() for c in next(csv.reader([lines[0]], delimiter=delim))]
-    index, units, ignored = _parse_header(header, file)
+    index, units, ignored = _parse_header(header, file, finger)
     if not index:
         return None
-    _check_required(index, header, file)
+    _check_required(index, header, file, finger)
     names = [f"c{i}" for i in range(len(header))]
     try:
         table = pacsv.read_csv(

@@ -14,7 +14,7 @@ from ._extras import exc_text, need
 from ._log import UNITS, LogError, SlidingLog, _json_meta, _Locator
 
 
-def _read_parquet(path: Path, file: str):
+def _read_parquet(path: Path, file: str, finger: int | None = None):
     pa = need("pyarrow", "reading Parquet")
     pq = need("pyarrow.parquet", "reading Parquet")
     if path.stat().st_size == 0:
@@ -24,8 +24,8 @@ def _read_parquet(path: Path, file: str):
     except Exception as exc:  # noqa: BLE001 (pyarrow raises several types for bad files)
         raise LogError(file, f"not a readable Parquet file ({exc_text(exc)})") from None
     names = list(table.column_names)
-    index, units, ignored = _parse_header(names, file)
-    _check_required(index, names, file)
+    index, units, ignored = _parse_header(names, file, finger)
+    _check_required(index, names, file, finger)
     if table.num_rows == 0:
         raise LogError(file, "no data rows (the table is empty)")
     loc = _Locator(file)
@@ -41,7 +41,7 @@ def _read_parquet(path: Path, file: str):
             cols[name] = _cells_to_float(col.to_pylist(), name, loc)
         else:
             raise loc.error(f"column type {typ} is not numeric (expected numbers in "
-                            f"{UNITS[name]})", None, name)
+                            f"{UNITS.get(name, 'N')})", None, name)
     meta: dict[str, Any] = {"format": "parquet", "columns": names, "ignored_columns": ignored}
     stored = (table.schema.metadata or {}).get(b"lugrip")
     if stored:

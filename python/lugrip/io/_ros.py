@@ -243,7 +243,7 @@ def to_contact(f: np.ndarray, m: np.ndarray, offset: float) -> tuple[np.ndarray,
 
 def read_ros(src: RosSource, *, wrench_topic: str | None, omega_topic: str | None,
              maneuver_topic: str | None, flip_normal: bool, contact_offset: float | None,
-             stacklevel: int):
+             stacklevel: int, scalar_topics=None):
     """Columns of a sliding log from a ROS source (see :func:`lugrip.io.read_log`)."""
     file = src.file
     wrench_topic = src.pick_wrench_topic(wrench_topic)
@@ -255,7 +255,11 @@ def read_ros(src: RosSource, *, wrench_topic: str | None, omega_topic: str | Non
         maneuver_topic = src.metadata.get("maneuver_topic") or None
     if maneuver_topic is not None:
         src.check_topic(maneuver_topic, ID_TYPES, "maneuver_topic")
-    names = [n for n in dict.fromkeys((wrench_topic, omega_topic, maneuver_topic)) if n]
+    scalar_topics = dict(scalar_topics or {})
+    for column, topic in scalar_topics.items():
+        src.check_topic(topic, SCALAR_TYPES, f"{column} topic")
+    names = [n for n in dict.fromkeys((wrench_topic, omega_topic, maneuver_topic,
+                                       *scalar_topics.values())) if n]
     topics = src.read(names)
 
     wrench = topics[wrench_topic]
@@ -314,6 +318,15 @@ def read_ros(src: RosSource, *, wrench_topic: str | None, omega_topic: str | Non
         cols["maneuver"] = hold_last(m_ns[pick], m_val, at,
                                      m_val[0] if m_val.size else 0.0)
         meta["maneuver_topic"] = maneuver_topic
+
+    for column, topic in scalar_topics.items():  # e.g. a recorded command: the latest value
+        st = topics[topic]
+        s_ns, s_source = st.times()
+        pick = ordered(file, st, s_ns, column, stacklevel + 1)
+        s_val = np.asarray([val[0] for val in st.values], dtype=np.float64)[pick]
+        at = stamps if (s_source == "header" and time_source == "header") else log_ns
+        cols[column] = hold_last(s_ns[pick], s_val, at, np.nan)
+        meta[f"{column}_topic"] = topic
 
     loc = _Locator(file, topic=wrench_topic, fields=fields, kind="ros")
     return cols, {}, loc, meta

@@ -23,7 +23,8 @@ _UNIT_FACTORS: dict[str, dict[str, float]] = {
     "count": {"": 1.0, "-": 1.0, "1": 1.0},
 }
 _QUANTITY = {"t": "time", "f_n": "force", "f_x": "force", "f_y": "force", "f_t": "force",
-             "tau": "torque", "omega": "angular velocity", "maneuver": "count"}
+             "tau": "torque", "omega": "angular velocity", "maneuver": "count",
+             "command": "force"}
 
 
 def _unit_key(unit: str) -> str:
