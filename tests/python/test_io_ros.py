@@ -326,3 +326,17 @@ def test_two_finger_bag_on_finger0_clock(tmp_path, data, ros1):
     np.testing.assert_array_equal(g.maneuver, log.maneuver)
     with pytest.raises(LogError, match="wrench topic of each finger"):
         read_grasp_log(bag)
+
+
+def test_mcap_decoders_agree(tmp_path, monkeypatch, data):
+    """An MCAP decoded by mcap-ros2-support and by rosbags' typestore (the fallback when
+    mcap-ros2-support is missing) gives the same log."""
+    pytest.importorskip("mcap_ros2.decoder", reason="mcap-ros2-support not installed")
+    path = write_log(data.log, tmp_path / "d.mcap")
+    with_mcap_ros2 = read_log(path)
+    monkeypatch.setitem(sys.modules, "mcap_ros2.decoder", None)
+    with_typestore = read_log(path)
+    for name in ("t", "f_n", "f_x", "f_y", "tau", "omega", "maneuver"):
+        np.testing.assert_array_equal(getattr(with_mcap_ros2, name),
+                                      getattr(with_typestore, name), err_msg=name)
+    np.testing.assert_array_equal(with_typestore.tau, data.log.tau)
