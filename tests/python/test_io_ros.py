@@ -232,6 +232,14 @@ def test_duplicated_stamps_are_dropped_not_fatal(tmp_path, data):
     keep = np.setdiff1d(np.arange(400), [50, 51, 200])
     assert len(got) == 397
     np.testing.assert_array_equal(got.tau, log.tau[keep])
+    # messages after the dropped ones are still named by their number in the recording
+    tau = log.tau.copy()
+    tau[300] = np.nan
+    rec = _Record(t=log.t, f_x=log.f_x, f_y=log.f_y, f_n=log.f_n, tau=tau, omega=log.omega,
+                  maneuver=log.maneuver)
+    bag = write_two_finger_bag(tmp_path / "dup_nan.bag", rec, ros1=True, stamps=stamps)
+    with pytest.warns(LogWarning, match=r"message 301 on topic '/finger0/wrench' \(tau\)"):
+        read_log(bag, wrench_topic="/finger0/wrench")
 
 
 def test_cli_hints_use_option_syntax(tmp_path, capsys, data):

@@ -94,7 +94,7 @@ class _Locator:
                  topic: str | None = None, fields: Mapping[str, str] | None = None,
                  kind: str = "table"):
         self.file = file
-        self.rows = rows  # physical row (line) per sample, tables only
+        self.rows = rows  # row (line) of a table / message number of a topic per sample
         self.topic = topic
         self.fields = dict(fields or {})
         self.kind = kind  # "table" | "ros" | "arrays"
@@ -102,8 +102,8 @@ class _Locator:
     def row(self, i: int) -> int | None:
         if self.kind == "table":
             return int(self.rows[i]) if self.rows is not None else i + 2
-        if self.kind == "ros":
-            return i + 1
+        if self.kind == "ros":  # message number on the topic, as recorded
+            return int(self.rows[i]) if self.rows is not None else i + 1
         return None
 
     def where(self, i: int | None, column: str | None) -> str:
@@ -113,7 +113,7 @@ class _Locator:
         if self.kind == "table":
             here = f"row {self.row(i)}"
         elif self.kind == "ros":
-            here = f"message {i + 1} on topic '{self.topic}'"
+            here = f"message {self.row(i)} on topic '{self.topic}'"
             if column and column in self.fields:
                 col = f"field {self.fields[column]} (column '{column}')"
         else:
@@ -127,7 +127,7 @@ class _Locator:
         if self.kind == "table":
             return f"rows {self.row(i)}-{self.row(j)}"
         if self.kind == "ros":
-            return f"messages {i + 1}-{j + 1} on topic '{self.topic}'"
+            return f"messages {self.row(i)}-{self.row(j)} on topic '{self.topic}'"
         return f"samples {i}-{j} (0-based indices)"
 
     def error(self, problem: str, i: int | None = None, column: str | None = None) -> LogError:

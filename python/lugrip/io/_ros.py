@@ -328,5 +328,5 @@ def read_ros(src: RosSource, *, wrench_topic: str | None, omega_topic: str | Non
         cols[column] = hold_last(s_ns[pick], s_val, at, np.nan)
         meta[f"{column}_topic"] = topic
 
-    loc = _Locator(file, topic=wrench_topic, fields=fields, kind="ros")
+    loc = _Locator(file, rows=keep + 1, topic=wrench_topic, fields=fields, kind="ros")
     return cols, {}, loc, meta
