@@ -64,23 +64,27 @@ def _non_negative(text: str) -> float:
     return value
 
 
-def add_log_options(parser: argparse.ArgumentParser, *, wrench_topic: bool = True):
-    """Add the log-reading options in their own group; returns the group. With
-    ``wrench_topic=False`` the single ``--wrench-topic`` is left out (for commands that read
-    several wrench topics and define their own options)."""
+def add_log_options(parser: argparse.ArgumentParser, *, wrench_topic: bool = True,
+                    omega_topic: bool = True, maneuvers: bool = True):
+    """Add the log-reading options in their own group; returns the group. ``wrench_topic``,
+    ``omega_topic``, ``maneuvers`` = False leave out ``--wrench-topic`` (for commands that
+    read several wrench topics), ``--omega-topic`` (no ground truth used) and
+    ``--maneuver-topic``/``--maneuvers`` (no observer restarts)."""
     r = parser.add_argument_group("reading the log (ROS recordings, units, maneuvers, damage)")
     if wrench_topic:
         r.add_argument("--wrench-topic", metavar="TOPIC",
                        help="WrenchStamped topic (MCAP, bags; default: the only one)")
-    r.add_argument("--omega-topic", metavar="TOPIC",
-                   help="ground-truth angular velocity topic (Twist[Stamped] angular.z, "
-                        "Vector3[Stamped] z, Float64)")
-    r.add_argument("--maneuver-topic", metavar="TOPIC",
-                   help="std_msgs integer topic of maneuver ids (MCAP, bags)")
-    r.add_argument("--maneuvers", type=parse_maneuvers, default="file", metavar="SPEC",
-                   help="where maneuvers (observer restarts) come from: 'file' (a maneuver "
-                        "column or topic; default), 'motion' (found from unloaded rests), "
-                        "or windows START:END[,START:END...] in seconds")
+    if omega_topic:
+        r.add_argument("--omega-topic", metavar="TOPIC",
+                       help="ground-truth angular velocity topic (Twist[Stamped] angular.z, "
+                            "Vector3[Stamped] z, Float64)")
+    if maneuvers:
+        r.add_argument("--maneuver-topic", metavar="TOPIC",
+                       help="std_msgs integer topic of maneuver ids (MCAP, bags)")
+        r.add_argument("--maneuvers", type=parse_maneuvers, default="file", metavar="SPEC",
+                       help="where maneuvers (observer restarts) come from: 'file' (a "
+                            "maneuver column or topic; default), 'motion' (found from unloaded "
+                            "rests), or windows START:END[,START:END...] in seconds")
     r.add_argument("--flip-normal", action="store_true",
                    help="the sensor's z axis points out of the pad (f_n = -force.z, ...)")
     r.add_argument("--contact-offset", type=_non_negative, metavar="M",
@@ -102,8 +106,8 @@ def log_kwargs(args: argparse.Namespace) -> dict:
     maneuvers = getattr(args, "maneuvers", "file")
     return {
         "wrench_topic": getattr(args, "wrench_topic", None),
-        "omega_topic": args.omega_topic,
-        "maneuver_topic": args.maneuver_topic,
+        "omega_topic": getattr(args, "omega_topic", None),
+        "maneuver_topic": getattr(args, "maneuver_topic", None),
         "maneuvers": None if maneuvers == "file" else maneuvers,
         "flip_normal": args.flip_normal,
         "contact_offset": args.contact_offset,
