@@ -348,3 +348,23 @@ def test_mcap_decoders_agree(tmp_path, monkeypatch, data):
         np.testing.assert_array_equal(getattr(with_mcap_ros2, name),
                                       getattr(with_typestore, name), err_msg=name)
     np.testing.assert_array_equal(with_typestore.tau, data.log.tau)
+
+
+@pytest.mark.filterwarnings("ignore:the optimiser stopped without convergence")
+def test_bag_gives_the_csv_identify_results(tmp_path, data):
+    """Identification (mu and beta_A free, the rest fixed at Table 1) on the bag's samples
+    gives the CSV's estimates: the reader hands identification the same numbers (8 iterations:
+    the comparison needs equal inputs, not a converged fit)."""
+    import lugrip
+
+    p = ContactParams.table1()
+    log = data.log.select(data.log.maneuver < 3)  # three maneuvers keep the fit short
+    csv_log = read_log(write_log(log, tmp_path / "run.csv"))
+    bag = write_two_finger_bag(tmp_path / "run.bag", log, ros1=True)
+    bag_log = read_log(bag, wrench_topic="/finger0/wrench", omega_topic="/truth/twist",
+                       maneuver_topic="/maneuver")
+    fits = [lugrip.identify([lg], params0=p, free=["mu", "beta_a"], threads=1,
+                            max_iterations=8) for lg in (csv_log, bag_log)]
+    for name in ("mu", "beta_a"):
+        a, b = (getattr(f.params, name) for f in fits)
+        assert b == pytest.approx(a, rel=1e-8), name
