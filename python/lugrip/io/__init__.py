@@ -24,9 +24,11 @@ CSV, Parquet and MCAP (ROS 2 CDR). Maneuver ids come from the file (a column or 
 time windows, or are found from the motion (:func:`find_maneuvers`).
 
 One module per concept: ``_log`` (the type and its checks), ``_units``, ``_csv``,
-``_parquet``, ``_ros`` (topics to columns), ``_mcap``, ``_bags``, ``_extras`` (optional
-packages). Malformed files raise :class:`LogError`, whose message names the file, the row
-(spreadsheet numbering: header = row 1) or message, and the column.
+``_parquet``, ``_ros`` (topics to columns), ``_mcap``, ``_bags``, ``_grasp`` (two-finger
+logs for ``lugrip replay``), ``_extras`` (optional packages).
+
+Malformed files raise :class:`LogError`, whose message names the file, the row (spreadsheet
+numbering: header = row 1) or message, and the column.
 """
 
 from __future__ import annotations
