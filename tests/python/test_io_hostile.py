@@ -62,6 +62,18 @@ def test_oversized_csv_is_refused_before_reading(tmp_path, monkeypatch):
         read_log(path)
 
 
+def test_parquet_with_too_many_rows_is_refused(tmp_path, monkeypatch):
+    """The row count in a Parquet file's metadata is checked before the table is read (limit
+    lowered for the test)."""
+    pytest.importorskip("pyarrow")
+    import lugrip.io._parquet as pq_mod
+
+    path = write_log(_small_log(200), tmp_path / "big.parquet")
+    monkeypatch.setattr(pq_mod, "MAX_PARQUET_ROWS", 100)
+    with pytest.raises(LogError, match=r"big\.parquet: 200 rows, more than the 100"):
+        read_log(path)
+
+
 def test_topic_with_too_many_messages_is_refused(tmp_path, monkeypatch):
     """A topic with more messages than MAX_MESSAGES is refused with a message naming it."""
     pytest.importorskip("mcap")

@@ -14,11 +14,23 @@ from ._extras import exc_text, need
 from ._log import UNITS, LogError, SlidingLog, _json_meta, _Locator
 
 
+#: Most rows read from one Parquet log (checked from the file's metadata before reading; about
+#: 200 bytes per row in memory with its columns, copies and checks).
+MAX_PARQUET_ROWS = 3_000_000
+
+
 def _read_parquet(path: Path, file: str, finger: int | None = None):
     pa = need("pyarrow", "reading Parquet")
     pq = need("pyarrow.parquet", "reading Parquet")
     if path.stat().st_size == 0:
         raise LogError(file, "empty file (expected a Parquet table)")
+    try:
+        rows = pq.ParquetFile(path).metadata.num_rows
+    except Exception as exc:  # noqa: BLE001 (pyarrow raises several types for bad files)
+        raise LogError(file, f"not a readable Parquet file ({exc_text(exc)})") from None
+    if rows > MAX_PARQUET_ROWS:
+        raise LogError(file, f"{rows} rows, more than the {MAX_PARQUET_ROWS} a Parquet log may "
+                       "hold (the reader keeps it in memory); split the recording")
     try:
         table = pq.read_table(path)
     except Exception as exc:  # noqa: BLE001 (pyarrow raises several types for bad files)
