@@ -13,7 +13,6 @@ from ._csv import _cells_to_float, _check_required, _parse_header
 from ._extras import exc_text, need
 from ._log import UNITS, LogError, SlidingLog, _json_meta, _Locator
 
-
 #: Most rows read from one Parquet log (checked from the file's metadata before reading; about
 #: 200 bytes per row in memory with its columns, copies and checks).
 MAX_PARQUET_ROWS = 3_000_000
