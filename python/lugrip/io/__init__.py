@@ -120,14 +120,15 @@ def _noise_std(x: np.ndarray) -> float:
     return float(np.median(np.abs(d))) / 0.6745 / math.sqrt(2.0) if d.size else 0.0
 
 
-def find_maneuvers(log: SlidingLog, *, min_rest: float = 0.1,
+def find_maneuvers(log: SlidingLog, *, min_rest: float = 0.05,
                    omega_threshold: float = 0.01) -> np.ndarray:
     """Maneuver ids found from the motion, for logs that do not mark them.
 
     A maneuver of a prescribed-motion recording starts from an unloaded rest (the observer
-    restarts with z = 0, which holds only without a torsional load). A
-    sample is at rest when the torsional moment is at the noise level (|tau| at most five
-    noise deviations, estimated from first differences, or 2 % of its 99th percentile) and,
+    restarts with z = 0, which holds only without a friction load). A sample is at rest when
+    the torsional moment and the tangential force are at their noise level (|tau| and f_t at
+    most five noise deviations, estimated from first differences, or 0.1 % of their 99th
+    percentile) and,
     when the log carries ground-truth ``omega``, the motion is still (|omega| <=
     ``omega_threshold`` [rad/s]). Every run of rest samples lasting ``min_rest`` [s] or more
     ends a maneuver; the next one starts at the run's middle. Samples without contact
@@ -137,11 +138,11 @@ def find_maneuvers(log: SlidingLog, *, min_rest: float = 0.1,
     ids = np.zeros(n, dtype=np.int64)
     if n < 3:
         return ids
-    tau = np.asarray(log.tau, dtype=np.float64)
-    finite = np.isfinite(tau)
-    level = 1e-3 * float(np.percentile(np.abs(tau[finite]), 99)) if finite.any() else 0.0
-    thr = max(5.0 * _noise_std(tau), level)
-    rest = finite & (np.abs(tau) <= thr)
+    rest = np.ones(n, dtype=bool)
+    for x in (np.asarray(log.tau, dtype=np.float64), np.asarray(log.f_t, dtype=np.float64)):
+        finite = np.isfinite(x)
+        level = 1e-3 * float(np.percentile(np.abs(x[finite]), 99)) if finite.any() else 0.0
+        rest &= finite & (np.abs(x) <= max(5.0 * _noise_std(x), level))
     if log.omega is not None:
         om = np.asarray(log.omega, dtype=np.float64)
         rest &= ~(np.isfinite(om) & (np.abs(om) > omega_threshold))
