@@ -12,12 +12,13 @@ from pathlib import Path
 __all__ = ["add_log_options", "log_kwargs", "parse_maneuvers", "parse_units",
            "read_log_from_args"]
 
-_UNIT_KEYS = ("t", "f_n", "f_x", "f_y", "f_t", "tau", "omega", "force")
+_UNIT_KEYS = ("t", "f_n", "f_x", "f_y", "f_t", "tau", "omega", "force", "command")
 
 
 def parse_units(text: str) -> dict[str, str]:
     """argparse type for ``--units``: ``COLUMN=UNIT[,COLUMN=UNIT...]``, an underscore standing
-    for a space in the unit (``tau=N_mm``); COLUMN 'force' sets every force column."""
+    for a space in the unit (``tau=N_mm``); COLUMN 'force' sets every force column, 'command'
+    is a two-finger log's recorded command."""
     out: dict[str, str] = {}
     for item in text.split(","):
         key, sep, unit = item.partition("=")

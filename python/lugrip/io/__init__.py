@@ -203,8 +203,9 @@ def read_log(path: str | os.PathLike, *, format: str | None = None,
             time span and across gaps longer than 10 of its median periods).
         maneuver_topic: ROS sources: a ``std_msgs`` integer (or float holding integers) topic
             whose latest message at or before each wrench sample is that sample's maneuver id
-            (header stamps against header stamps when both have them, else log times);
-            default: the one a lugrip-written MCAP names.
+            (header stamps against header stamps when both have them, else log times;
+            samples before the first message take its id); default: the one a
+            lugrip-written MCAP names.
         maneuvers: replaces the file's maneuver ids: ``"motion"`` finds them from the wrench
             and omega (:func:`find_maneuvers`), a sequence of ``(t_start, t_end)`` windows [s]
             numbers them (:func:`maneuvers_from_windows`); None keeps the file's (a column or
