@@ -100,7 +100,8 @@ def add_log_options(parser: argparse.ArgumentParser, *, wrench_topic: bool = Tru
 
 
 def log_kwargs(args: argparse.Namespace) -> dict:
-    """:func:`lugrip.read_log` keywords from options added by :func:`add_log_options`."""
+    """:func:`lugrip.read_log` keywords from options added by :func:`add_log_options` (options
+    a parser left out read as their defaults)."""
     units: dict[str, str] = {}
     for part in getattr(args, "units", None) or []:
         units.update(part)
@@ -110,10 +111,10 @@ def log_kwargs(args: argparse.Namespace) -> dict:
         "omega_topic": getattr(args, "omega_topic", None),
         "maneuver_topic": getattr(args, "maneuver_topic", None),
         "maneuvers": None if maneuvers == "file" else maneuvers,
-        "flip_normal": args.flip_normal,
-        "contact_offset": args.contact_offset,
+        "flip_normal": bool(getattr(args, "flip_normal", False)),
+        "contact_offset": getattr(args, "contact_offset", None),
         "units": units or None,
-        "allow_gaps": args.allow_gaps,
+        "allow_gaps": bool(getattr(args, "allow_gaps", False)),
     }
 
 
