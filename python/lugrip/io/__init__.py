@@ -177,7 +177,7 @@ def _detect_format(path: Path, format: str | None, file: str) -> str:
     if fmt is None:
         known = ", ".join(sorted(_SUFFIXES)) + ", a ROS 2 bag directory"
         raise LogError(file, f"unknown file type {path.suffix or '(no suffix)'!r} (known: "
-                       f"{known}); pass format= to choose one")
+                       f"{known}); [[alt:pass format= to choose one|give the file one of these suffixes]]")
     if fmt == "mcap" and (path.parent / "metadata.yaml").exists():
         return "ros2"  # the storage file of a ROS 2 bag: read the bag (its metadata)
     return fmt

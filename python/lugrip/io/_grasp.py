@@ -94,8 +94,8 @@ def read_grasp_log(path: str | os.PathLike, *, finger_topics: Sequence[str] | No
     fmt = _detect_format(p, format, file)
     table = fmt in ("csv", "parquet")
     if table and (finger_topics or command_topic):
-        raise LogError(file, "finger_topics and command_topic apply to ROS recordings; a "
-                       "table names its fingers by the column suffixes _0 and _1")
+        raise LogError(file, "[[opt:finger_topics]] and [[opt:command_topic]] apply to ROS "
+                       "recordings; a table names its fingers by the column suffixes _0 and _1")
     if not table:
         if finger_topics is None or len(finger_topics) not in (1, 2):
             raise LogError(file, "a ROS recording needs the wrench topic of each finger "

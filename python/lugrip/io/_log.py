@@ -30,7 +30,7 @@ _MAX_TAU_PER_FORCE = 0.1  # [m] |tau|/f_n is at most mu*xi*rho, a few cm at most
 _GAP_FACTOR = 5.0  # default segments() gap: this many median sample periods
 
 
-_HINT_RE = re.compile(r"\[\[(units|flag|opt):([^\]]*)\]\]")
+_HINT_RE = re.compile(r"\[\[(units|flag|opt|alt):([^\]]*)\]\]")
 
 
 def _render_hints(text: str, cli: bool) -> str:
@@ -38,7 +38,8 @@ def _render_hints(text: str, cli: bool) -> str:
 
     ``[[units:tau=N mm]]`` becomes ``units={'tau': 'N mm'}`` or ``--units tau=N_mm``;
     ``[[flag:flip_normal]]`` becomes ``flip_normal=True`` or ``--flip-normal``;
-    ``[[opt:wrench_topic]]`` becomes ``wrench_topic=`` or ``--wrench-topic``.
+    ``[[opt:wrench_topic]]`` becomes ``wrench_topic=`` or ``--wrench-topic``;
+    ``[[alt:python words|command-line words]]`` picks one of its two texts.
     """
     def one(m: re.Match) -> str:
         kind, body = m.group(1), m.group(2)
@@ -46,6 +47,9 @@ def _render_hints(text: str, cli: bool) -> str:
             return f"--{body.replace('_', '-')}" if cli else f"{body}=True"
         if kind == "opt":
             return f"--{body.replace('_', '-')}" if cli else f"{body}="
+        if kind == "alt":
+            python, _, command_line = body.partition("|")
+            return command_line if cli else python
         pairs = [item.split("=", 1) for item in body.split(",")]
         if cli:
             return "--units " + ",".join(f"{k}={v.replace(' ', '_')}" for k, v in pairs)
