@@ -52,7 +52,7 @@ def main(out_dir: str | None = None) -> float:
     print(f"omega_hat has the sign of omega on {100 * same.mean():.1f} % of the sliding samples")
 
     if out_dir is not None:
-        from lugrip.plot_observer import write_figure5
+        from lugrip.plot.observer import write_figure5
 
         fig = write_figure5(out_dir, log, run, title="Example 02: observer replay", rmse=sc.rmse)
         print(f"wrote {fig}")

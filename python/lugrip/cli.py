@@ -60,7 +60,8 @@ def build_parser() -> argparse.ArgumentParser:
 
 
 def _one_line(err: BaseException) -> str:
-    text = str(err) or type(err).__name__
+    # errors that carry a command-line wording of their hints (lugrip.io.LogError) use it
+    text = getattr(err, "cli_message", None) or str(err) or type(err).__name__
     if isinstance(err, OSError) and err.filename is not None and err.strerror:
         text = f"{err.filename}: {err.strerror}"
     return "; ".join(part.strip() for part in text.splitlines() if part.strip())
@@ -89,6 +90,11 @@ def main(argv: list[str] | None = None) -> int:
     except (CliError, ValueError, OSError) as err:
         if os.environ.get("LUGRIP_DEBUG"):
             raise
+        print(f"{prog}: error: {_one_line(err)}", file=sys.stderr)
+        return 2
+    except ImportError as err:
+        if getattr(err, "extra", None) is None or os.environ.get("LUGRIP_DEBUG"):
+            raise  # a broken installation, not a missing optional package
         print(f"{prog}: error: {_one_line(err)}", file=sys.stderr)
         return 2
     except KeyboardInterrupt:

@@ -146,7 +146,7 @@ def test_csv_head_and_header_units(tmp_path):
 
 def test_csv_fast_and_line_by_line_readers_agree(tmp_path, monkeypatch):
     """The pyarrow CSV path and the line-by-line path read identical arrays."""
-    import lugrip.io as lio
+    import lugrip.io._csv as lio
 
     log = make_log(n=200, seed=9)
     path = write_log(log, tmp_path / "both.csv")
@@ -730,16 +730,19 @@ def test_ros_flip_normal_and_topic_choice(tmp_path):
     assert np.all(log.f_n > 0) and log.meta["flip_normal"] is True
 
 
-def test_ros_duplicated_stamp_names_the_message(tmp_path):
-    """Bad header stamps are reported by message number, topic and field."""
+def test_ros_duplicated_stamp_is_dropped_with_a_warning(tmp_path):
+    """A duplicated header stamp drops that message (first of the time kept) with a warning
+    naming the message and topic; the rest of the bag is read, not rejected."""
     _typestore(True)
     stamps, force, torque = _ros_samples(n=10)
     stamps[6] = stamps[5]
     path = tmp_path / "dup.bag"
     _write_bag(path, ros1=True, stamps=stamps, force=force, torque=torque)
-    with pytest.raises(LogError) as info:
-        read_log(path)
-    msg = str(info.value)
-    assert str(path) in msg and info.value.row == 7
-    assert "message 7 on topic '/ft/wrench', field header.stamp (column 't')" in msg
-    assert "duplicated time" in msg
+    with pytest.warns(LogWarning, match=r"topic '/ft/wrench': 1 message\(s\) with a "
+                                        r"duplicated time, first message 7") as rec:
+        log = read_log(path)
+    assert str(path) in str(rec[0].message)
+    keep = np.r_[0:6, 7:10]
+    assert len(log) == 9
+    np.testing.assert_array_equal(log.f_n, force[keep, 2])
+    np.testing.assert_array_equal(log.tau, torque[keep, 2])

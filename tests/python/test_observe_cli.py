@@ -283,3 +283,35 @@ def test_log_without_ground_truth_is_replayed_without_rmse(tmp_path, capsys, dat
     assert rc == 0, err
     assert "RMSE not computed" in out and "RMSE omega_hat" not in out
     assert os.path.getsize(tmp_path / "e.csv") > 0
+
+
+def test_log_options_parse_and_reach_the_reader(tmp_path, capsys, data):
+    """--units and --maneuvers parse CLI syntax (bad values: one line, exit 2) and reach
+    read_log: windows renumber the maneuvers of the estimate file."""
+    import argparse
+
+    from lugrip.commands._log_options import parse_maneuvers, parse_units
+
+    assert parse_units("tau=N_mm,t=ms") == {"tau": "N mm", "t": "ms"}
+    assert parse_maneuvers("motion") == "motion"
+    assert parse_maneuvers("0:1.5, 2:3") == [(0.0, 1.5), (2.0, 3.0)]
+    for bad in ("tau", "=N", "speed=m/s"):
+        with pytest.raises(argparse.ArgumentTypeError):
+            parse_units(bad)
+    for bad in ("2:1", "a:b", "1", "0:inf"):
+        with pytest.raises(argparse.ArgumentTypeError):
+            parse_maneuvers(bad)
+    log_path = write_log(data.log, tmp_path / "d.csv")
+    out = tmp_path / "e.csv"
+    rc, _, err = _observe(capsys, log_path, "--preset", "table1", "--out", out,
+                          "--maneuvers", "0:2,2:4")
+    assert rc == 0, err
+    ids = np.array(_read_csv(out)["maneuver"], dtype=int)
+    t = np.array(_read_csv(out)["t"], dtype=float)
+    np.testing.assert_array_equal(ids, np.where(t < 2, 1, np.where(t < 4, 2, 0)))
+    rc, _, err = _observe(capsys, log_path, "--preset", "table1", "--out", tmp_path / "f.csv",
+                          "--maneuvers", "3:1")
+    assert rc == 2 and "--maneuvers" in err and len(err.strip().splitlines()) == 1
+    rc, _, err = _observe(capsys, log_path, "--preset", "table1", "--out", tmp_path / "g.csv",
+                          "--wrench-topic", "/ft")
+    assert rc == 2 and "--wrench-topic applies to ROS recordings" in err

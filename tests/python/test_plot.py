@@ -167,7 +167,7 @@ def test_merged_legend_collects_twin_axes_in_order():
     assert ax.get_legend() is leg and twin.get_legend() is None
 
 
-# --- the experiment figures (lugrip.plot_experiments) drawn with these helpers ----------------
+# --- the experiment figures (lugrip.plot.experiments) drawn with these helpers ----------------
 
 _SCENARIOS = Path(__file__).resolve().parents[2] / "scenarios"
 
@@ -202,7 +202,7 @@ def _spans(ax):
 def test_experiment_figures_panels_labels_and_legends(short_runs):
     """Figures 11/13/15/17 and the baseline figure: panels, axis labels, legend entries, panel
     letters, time axis, and the shaded phases where the scenario puts them."""
-    from lugrip import plot_experiments as pe
+    from lugrip.plot import experiments as pe
 
     r1, r2, r3 = (short_runs[n] for n in ("exp1_big_resin_block", "exp2_small_resin_block",
                                           "exp3_plastic_bottle_pivot"))

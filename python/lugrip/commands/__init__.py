@@ -36,6 +36,7 @@ COMMANDS: list[str] = [
     "simulate_sliding",
     "simulate_rubbing",
     "observe",
+    "replay",
     "identify",
     "simulate",
     "demo",

@@ -253,7 +253,7 @@ def write_report(result, out_dir: Path, *, title: str | None = None) -> list[Pat
         name = "fig05_identification"
         heading = title or (f"validation maneuvers ({len(tr['keys'])}): identified parameters")
         try:
-            from ..plot_observer import figure5
+            from ..plot.observer import figure5
         except ImportError:  # pragma: no cover - the plot module ships with the package
             figure5 = None
         if figure5 is not None:

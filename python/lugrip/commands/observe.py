@@ -14,6 +14,7 @@ import time
 from pathlib import Path
 
 from . import CliError, observer_options, positive_float
+from ._log_options import add_log_options, read_log_from_args
 from .simulate_sliding import add_params_arguments, load_params
 
 __all__ = ["OUTPUT_COLUMNS", "demo_section", "register", "run", "write_estimates"]
@@ -45,10 +46,12 @@ examples:
   lugrip observe run.parquet --params fingertip.yaml --out est.parquet
   lugrip observe run.parquet --params p.yaml --out est.parquet --integrator rk4 --gain 200
   lugrip observe run.bag --preset aluminium_can --out est.csv --wrench-topic /ft --flip-normal
+  lugrip observe run.mcap --preset table1 --out est.csv --maneuvers motion --units tau=N_mm
 
 LOG is a sliding log (.csv, .parquet, .mcap, ROS 1 .bag or a ROS 2 bag directory; see
 docs/sliding_log.md): the wrench the object exerts on the fingertip. The observer restarts
-where the maneuver id changes. With an `omega` column (ground truth) the RMSE of omega_hat
+where the maneuver id changes (ids from the file, --maneuver-topic, --maneuvers motion or
+time windows). With an `omega` column (ground truth) the RMSE of omega_hat
 (overall and per CoR regime) and the slip detection (delay from |omega| > --omega-threshold to
 S >= --s-threshold, false alarms) are printed. Nothing is overwritten without --force.
 A --params file written by 'lugrip identify' carries an 'observer' block (the observer the
@@ -137,19 +140,7 @@ def register(subparsers) -> None:
         metavar="S",
         help="S at or above which the observer signals slip (default 0.9)",
     )
-    r = p.add_argument_group("reading ROS recordings and damaged logs")
-    r.add_argument("--wrench-topic", metavar="TOPIC", help="WrenchStamped topic (MCAP, bags)")
-    r.add_argument("--omega-topic", metavar="TOPIC", help="ground-truth angular velocity topic")
-    r.add_argument(
-        "--flip-normal",
-        action="store_true",
-        help="the sensor's z axis points out of the pad (f_n = -force.z, ...)",
-    )
-    r.add_argument(
-        "--allow-gaps",
-        action="store_true",
-        help="accept long NaN runs (the observer restarts after them)",
-    )
+    add_log_options(p)
     p.add_argument("--force", action="store_true", help="overwrite existing output files")
     p.set_defaults(run=run)
 
@@ -297,7 +288,6 @@ def _observer(params, args, dt: float, block: dict | None = None):
 
 
 def run(args) -> int:
-    from .. import read_log
     from ..sliding import score
 
     out = Path(args.out)
@@ -308,7 +298,7 @@ def run(args) -> int:
     _check_target(out, "--out", args.force)
     fig_path = None
     if args.plot is not None:
-        from ..plot_observer import FIG5_NAME
+        from ..plot.observer import FIG5_NAME
 
         if args.plot.exists() and not args.plot.is_dir():
             raise CliError(f"argument --plot: {args.plot} exists and is not a directory")
@@ -319,15 +309,7 @@ def run(args) -> int:
         raise CliError("argument --out: the output would replace the input log")
     params = load_params(args, default=None)
     block = observer_block(args)
-    if not Path(args.log).exists():
-        raise CliError(f"{args.log}: no such file or directory")
-    log = read_log(
-        args.log,
-        wrench_topic=args.wrench_topic,
-        omega_topic=args.omega_topic,
-        flip_normal=args.flip_normal,
-        allow_gaps=args.allow_gaps,
-    )
+    log = read_log_from_args(args.log, args)
     if len(log) == 0:
         raise CliError(f"{args.log}: the log holds no samples")
     dt = log.sample_period if len(log) > 1 else 0.002
@@ -368,7 +350,7 @@ def run(args) -> int:
     else:
         print("  no ground-truth omega in the log: RMSE not computed")
     if fig_path is not None:
-        from ..plot_observer import write_figure5
+        from ..plot.observer import write_figure5
 
         args.plot.mkdir(parents=True, exist_ok=True)
         path = write_figure5(
@@ -388,7 +370,7 @@ def demo_section(out_dir: Path) -> str:
     """Demo step "observer replay": 40 synthetic Table 1 maneuvers through the observer with
     the default settings, Figure 5 and the scores (Markdown)."""
     from .. import ContactParams, Observer
-    from ..plot_observer import write_figure5
+    from ..plot.observer import write_figure5
     from ..sliding import score, simulate_maneuvers
 
     params = ContactParams.table1()

@@ -6,6 +6,7 @@ translation-dominated CoRs, plant = the slider model with known parameters, sens
 from __future__ import annotations
 
 import argparse
+import math
 import textwrap
 from pathlib import Path
 
@@ -23,6 +24,11 @@ The log holds t, f_n, f_x, f_y, tau (the wrench the object exerts on the fingert
 the ground truth omega and the maneuver id; the format follows the suffix (.csv, .parquet, .mcap).
 Replay it with `lugrip observe LOG --preset NAME --out est.csv`.
 """
+
+
+MAX_SAMPLES = 4_000_000
+"""Most samples one simulated log may need in the worst case (measured peak memory: about 240
+bytes per sample, and a maneuver's mean length is under half its worst case)."""
 
 
 def _non_negative(text: str) -> float:
@@ -178,6 +184,15 @@ def run(args) -> int:
         raise CliError(f"argument --stick-fraction: {args.stick_fraction:g} must be <= 1")
     if args.f_n_range[1] < args.f_n_range[0]:
         raise CliError("argument --f-n-range: HI must be >= LO")
+    # worst-case length of one maneuver: two rests, the longest ramp, hold and release
+    longest = 2 * 0.2 + 1.0 + 2.0 + 0.4  # [s] simulate_maneuvers' default ranges
+    worst = args.maneuvers * math.ceil(longest / args.dt)
+    if worst > MAX_SAMPLES:
+        raise CliError(
+            f"argument --maneuvers: {args.maneuvers} maneuvers at dt = {args.dt:g} s may need "
+            f"up to {worst:.3g} samples, more than the {MAX_SAMPLES:.0e} one log may hold "
+            f"(about {MAX_SAMPLES * 120 // 2**20} MiB); write several logs with different --seed"
+        )
     params = load_params(args)
     data = simulate_maneuvers(
         params,

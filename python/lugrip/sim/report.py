@@ -274,7 +274,7 @@ def write_outputs(
 ) -> tuple[str, dict[str, Path]]:
     """Figures, the Markdown section (also written to out_dir/report_name) and metrics.json
     (default out_dir/metrics.json). Returns (markdown, paths)."""
-    from ..plot_experiments import write_figures
+    from ..plot.experiments import write_figures
 
     out = Path(out_dir)
     out.mkdir(parents=True, exist_ok=True)

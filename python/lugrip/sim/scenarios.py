@@ -89,12 +89,15 @@ CRITERIA = {
 
 def scenario_dir() -> Path | None:
     """Directory of the bundled scenario files: $LUGRIP_SCENARIOS, ./scenarios, or the
-    repository's scenarios/ next to an in-tree package. None when none exists."""
+    scenarios shipped with lugrip (the installed copy, or the repository's scenarios/ next to
+    an in-tree package). None when none exists."""
+    from .._data import data_dir
+
     env = os.environ.get("LUGRIP_SCENARIOS")
     candidates = [Path(env)] if env else []
-    candidates += [Path.cwd() / "scenarios", Path(__file__).resolve().parents[3] / "scenarios"]
+    candidates += [Path.cwd() / "scenarios", data_dir("scenarios")]
     for c in candidates:
-        if c.is_dir() and any(c.glob("*.yaml")):
+        if c is not None and c.is_dir() and any(c.glob("*.yaml")):
             return c
     return None
 

@@ -1,4 +1,6 @@
-"""Shared figure style for lugrip's plots.
+"""Shared figure style for lugrip's plots, and the figures themselves in submodules:
+:mod:`lugrip.plot.observer` (observer replay, paper Figure 5) and
+:mod:`lugrip.plot.experiments` (the experiment figures 11, 13, 15, 17).
 
 Every figure of the project (limit surface, observer replay, experiments) is drawn with the
 helpers below so they look alike: one colour cycle, labelled axes with units, a light grid,

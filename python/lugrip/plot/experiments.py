@@ -7,7 +7,7 @@ the paper's panels, plus one baseline-comparison figure per scenario (ground tru
 * Figure 17 (exp4): grasp force, tangential force, torque for the full and the empty can; S.
 
 Plotted per-finger quantities are finger 0's (finger 1 mirrors it); S is max(S_0, S_1) and c~
-the mean of |c~_i|, the values the controller uses (MODEL.md 9.8). Forces are per finger.
+the mean of |c~_i|, the values the controller uses (docs/model.md §9.8). Forces are per finger.
 Shaded: the lift (grey), disturbances (orange), pivoting (green).
 """
 
@@ -19,7 +19,7 @@ from pathlib import Path
 
 import numpy as np
 
-from . import plot
+from .. import plot
 
 __all__ = [
     "FIGURES",

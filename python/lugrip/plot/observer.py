@@ -13,7 +13,7 @@ from pathlib import Path
 
 import numpy as np
 
-from . import plot
+from .. import plot
 
 __all__ = ["COLORS", "FIG5_NAME", "figure5", "pick_zooms", "write_figure5"]
 

@@ -1,0 +1,252 @@
+"""CSV sliding logs (one table per file; docs/sliding_log.md) and the header rules that
+Parquet tables share."""
+
+from __future__ import annotations
+
+import codecs
+import csv
+import io
+import math
+import re
+from collections.abc import Mapping
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from ._log import UNITS, LogError, SlidingLog, _Locator
+
+#: Largest CSV file read [bytes]: the reader holds the file and its columns in memory, about
+#: 4 times the file's size at the peak (measured: 53 MB file, 208 MB), so under 1 GB.
+MAX_CSV_BYTES = 192 * 1024 * 1024
+
+_HEADER_RE = re.compile(r"^\s*([A-Za-z_][A-Za-z0-9_]*)\s*(?:[\[(]\s*([^\])]*?)\s*[\])])?\s*$")
+
+
+#: Columns of one finger in a two-finger table (suffix _0 or _1); the others are shared.
+FINGER_COLUMNS = ("f_n", "f_x", "f_y", "f_t", "tau", "omega")
+#: Columns a two-finger table may add: the grasp-force command recorded with it [N].
+GRASP_COLUMNS = ("command",)
+
+
+def _column_name(raw: str, finger: int | None) -> str | None:
+    """The format's name of a header cell (lower case, unit stripped), None for other cells;
+    with ``finger`` k, ``f_n_k`` etc. name finger k's columns and other fingers' are None."""
+    m = _HEADER_RE.match(str(raw))
+    name = m.group(1).lower() if m else None
+    if finger is None or name is None:
+        return name
+    if name in GRASP_COLUMNS:
+        return name
+    base, _, k = name.rpartition("_")
+    if base in FINGER_COLUMNS:
+        return base if k == str(finger) else None
+    return None if name in FINGER_COLUMNS else name
+
+
+def _parse_header(names: list[str], file: str, finger: int | None = None
+                  ) -> tuple[dict[str, int], dict[str, str], list[str]]:
+    """Map column name -> position, column -> unit from ``name [unit]``, ignored names
+    (``finger``: see :func:`_column_name`)."""
+    index: dict[str, int] = {}
+    units: dict[str, str] = {}
+    ignored: list[str] = []
+    known = set(UNITS) | (set(GRASP_COLUMNS) if finger is not None else set())
+    for pos, raw in enumerate(names):
+        m = _HEADER_RE.match(str(raw))
+        name = _column_name(raw, finger)
+        if name not in known:
+            ignored.append(str(raw))
+            continue
+        if name in index:
+            raise LogError(file, f"column '{name}' appears twice (columns {index[name] + 1} "
+                           f"and {pos + 1})", where=f"row 1, column '{name}'", row=1,
+                           column=name)
+        index[name] = pos
+        if m.group(2) is not None:
+            units[name] = m.group(2)
+    return index, units, ignored
+
+
+def _check_required(index: Mapping[str, Any], names: list[str], file: str,
+                    finger: int | None = None) -> None:
+    have = ", ".join(str(n) for n in names) or "(none)"
+    expected = ("expected t [s], f_n [N], f_x and f_y [N] (or f_t [N]), tau [N m]; optional "
+                "omega [rad/s], maneuver")
+    missing = [c for c in ("t", "f_n", "tau") if c not in index]
+    if "f_x" in index and "f_y" not in index:
+        missing.append("f_y")
+    elif "f_y" in index and "f_x" not in index:
+        missing.append("f_x")
+    elif not any(c in index for c in ("f_x", "f_y", "f_t")):
+        missing.append("f_x/f_y or f_t")
+    if missing and finger is not None:
+        k = finger
+        missing = [f"f_x_{k}/f_y_{k} or f_t_{k}" if m == "f_x/f_y or f_t"
+                   else (f"{m}_{k}" if m in FINGER_COLUMNS else m) for m in missing]
+        expected = ("a two-finger table has t and per finger k = 0, 1: f_n_k, f_x_k and f_y_k "
+                    "(or f_t_k), tau_k; optional omega_k, command, maneuver")
+    if missing:
+        names_ = ", ".join(f"'{c}'" for c in missing)
+        raise LogError(file, f"missing required column(s) {names_}; the file has: {have}; "
+                       f"{expected}", where=f"row 1, column '{missing[0]}'", row=1,
+                       column=missing[0])
+
+
+def _cells_to_float(cells, column: str, loc: _Locator) -> np.ndarray:
+    """Text cells -> float64; empty cells are NaN; LogError names the first bad cell."""
+    cleaned = ["nan" if c is None or not str(c).strip() else c for c in cells]
+    try:
+        return np.array(cleaned, dtype=np.float64)
+    except (ValueError, TypeError):
+        pass
+    for i, cell in enumerate(cleaned):
+        try:
+            float(cell)
+        except (ValueError, TypeError):
+            hint = ""
+            if re.fullmatch(r"\s*[-+]?\d+,\d+\s*", str(cell)):
+                hint = " (decimal comma? use '.' as decimal separator)"
+            raise loc.error(f"{str(cell)!r} is not a number{hint}", i, column) from None
+    raise loc.error("column is not numeric", None, column)  # pragma: no cover
+
+
+def _read_csv(path: Path, file: str, finger: int | None = None
+              ) -> tuple[dict[str, np.ndarray], dict[str, str], _Locator, dict]:
+    size = path.stat().st_size
+    if size > MAX_CSV_BYTES:
+        raise LogError(file, f"{size / 2**20:.0f} MiB is more than the {MAX_CSV_BYTES // 2**20} "
+                       "MiB a CSV log may hold (the reader keeps it in memory); split the "
+                       "recording or convert it to Parquet")
+    raw = path.read_bytes()
+    if raw[:2] in (b"\xff\xfe", b"\xfe\xff") or b"\x00" in raw[:4096]:
+        raise LogError(file, "not UTF-8 text (UTF-16 or a binary file?); save the table as "
+                       "UTF-8 CSV")
+    raw = raw.removeprefix(codecs.BOM_UTF8)
+    fast = _read_csv_fast(raw, file, finger)
+    if fast is not None:
+        return fast
+    try:
+        text = raw.decode("utf-8")
+    except UnicodeDecodeError as exc:
+        line = raw[:exc.start].count(b"\n") + 1
+        raise LogError(file, f"byte {exc.start} is not UTF-8 text; save the table as UTF-8 CSV",
+                       where=f"row {line}", row=line) from None
+    del raw
+    if not text.strip():
+        raise LogError(file, "empty file (expected a header row and data rows)")
+    first = next(line for line in text.splitlines() if line.strip())
+    delim = _delimiter(first)
+    reader = csv.reader(io.StringIO(text, newline=""), delimiter=delim,
+                        skipinitialspace=True)
+    header: list[str] | None = None
+    rows: list[list[str]] = []
+    lines: list[int] = []
+    records = iter(reader)
+    while True:
+        try:
+            record = next(records)
+        except StopIteration:
+            break
+        except csv.Error as exc:  # e.g. a cell longer than the csv module's field limit
+            raise LogError(file, f"unreadable CSV ({exc})", where=f"row {reader.line_num}",
+                           row=reader.line_num) from None
+        if not record or all(not c.strip() for c in record) and len(record) <= 1:
+            continue  # blank line
+        if header is None:
+            header = [c.strip() for c in record]
+            header_line = reader.line_num
+            continue
+        rows.append(record)
+        lines.append(reader.line_num)
+    assert header is not None
+    index, units, ignored = _parse_header(header, file, finger)
+    if not index and all(_is_number(c) for c in header if c):
+        raise LogError(file, f"no header row: row {header_line} holds numbers; the first row "
+                       "must name the columns (t, f_n, f_x, f_y or f_t, tau, omega, maneuver)",
+                       where=f"row {header_line}", row=header_line)
+    _check_required(index, header, file, finger)
+    if not rows:
+        raise LogError(file, "no data rows (only the header)")
+    loc = _Locator(file, rows=np.asarray(lines))
+    width = len(header)
+    for k, record in enumerate(rows):
+        if len(record) != width:
+            raise loc.error(f"{len(record)} cells, but the header has {width} columns "
+                            f"(delimiter {delim!r})", k, None)
+    cols = {}
+    for name, pos in index.items():
+        cols[name] = _cells_to_float([r[pos] for r in rows], name, loc)
+    meta = {"format": "csv", "columns": [str(h) for h in header], "ignored_columns": ignored}
+    return cols, units, loc, meta
+
+
+def _delimiter(first_line: str) -> str:
+    return next((d for d in (",", ";", "\t") if d in first_line), ",")
+
+
+_BLANK_LINE = re.compile(rb"(?:^|\n)[ \t\r]*(?:\n|$)")
+
+
+def _read_csv_fast(raw: bytes, file: str, finger: int | None = None):
+    """pyarrow's CSV parser on the file's bytes for clean files (no blank lines, every cell
+    of the format's columns a number); None to fall back to the line-by-line reader, which
+    finds and names any problem. Holds no second copy of the text."""
+    try:
+        import pyarrow as pa
+        import pyarrow.csv as pacsv
+    except ImportError:
+        return None
+    body = raw[:-2] if raw.endswith(b"\r\n") else raw[:-1] if raw.endswith(b"\n") else raw
+    if not body or _BLANK_LINE.search(body) or (b"\r" in body and b"\n" not in body):
+        return None
+    n_lines = body.count(b"\n") + 1
+    if n_lines < 2:
+        return None
+    try:
+        first = body[:body.index(b"\n")].decode("utf-8")
+    except UnicodeDecodeError:
+        return None
+    delim = _delimiter(first)
+    header = [c.strip() for c in next(csv.reader([first], delimiter=delim))]
+    index, units, ignored = _parse_header(header, file, finger)
+    if not index:
+        return None
+    _check_required(index, header, file, finger)
+    names = [f"c{i}" for i in range(len(header))]
+    try:
+        table = pacsv.read_csv(
+            pa.BufferReader(pa.py_buffer(raw)),
+            read_options=pacsv.ReadOptions(skip_rows=1, column_names=names),
+            parse_options=pacsv.ParseOptions(delimiter=delim),
+            convert_options=pacsv.ConvertOptions(
+                column_types={names[pos]: pa.float64() for pos in index.values()},
+                include_columns=[names[pos] for pos in index.values()],
+                null_values=[""], strings_can_be_null=False))
+    except (pa.ArrowException, ValueError):
+        return None
+    if table.num_rows != n_lines - 1:
+        return None
+    cols = {name: np.asarray(table.column(names[pos]).fill_null(math.nan).to_numpy(),
+                             dtype=np.float64) for name, pos in index.items()}
+    meta = {"format": "csv", "columns": header, "ignored_columns": ignored}
+    return cols, units, _Locator(file), meta
+
+
+def _is_number(text: str) -> bool:
+    try:
+        float(text)
+    except ValueError:
+        return False
+    return True
+
+def _write_csv(log: SlidingLog, fh) -> None:
+    cols = log.columns()
+    text = io.TextIOWrapper(fh, encoding="utf-8", newline="")
+    writer = csv.writer(text, lineterminator="\n")
+    writer.writerow(list(cols))
+    lists = [a.tolist() for a in cols.values()]  # Python floats: repr round-trips exactly
+    writer.writerows(zip(*lists))
+    text.flush()
+    text.detach()
+

@@ -1,0 +1,332 @@
+"""ROS recordings as sliding logs: the topics a log is read from, how their messages become
+columns, and what is done to the wrench on the way (frame flip, move to the contact point).
+
+Messages are decoded by the recording libraries themselves (rosbags' typestore, mcap and,
+when installed, mcap-ros2-support); this module only picks fields out of the decoded objects.
+The sources live in :mod:`._mcap` and :mod:`._bags`.
+"""
+
+from __future__ import annotations
+
+import operator
+import warnings
+from collections.abc import Iterator
+from typing import Any
+
+import numpy as np
+
+from ._log import LogError, LogWarning, _Locator
+
+_DEFAULT_WRENCH_TOPIC = "/lugrip/wrench"
+_DEFAULT_OMEGA_TOPIC = "/lugrip/omega"
+_DEFAULT_MANEUVER_TOPIC = "/lugrip/maneuver"
+_MCAP_META = "lugrip.sliding_log"
+
+_WRENCH_FIELDS = tuple(f"{a}.{b}" for a in ("force", "torque") for b in "xyz")
+_INT_TYPES = tuple(f"std_msgs/{k}Int{n}" for k in ("", "U") for n in (8, 16, 32, 64))
+_FLOAT_TYPES = ("std_msgs/Float64", "std_msgs/Float32")
+# short type name -> (has a std_msgs/Header, fields read in this order)
+_TYPES: dict[str, tuple[bool, tuple[str, ...]]] = {
+    "geometry_msgs/WrenchStamped": (True, tuple("wrench." + f for f in _WRENCH_FIELDS)),
+    "geometry_msgs/Wrench": (False, _WRENCH_FIELDS),
+    "geometry_msgs/TwistStamped": (True, ("twist.angular.z",)),
+    "geometry_msgs/Twist": (False, ("angular.z",)),
+    "geometry_msgs/Vector3Stamped": (True, ("vector.z",)),
+    "geometry_msgs/Vector3": (False, ("z",)),
+    **{t: (False, ("data",)) for t in _FLOAT_TYPES + _INT_TYPES},
+}
+WRENCH_TYPES = ("geometry_msgs/WrenchStamped", "geometry_msgs/Wrench")
+OMEGA_TYPES = ("geometry_msgs/TwistStamped", "geometry_msgs/Twist",
+               "geometry_msgs/Vector3Stamped", "geometry_msgs/Vector3") + _FLOAT_TYPES
+ID_TYPES = _INT_TYPES + _FLOAT_TYPES  # maneuver ids (floats must hold integers)
+SCALAR_TYPES = _FLOAT_TYPES + _INT_TYPES  # recorded commands and similar scalars
+#: Most messages read from one topic (about 330 bytes each in memory: 2e6 = 66 min at 500 Hz).
+MAX_MESSAGES = 2_000_000
+
+
+def short_type(name: str) -> str:
+    """'geometry_msgs/msg/WrenchStamped' and 'geometry_msgs/WrenchStamped' -> the latter."""
+    return name.replace("/msg/", "/")
+
+
+def full_type(name: str) -> str:
+    """'geometry_msgs/WrenchStamped' -> 'geometry_msgs/msg/WrenchStamped' (typestore name)."""
+    pkg, _, rest = short_type(name).partition("/")
+    return f"{pkg}/msg/{rest}"
+
+
+_GETTERS = {typ: operator.attrgetter(*fields) for typ, (_s, fields) in _TYPES.items()}
+
+
+def _values(typ: str, msg: Any) -> tuple:
+    got = _GETTERS[typ](msg)
+    return got if isinstance(got, tuple) else (got,)
+
+
+def _stamp_ns(msg: Any) -> int:
+    stamp = msg.header.stamp
+    return int(stamp.sec) * 1_000_000_000 + int(getattr(stamp, "nanosec", 0))
+
+
+class Topic:
+    """All messages of one topic in recording order: log times [ns], header stamps [ns] (0
+    for unstamped types) and the fields of :data:`_TYPES` per message."""
+
+    def __init__(self, name: str, typ: str):
+        self.name = name
+        self.type = typ
+        self.log_ns: list[int] = []
+        self.stamp_ns: list[int] = []
+        self.values: list[tuple] = []
+
+    def add(self, log_ns: int, msg: Any) -> None:
+        stamped = _TYPES[self.type][0]
+        self.log_ns.append(int(log_ns))
+        self.stamp_ns.append(_stamp_ns(msg) if stamped else 0)
+        self.values.append(_values(self.type, msg))
+
+    def times(self) -> tuple[np.ndarray, str]:
+        """Header stamps when the type has them and they are set, else the log times."""
+        stamps = np.asarray(self.stamp_ns, dtype=np.int64)
+        if _TYPES[self.type][0] and stamps.size and np.any(stamps != 0):
+            return stamps, "header"
+        return np.asarray(self.log_ns, dtype=np.int64), "log"
+
+
+class RosSource:
+    """Topics of an MCAP file or a ROS bag; :meth:`read` decodes the messages of some topics.
+
+    Subclasses fill ``topics`` (name -> (short type, encoding, message count or None)) and
+    ``metadata`` (lugrip's MCAP metadata record, else empty) and implement
+    :meth:`_messages`, yielding ``(topic, log time [ns], decoded message)``.
+    """
+
+    def __init__(self, file: str):
+        self.file = file
+        self.topics: dict[str, tuple[str, str, int | None]] = {}
+        self.metadata: dict[str, str] = {}
+
+    def describe(self) -> str:
+        if not self.topics:
+            return "(no topics)"
+        out = []
+        for name, (typ, _enc, count) in sorted(self.topics.items()):
+            n = "" if count is None else f", {count} messages"
+            out.append(f"{name} ({typ}{n})")
+        return ", ".join(out)
+
+    def _messages(self, names: list[str]) -> Iterator[tuple[str, int, Any]]:
+        raise NotImplementedError
+
+    def _too_many(self, name: str, count: int) -> LogError:
+        return LogError(self.file, f"topic '{name}' has {count} messages or more, over the "
+                        f"{MAX_MESSAGES} one log may hold in memory; cut the recording into "
+                        "pieces (e.g. rosbags-convert or mcap filter with a time range)")
+
+    def read(self, names: list[str]) -> dict[str, Topic]:
+        for name in names:
+            count = self.topics[name][2]
+            if count is not None and count > MAX_MESSAGES:
+                raise self._too_many(name, count)
+        out = {name: Topic(name, self.topics[name][0]) for name in names}
+        for name, log_ns, msg in self._messages(names):
+            topic = out[name]
+            if len(topic.values) >= MAX_MESSAGES:
+                raise self._too_many(name, MAX_MESSAGES + 1)
+            try:
+                topic.add(log_ns, msg)
+            except (AttributeError, TypeError, ValueError) as exc:
+                raise LogError(self.file, f"message has no usable {topic.type} fields ({exc})",
+                               where=f"message {len(topic.values) + 1} on topic '{name}'",
+                               row=len(topic.values) + 1) from None
+        return out
+
+    def check_topic(self, topic: str, types, what: str) -> None:
+        if topic not in self.topics:
+            raise LogError(self.file, f"no topic '{topic}' ({what}); topics present: "
+                           f"{self.describe()}")
+        typ = self.topics[topic][0]
+        if typ not in types:
+            raise LogError(self.file, f"topic '{topic}' has type {typ}; {what} must be one of "
+                           f"{', '.join(types)}")
+
+    def pick_wrench_topic(self, wrench_topic: str | None) -> str:
+        if wrench_topic is None:
+            wrench_topic = self.metadata.get("wrench_topic")
+        if wrench_topic is None:
+            found = [n for n, (typ, _, _) in self.topics.items() if typ in WRENCH_TYPES]
+            if len(found) == 1:
+                return found[0]
+            if not found:
+                raise LogError(self.file, "no geometry_msgs/WrenchStamped topic; topics "
+                               f"present: {self.describe()}")
+            raise LogError(self.file, f"{len(found)} wrench topics "
+                           f"({', '.join(sorted(found))}); choose one with [[opt:wrench_topic]]")
+        self.check_topic(wrench_topic, WRENCH_TYPES, "wrench_topic")
+        return wrench_topic
+
+
+def ordered(file: str, topic: Topic, ns: np.ndarray, column: str,
+            stacklevel: int) -> np.ndarray:
+    """Indices that put the messages of ``topic`` in increasing time ``ns`` with exact
+    duplicates dropped (first kept); both are warned about, naming the first message."""
+    n = len(ns)
+    order = np.argsort(ns, kind="stable")
+    if n > 1 and np.any(np.diff(ns) < 0):
+        k = int(np.flatnonzero(np.diff(ns) < 0)[0]) + 1
+        warnings.warn(f"{file}: topic '{topic.name}': times go backwards from message {k + 1} "
+                      f"on (column '{column}'); messages sorted by time", LogWarning,
+                      stacklevel=stacklevel)
+    s = ns[order]
+    dup = np.zeros(n, dtype=bool)
+    dup[1:] = s[1:] == s[:-1]
+    if dup.any():
+        first = int(order[np.flatnonzero(dup)[0]])
+        warnings.warn(f"{file}: topic '{topic.name}': {int(dup.sum())} message(s) with a "
+                      f"duplicated time, first message {first + 1} (column '{column}', "
+                      f"t = {int(ns[first])} ns); dropped, the first of each time kept",
+                      LogWarning, stacklevel=stacklevel)
+    return order[~dup]
+
+
+def resample(t_src: np.ndarray, y_src: np.ndarray, t_dst: np.ndarray,
+             max_gap: float) -> np.ndarray:
+    """Linear interpolation of (t_src, y_src) at t_dst; NaN outside the source's time span
+    and between source samples further apart than max_gap."""
+    m = len(t_src)
+    out = np.full(len(t_dst), np.nan)
+    if m == 0:
+        return out
+    idx = np.searchsorted(t_src, t_dst, side="left")
+    inside = idx < m
+    exact = np.zeros(len(t_dst), dtype=bool)
+    exact[inside] = t_src[idx[inside]] == t_dst[inside]
+    out[exact] = y_src[idx[exact]]
+    mid = (idx > 0) & inside & ~exact
+    lo, hi = idx[mid] - 1, idx[mid]
+    span = t_src[hi] - t_src[lo]
+    w = (t_dst[mid] - t_src[lo]) / span
+    val = y_src[lo] + w * (y_src[hi] - y_src[lo])
+    val[span > max_gap] = np.nan
+    out[mid] = val
+    return out
+
+
+def hold_last(ns_src: np.ndarray, y_src: np.ndarray, ns_dst: np.ndarray,
+              before: float) -> np.ndarray:
+    """Zero-order hold: at each ns_dst the value of the latest source message at or before
+    it; ``before`` ahead of the first message."""
+    k = np.searchsorted(ns_src, ns_dst, side="right") - 1
+    return np.where(k >= 0, y_src[np.maximum(k, 0)], before)
+
+
+def to_contact(f: np.ndarray, m: np.ndarray, offset: float) -> tuple[np.ndarray, np.ndarray]:
+    """Torsional moment about the contact normal at the centre of pressure, from the wrench
+    (f, m) [N], [N m] of shape (n, 3) measured at a sensor origin ``offset`` [m] behind the
+    pad surface along the normal (the frame has f_n = f[:, 2] > 0 in contact; the surface is
+    the plane z = -offset). Returns (tau [N m], centre of pressure (n, 2) [m]); samples
+    without a usable normal force keep m_z and get a NaN centre (docs/sliding_log.md,
+    "Wrench at the sensor origin")."""
+    fx, fy, fz = f[:, 0], f[:, 1], f[:, 2]
+    mx, my, mz = m[:, 0], m[:, 1], m[:, 2]
+    pressed = fz[np.isfinite(fz) & (fz > 0)]
+    floor = max(1e-3, 0.05 * float(np.median(pressed))) if pressed.size else np.inf
+    ok = np.isfinite(fz) & (fz > floor)
+    x = np.full(len(fz), np.nan)
+    y = np.full(len(fz), np.nan)
+    x[ok] = -(my[ok] + offset * fx[ok]) / fz[ok]
+    y[ok] = (mx[ok] - offset * fy[ok]) / fz[ok]
+    tau = mz.copy()
+    tau[ok] = mz[ok] - x[ok] * fy[ok] + y[ok] * fx[ok]
+    return tau, np.c_[x, y]
+
+
+def read_ros(src: RosSource, *, wrench_topic: str | None, omega_topic: str | None,
+             maneuver_topic: str | None, flip_normal: bool, contact_offset: float | None,
+             stacklevel: int, scalar_topics=None):
+    """Columns of a sliding log from a ROS source (see :func:`lugrip.io.read_log`)."""
+    file = src.file
+    wrench_topic = src.pick_wrench_topic(wrench_topic)
+    if omega_topic is None:
+        omega_topic = src.metadata.get("omega_topic") or None
+    if omega_topic is not None:
+        src.check_topic(omega_topic, OMEGA_TYPES, "omega_topic")
+    if maneuver_topic is None:
+        maneuver_topic = src.metadata.get("maneuver_topic") or None
+    if maneuver_topic is not None:
+        src.check_topic(maneuver_topic, ID_TYPES, "maneuver_topic")
+    scalar_topics = dict(scalar_topics or {})
+    for column, topic in scalar_topics.items():
+        src.check_topic(topic, SCALAR_TYPES, f"{column} topic")
+    names = [n for n in dict.fromkeys((wrench_topic, omega_topic, maneuver_topic,
+                                       *scalar_topics.values())) if n]
+    topics = src.read(names)
+
+    wrench = topics[wrench_topic]
+    if not wrench.values:
+        raise LogError(file, f"topic '{wrench_topic}' has no messages")
+    stamps, time_source = wrench.times()
+    keep = ordered(file, wrench, stamps, "t", stacklevel + 1)
+    stamps = stamps[keep]
+    log_ns = np.asarray(wrench.log_ns, dtype=np.int64)[keep]
+    t0 = int(src.metadata["t0_ns"]) if "t0_ns" in src.metadata else int(stamps[0])
+    t = (stamps - t0) / 1e9
+    v = np.asarray(wrench.values, dtype=np.float64)[keep]
+    sign = -1.0 if flip_normal else 1.0  # rotation by pi about x: y and z components flip
+    force = v[:, 0:3] * [1.0, sign, sign]
+    moment = v[:, 3:6] * [1.0, sign, sign]
+    if contact_offset is None:
+        tau = moment[:, 2]
+    else:
+        tau, _cop = to_contact(force, moment, float(contact_offset))
+    cols = {"t": t, "f_x": force[:, 0], "f_y": force[:, 1], "f_n": force[:, 2], "tau": tau}
+    if src.metadata.get("force_vector") == "false":
+        cols["f_t"] = np.hypot(cols.pop("f_x"), cols.pop("f_y"))
+    prefix = "wrench." if _TYPES[wrench.type][0] else ""
+    fields = {"t": "header.stamp" if time_source == "header" else "log time",
+              "f_x": prefix + "force.x", "f_y": prefix + "force.y",
+              "f_t": f"|{prefix}force.xy|", "f_n": prefix + "force.z",
+              "tau": prefix + ("torque.z" if contact_offset is None
+                               else "torque moved to the contact point")}
+    meta: dict[str, Any] = {"format": None, "wrench_topic": wrench_topic,
+                            "wrench_type": wrench.type, "time_source": time_source,
+                            "t0_ns": t0, "flip_normal": bool(flip_normal)}
+    if contact_offset is not None:
+        meta["contact_offset"] = float(contact_offset)
+
+    if omega_topic is not None:
+        om = topics[omega_topic]
+        if not om.values:
+            raise LogError(file, f"topic '{omega_topic}' has no messages")
+        o_ns, o_source = om.times()
+        pick = ordered(file, om, o_ns, "omega", stacklevel + 1)
+        o_t = (o_ns[pick] - t0) / 1e9
+        y = sign * np.asarray(om.values, dtype=np.float64)[pick, 0]
+        step = np.diff(o_t)
+        max_gap = 10.0 * float(np.median(step)) if step.size else 0.0
+        cols["omega"] = resample(o_t, y, t, max_gap)
+        fields["omega"] = f"{_TYPES[om.type][1][0]} of '{omega_topic}' resampled"
+        meta.update(omega_topic=omega_topic, omega_type=om.type, omega_time_source=o_source)
+
+    if maneuver_topic is not None:
+        mt = topics[maneuver_topic]
+        m_ns, m_source = mt.times()
+        pick = ordered(file, mt, m_ns, "maneuver", stacklevel + 1)
+        m_val = np.asarray([val[0] for val in mt.values], dtype=np.float64)[pick]
+        # compare like with like: a stamped id topic against the wrench stamps, else log times
+        at = stamps if (m_source == "header" and time_source == "header") else log_ns
+        cols["maneuver"] = hold_last(m_ns[pick], m_val, at,
+                                     m_val[0] if m_val.size else 0.0)
+        meta["maneuver_topic"] = maneuver_topic
+
+    for column, topic in scalar_topics.items():  # e.g. a recorded command: the latest value
+        st = topics[topic]
+        s_ns, s_source = st.times()
+        pick = ordered(file, st, s_ns, column, stacklevel + 1)
+        s_val = np.asarray([val[0] for val in st.values], dtype=np.float64)[pick]
+        at = stamps if (s_source == "header" and time_source == "header") else log_ns
+        cols[column] = hold_last(s_ns[pick], s_val, at, np.nan)
+        meta[f"{column}_topic"] = topic
+
+    loc = _Locator(file, rows=keep + 1, topic=wrench_topic, fields=fields, kind="ros")
+    return cols, {}, loc, meta
