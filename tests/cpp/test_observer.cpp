@@ -296,13 +296,16 @@ TEST(Observer, SignOfOmegaHatFollowsGroundTruth) {
 TEST(Observer, BeyondTheClipOmegaObjectOnAnIndependentPatchPlant) {
   // Independent plant: steady slip omega about a CoR at c~ rho (c~ from 0.5 to 20), wrench by
   // quadrature of the dry and viscous stress over the patch (patch_wrench), sensor noise 2e-5 N m
-  // and 0.01 N; beta_A = 2e7 (speed observable at these forces). The truth is the prescribed
+  // and 0.01 N; beta_A = 2e7 (speed observable at these forces), sigma_z = 1e-3 (with Table 1's
+  // sigma_z = 2 the normal-force noise, through sigma_z dz/dt, biases omega_hat low by up to
+  // 65 % at 0.1 rad/s and 2 N; noise-free it is exact). The truth is the prescribed
   // kinematics: omega, and the patch centre sliding at |omega| c~ rho.
   // Below the clip omega_object is omega_hat exactly; beyond it (c~ > 3) the error of
   // omega_object must not exceed that of predicting zero, where omega_hat's does.
   ContactParams p = table1_params();
   p.mu = 0.5;
   p.beta_a = 2e7;
+  p.sigma_z = 1e-3;
   const ContactModel m(p);
   std::mt19937_64 rng(17);
   std::normal_distribution<double> normal(0.0, 1.0);
@@ -349,11 +352,14 @@ TEST(Observer, BeyondTheClipOmegaObjectOnAnIndependentPatchPlant) {
           v_rel += (v - v_true) * (v - v_true) / (v_true * v_true);
           const double v_clip = std::fabs(w_hat) * p.c_max * rho;  // |omega_hat c| at the clip
           v_rel_clip += (v_clip - v_true) * (v_clip - v_true) / (v_true * v_true);
-          EXPECT_GT(v, 0.4 * v_true);
-          EXPECT_LT(v, 1.1 * v_true);
-        } else if (ct < p.c_max) {  // (below the clip the lumped LS and the quadrature differ by
-          ++n_near;                  // up to 40 % of omega at 2 N; omega_hat's own accuracy)
-          EXPECT_LT(std::fabs(w_obj - omega), std::fabs(omega));
+          // within 15 %: the residual is the dry torque about the clipped point, (xi T(a_u) +
+          // a F(a_u)) mu f_n rho <= g(a), which omega_hat (and so omega_object) reads as less slip
+          EXPECT_NEAR(w_obj, omega, 0.15 * std::fabs(omega));
+          EXPECT_NEAR(v, v_true, 0.15 * v_true);
+        } else if (ct < p.c_max) {
+          ++n_near;
+          EXPECT_NEAR(w_obj, omega, 0.1 * std::fabs(omega));
+          EXPECT_NEAR(v, v_true, 0.1 * v_true);
         }
       }
     }
@@ -367,10 +373,10 @@ TEST(Observer, BeyondTheClipOmegaObjectOnAnIndependentPatchPlant) {
   v_rel_clip = std::sqrt(v_rel_clip / n_far);
   std::printf("  [beyond clip] |c~| >= 3 RMSE: omega_object %.4f, omega_hat %.4f, zero %.4f rad/s; "
               "relative RMSE of v_slip %.3f (|omega_hat c| at the clip: %.3f)\n", e_obj, e_hat, e_zero, v_rel, v_rel_clip);
-  EXPECT_LE(e_obj, 0.5 * e_zero);
+  EXPECT_LE(e_obj, 0.05 * e_zero);  // measured 0.011
   EXPECT_GT(e_hat, e_zero);  // the clipped CoR's omega_hat is not the object's angular velocity
-  EXPECT_LT(v_rel, 0.2);
-  EXPECT_LT(v_rel, v_rel_clip);
+  EXPECT_LT(v_rel, 0.1);     // measured 0.04
+  EXPECT_LT(v_rel, 0.5 * v_rel_clip);
 }
 
 // ---------------------------------------------------------------------------------------------

@@ -4,7 +4,9 @@
 * ``grid-viscous`` (lugrip.rigs.GridContactRig.viscous): a distributed grid of LuGre cells
   with Hertzian pressure, Stribeck friction and a viscous shear uniform over the patch, written
   from its own physics -- an independent plant. The observer runs with the plant's true
-  contact law (mu = mu_k, beta_A, delta, gamma, k = 2 for Hertz); no parameter is fitted here.
+  contact law (mu = mu_k, beta_A, delta, gamma, k = 2 for Hertz) and sigma_z = 1e-3 (the grid
+  has no lumped presliding damping; Table 1's 2 makes the normal-force noise bias omega_hat
+  low); no parameter is fitted here.
 * ``lumped``: lugrip's own lumped model under the same prescribed motion -- a consistency test.
 
 The truth is the prescribed motion: the slider's omega about the commanded CoR and the patch
@@ -26,7 +28,8 @@ FAR = RubbingDesign(c_tilde_range=(3.0, 20.0))  # translation-dominated rubs, be
 def _observer_for(rig, truth) -> lugrip.Observer:
     if isinstance(rig, GridContactRig):
         p = lugrip.ContactParams.table1().replace(
-            mu=truth.mu, beta_a=truth.beta_a, delta=truth.delta, gamma=truth.gamma, k=2.0)
+            mu=truth.mu, beta_a=truth.beta_a, delta=truth.delta, gamma=truth.gamma, k=2.0,
+            sigma_z=1e-3)
     else:  # the lumped rig's own contact
         p = rig.contact()
     return lugrip.Observer(p)
@@ -48,8 +51,8 @@ def _rmse(x, ref, mask):
 
 def test_omega_object_beats_predicting_zero_beyond_the_clip(far_run):
     """Gross sliding with |c~| > 3: the |omega| error of omega_object is below that of
-    predicting zero (measured 0.11-0.45 of it), while omega_hat -- the slip about the clipped
-    CoR -- is 2-3 times worse than zero."""
+    predicting zero (measured 0.11-0.26 of it), while omega_hat -- the slip about the clipped
+    CoR -- is 2-3.5 times worse than zero."""
     plant, data, run = far_run
     w = data.log.omega
     m = (data.phase == 2) & (np.abs(data.c_tilde_true) > 3.0)
@@ -57,7 +60,7 @@ def test_omega_object_beats_predicting_zero_beyond_the_clip(far_run):
     zero = float(np.sqrt(np.mean(w[m] ** 2)))
     e_obj, e_hat = _rmse(run.omega_object, w, m), _rmse(run.omega_hat, w, m)
     print(f"{plant}: |c~| > 3 RMSE omega_object {e_obj:.4f}, omega_hat {e_hat:.4f}, zero {zero:.4f}")
-    assert e_obj <= 0.7 * zero
+    assert e_obj <= 0.5 * zero
     assert e_hat > zero
     # same sign as the truth where the object turns measurably
     turning = m & (np.abs(w) > 0.05)
@@ -66,7 +69,8 @@ def test_omega_object_beats_predicting_zero_beyond_the_clip(far_run):
 
 def test_v_slip_tracks_the_patch_centre_speed(far_run):
     """v_slip against the patch centre's prescribed speed in gross sliding: well below the
-    error of predicting zero, and no worse than |omega_hat c| at the clip."""
+    error of predicting zero (measured 0.06-0.11 of it) and of |omega_hat c| at the clip
+    (0.34-0.49 of it)."""
     plant, data, run = far_run
     m = (data.phase == 2) & (np.abs(data.c_tilde_true) > 3.0)
     v = data.v_true
@@ -74,8 +78,8 @@ def test_v_slip_tracks_the_patch_centre_speed(far_run):
     e_v = _rmse(run.v_slip, v, m)
     e_clip = _rmse(np.abs(run.omega_hat * run.c), v, m)
     print(f"{plant}: v_slip RMSE {e_v:.2e} m/s, |omega_hat c| {e_clip:.2e}, zero {zero:.2e}")
-    assert e_v < 0.5 * zero
-    assert e_v <= e_clip * 1.05
+    assert e_v < 0.25 * zero
+    assert e_v < 0.7 * e_clip
 
 
 def test_unclipped_cor_follows_the_prescribed_cor(far_run):
