@@ -541,6 +541,22 @@ def compute_metrics(
             max(np.max(np.abs(run[f"omega_true_{k}"][hw])) for k in (0, 1))
         )
     scene = getattr(run, "scene", None)
+    if scene and scenario.steady_window is not None:
+        # the plant's own slip force for the steady loads of each finger: MuJoCo's elliptic cone
+        from .mujoco.loop import cone_slip_force
+
+        sw = run.window(*scenario.steady_window)
+        if sw.stop > sw.start:
+            m["min_force_plant"] = max(
+                cone_slip_force(
+                    cfg.contact,
+                    float(np.mean(run[f"f_t_true_{k}"][sw])),
+                    float(np.mean(np.abs(run[f"tau_true_{k}"][sw]))),
+                )
+                for k in (0, 1)
+            )
+    elif "min_force" in m:
+        m["min_force_plant"] = m["min_force"]  # the patch follows lugrip's limit surface
     m["scene_status"] = scene["status"] if scene else "ok"
     if scene:
         m["scene"] = dict(scene)

@@ -47,10 +47,10 @@ class PadSpec:
     mass: float = 0.01  #: [kg] pad mass between its springs and the contact
     tangential_stiffness: float = 4000.0  #: [N/m] in-plane spring finger -> pad (y and z)
     tangential_damping: float = 20.0  #: [N s/m]
-    twist_stiffness: float = 1.0  #: [N m/rad] spring about the grasp axis
-    twist_damping: float = 0.01  #: [N m s/rad]
+    twist_stiffness: float = 2.0  #: [N m/rad] spring about the grasp axis
+    twist_damping: float = 0.05  #: [N m s/rad]
     twist_inertia: float = 2.0e-6  #: [kg m^2] about the grasp axis
-    solref: tuple[float, float] = (0.005, 1.0)  #: MuJoCo contact time constant [s], damping ratio
+    solref: tuple[float, float] = (0.002, 1.0)  #: MuJoCo contact time constant [s], damping ratio
 
 
 @dataclasses.dataclass
@@ -249,10 +249,18 @@ def build_scene(
 <mujoco model="lugrip_gripper">
   <option timestep="{spec.timestep}" cone="{spec.cone}" noslip_iterations="{spec.noslip_iterations}"
           impratio="{spec.impratio}" integrator="implicitfast" gravity="0 0 -9.81"/>
-  <visual><global offwidth="640" offheight="480"/><quality shadowsize="0"/></visual>
+  <visual>
+    <global offwidth="640" offheight="480"/>
+    <quality shadowsize="0"/>
+    <headlight ambient="0.35 0.35 0.35" diffuse="0.5 0.5 0.5"/>
+  </visual>
+  <asset>
+    <texture name="sky" type="skybox" builtin="gradient" rgb1="0.75 0.82 0.9" rgb2="0.35 0.4 0.5"
+             width="64" height="64"/>
+  </asset>
   <worldbody>
     <light pos="0.3 -0.4 0.6" dir="-0.3 0.4 -0.6" directional="true"/>
-    <camera name="side" pos="0.45 0 {z0 + 0.05}" xyaxes="0 1 0 -0.1 0 1" fovy="50"/>
+    <camera name="side" pos="0.36 0 {z0 + 0.07}" xyaxes="0 1 0 -0.15 0 1" fovy="45"/>
     {table}
     <body name="object" pos="{ox} {oy} {z0 + oz}">
       <joint name="ox" type="slide" axis="1 0 0"/>

@@ -29,7 +29,13 @@ from .._closed_loop import ClosedLoopRun, _schedule, estimator_params
 from .._plant import Disturbance, PlantConfig
 from .gripper import SceneSpec, build_scene, pad_wrenches, spin_coefficient
 
-__all__ = ["SCENE_STATUS", "MujocoRun", "disturbance_wrench", "run_mujoco_loop"]
+__all__ = [
+    "SCENE_STATUS",
+    "MujocoRun",
+    "cone_slip_force",
+    "disturbance_wrench",
+    "run_mujoco_loop",
+]
 
 #: Scene status codes of a MuJoCo run, by name.
 SCENE_STATUS = {
@@ -84,6 +90,31 @@ def disturbance_wrench(
         fy += qy
         tau += a * d.torque + px * qy - py * qx
     return fx, fy, tau
+
+
+def cone_slip_force(params: ContactParams, f_t: float, tau: float) -> float:
+    """The normal force [N] below which MuJoCo's contact slips under the load (f_t [N], tau
+    [N m]): the root of (f_t / (mu f))^2 + (tau / (mu_spin(f) f))^2 = 1 with the torsional
+    coefficient mu_spin(f) = mu xi rho(f) the scene sets (bisection on log f)."""
+    f_t, tau = abs(float(f_t)), abs(float(tau))
+    if f_t == 0.0 and tau == 0.0:
+        return 0.0
+
+    def load(f: float) -> float:
+        return (f_t / (params.mu * f)) ** 2 + (tau / (spin_coefficient(params, f) * f)) ** 2
+
+    lo, hi = 1e-6, 1.0
+    while load(hi) > 1.0:
+        hi *= 2.0
+    for _ in range(200):
+        mid = math.sqrt(lo * hi)
+        if load(mid) > 1.0:
+            lo = mid
+        else:
+            hi = mid
+        if hi / lo < 1.0 + 1e-9:
+            break
+    return hi
 
 
 def _cone_command(command, fn, ft, mu, margin, release, T, s) -> float:
