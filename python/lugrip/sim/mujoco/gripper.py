@@ -28,29 +28,33 @@ import numpy as np
 
 from ..._params import ContactParams
 from ..._contact import LimitSurface
+from .pad import Pad, PadSpec, pad_body_xml, pair_xml
 
 __all__ = [
-    "PadSpec",
+    "PAD_DEFAULTS",
     "SceneSpec",
     "WristMove",
     "build_scene",
-    "pad_wrenches",
+    "pad_spec",
     "spin_coefficient",
 ]
 
-
-@dataclasses.dataclass
-class PadSpec:
-    """A compliant hemispherical fingertip pad on its finger."""
-
-    radius: float = 0.012  #: [m] sphere radius of the pad surface
-    mass: float = 0.01  #: [kg] pad mass between its springs and the contact
-    tangential_stiffness: float = 4000.0  #: [N/m] in-plane spring finger -> pad (y and z)
-    tangential_damping: float = 20.0  #: [N s/m]
-    twist_stiffness: float = 2.0  #: [N m/rad] spring about the grasp axis
-    twist_damping: float = 0.05  #: [N m s/rad]
-    twist_inertia: float = 2.0e-6  #: [kg m^2] about the grasp axis
-    solref: tuple[float, float] = (0.002, 1.0)  #: MuJoCo contact time constant [s], damping ratio
+#: The gripper's pads (lugrip.sim.mujoco.pad.PadSpec fields; the scenario's ``mujoco.pad``
+#: overrides them): 12 mm hemispheres on 4 N/mm in-plane and 2 N m/rad twist springs. Their
+#: damping is MuJoCo's implicit joint damping (``pad_damping``), not the pad's explicit one: a
+#: held object on the twist springs is a lightly damped oscillator that the explicit damping
+#: could not damp at a 1 ms step without making the pad unstable. The pad's 35 g (sensor
+#: flange included) put its twist mode at 1000 rad/s, inside the 1 ms step's stability limit
+#: for the explicit spring (with 10 g the held block spins off the pads).
+PAD_DEFAULTS = {
+    "radius": 0.012,
+    "mass": 0.035,
+    "k_slide": 4000.0,
+    "k_twist": 2.0,
+    "d_slide": 0.0,
+    "d_twist": 0.0,
+    "solref": (0.002, 1.0),
+}
 
 
 @dataclasses.dataclass
@@ -89,7 +93,10 @@ class SceneSpec:
     #: geometric centre relative to the grasp point, in-plane (horizontal, vertical) [m];
     #: None: at the CoG (uniform object)
     geom_center: tuple[float, float] | None = None
-    pad: PadSpec = dataclasses.field(default_factory=PadSpec)
+    #: PadSpec overrides of PAD_DEFAULTS (radius, mass, k_slide, k_twist, solref, ...)
+    pad: dict = dataclasses.field(default_factory=dict)
+    #: implicit damping of the pad springs: in-plane [N s/m], twist [N m s/rad]
+    pad_damping: tuple[float, float] = (20.0, 0.05)
     finger_mass: float = 0.05  #: [kg]
     finger_damping: float = 2.0  #: [N s/m] finger slide
     clearance: float = 0.001  #: [m] gap between each pad and the object at t = 0
@@ -104,8 +111,6 @@ class SceneSpec:
     cone: str = "elliptic"
     noslip_iterations: int = 10
     impratio: float = 10.0
-    #: the normal force [N] below which the torsional coefficient stops following rho(f_n)
-    spin_force_floor: float = 0.05
 
     def __post_init__(self):
         if self.shape not in ("box", "cylinder"):
@@ -119,8 +124,19 @@ class SceneSpec:
         if self.geom_center is not None:
             self.geom_center = _vec(self.geom_center, 2, "mujoco.geom_center")
         self.object_offset = _vec(self.object_offset, 3, "mujoco.object_offset")
-        if isinstance(self.pad, Mapping):
-            self.pad = _build(PadSpec, self.pad, "mujoco.pad")
+        if not isinstance(self.pad, Mapping):
+            raise ValueError("mujoco.pad: expected a mapping of pad settings")
+        self.pad = dict(self.pad)
+        bad = sorted(set(self.pad) - {f.name for f in dataclasses.fields(PadSpec)} | (
+            set(self.pad) & {"name", "mu", "delta", "gamma", "xi"}))
+        if bad:
+            raise ValueError(
+                f"mujoco.pad: unknown or fixed key(s) {', '.join(bad)} (mu and the contact "
+                "radius law come from the scenario's contact)"
+            )
+        self.pad_damping = _vec(self.pad_damping, 2, "mujoco.pad_damping")
+        if min(self.pad_damping) < 0.0:
+            raise ValueError("mujoco.pad_damping: must be >= 0")
         self.wrist = [_build(WristMove, w, f"mujoco.wrist[{i}]") for i, w in enumerate(self.wrist)]
         if self.cone not in ("elliptic", "pyramidal"):
             raise ValueError(f"mujoco.cone {self.cone!r}: expected elliptic or pyramidal")
@@ -164,7 +180,39 @@ def _xi(k: float) -> float:
 def spin_coefficient(params: ContactParams, f_n: float) -> float:
     """MuJoCo's torsional friction coefficient [m] at normal force f_n [N]: mu xi rho(f_n), so
     that its torsional capacity mu_spin f_n equals the patch's tau_max = mu xi rho f_n."""
-    return params.mu * _xi(float(params.k)) * params.delta * max(float(f_n), 0.0) ** params.gamma
+    f = max(float(f_n), 0.05)  # the pad's f_n_floor
+    return params.mu * _xi(float(params.k)) * params.delta * f**params.gamma
+
+
+def pad_spec(spec: SceneSpec, params: ContactParams, k: int) -> PadSpec:
+    """The PadSpec of pad k (0: at -x, 1: at +x): the gripper's pad with the object's mu and
+    the contact radius law of `params`."""
+    values = dict(PAD_DEFAULTS)
+    values.update(spec.pad)
+    if "solref" in values:
+        values["solref"] = tuple(float(v) for v in values["solref"])
+    return PadSpec(
+        name=f"pad{k}",
+        mu=float(params.mu),
+        delta=float(params.delta),
+        gamma=float(params.gamma),
+        xi=_xi(float(params.k)),
+        rgba=(0.2, 0.4, 0.8, 1.0),
+        **values,
+    )
+
+
+#: pad frames (columns x, y, z in world coordinates; z from the face into the finger)
+_PAD_FRAMES = (
+    np.array([[0.0, 0.0, -1.0], [1.0, 0.0, 0.0], [0.0, -1.0, 0.0]]),  # pad 0, facing +x
+    np.array([[0.0, 0.0, 1.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]]),  # pad 1, facing -x
+)
+
+
+def _quat(R: np.ndarray) -> np.ndarray:
+    q = np.zeros(4)
+    mujoco.mju_mat2Quat(q, np.ascontiguousarray(R).reshape(-1))
+    return q
 
 
 def _object_geom(spec: SceneSpec, center: tuple[float, float], mu: float) -> str:
@@ -194,26 +242,28 @@ def build_scene(
     inertia: float,
     cog: tuple[float, float],
     grasp_height: float = 0.1,
-) -> mujoco.MjModel:
+) -> tuple[mujoco.MjModel, list[Pad]]:
     """The MJCF model of one grasp: the object's grasp point on the grasp axis at
     `grasp_height` [m] (its CoG at `cog` = (horizontal, vertical) [m] from it), the pads
     `clearance` off its faces, the table under it.
 
     Bodies: ``object`` (joints ox, oy, oz, otheta), ``hand`` (hy, hz, hroll: position servos),
-    ``finger0/1`` (f0, f1: force motors m0, m1), ``pad0/1`` (in-plane slides and a twist hinge
-    with springs). Contact pairs pad0/pad1 - object: condim 4, elliptic cone.
+    ``finger0/1`` (f0, f1: force motors m0, m1), ``pad0/1`` (pad0_x, pad0_y, pad0_twist: in-plane
+    slides and a twist hinge about the pad normal
+    with springs, lugrip.sim.mujoco.pad). Contact pairs pad0/pad1 - object: condim 4,
+    elliptic cone. Returns (model, [Pad 0, Pad 1]).
     """
-    p = spec.pad
+    pads_spec = [pad_spec(spec, params, k) for k in (0, 1)]
+    r = pads_spec[0].radius
     hw = spec.half_width
     cy, cz = cog
     center = spec.geom_center if spec.geom_center is not None else (cy, cz)
     ox, oy, oz = spec.object_offset
     z0 = grasp_height
     bottom = z0 + oz + _object_bottom(spec, center[1])
-    x_pad = hw + spec.clearance + p.radius  # finger body (pad centre) distance from the axis
-    travel = hw + spec.clearance - spec.min_half_gap  # until the pad surface meets the stop
+    x_face = hw + spec.clearance  # the pad faces' distance from the grasp axis at t = 0
+    travel = hw + spec.clearance - spec.min_half_gap  # until the pad face meets the stop
     i_obj = float(inertia)
-    spin = spin_coefficient(params, 1.0)
     table = ""
     if spec.table:
         table = (
@@ -223,28 +273,19 @@ def build_scene(
     pads = []
     for k, sign in ((0, -1.0), (1, 1.0)):
         # finger k's slide axis points inward (toward the object): +x for finger 0, -x for 1
+        q = " ".join(f"{v:.12g}" for v in _quat(_PAD_FRAMES[k]))
         pads.append(
             f"""
-      <body name="finger{k}" pos="{sign * x_pad} 0 0" gravcomp="1">
+      <body name="finger{k}" pos="{sign * x_face} 0 0" gravcomp="1">
         <joint name="f{k}" type="slide" axis="{-sign} 0 0" damping="{spec.finger_damping}"
                limited="true" range="-0.01 {travel}"/>
         <inertial pos="0 0 0" mass="{spec.finger_mass}" diaginertia="1e-5 1e-5 1e-5"/>
-        <geom type="box" pos="{sign * (p.radius + 0.006)} 0 0" size="0.005 0.012 0.02"
+        <geom type="box" pos="{sign * (2 * r + 0.005)} 0 0" size="0.005 0.012 0.02"
               contype="0" conaffinity="0" rgba="0.3 0.3 0.35 1"/>
-        <body name="pad{k}" gravcomp="1">
-          <joint name="p{k}y" type="slide" axis="0 1 0" stiffness="{p.tangential_stiffness}"
-                 damping="{p.tangential_damping}"/>
-          <joint name="p{k}z" type="slide" axis="0 0 1" stiffness="{p.tangential_stiffness}"
-                 damping="{p.tangential_damping}"/>
-          <joint name="p{k}t" type="hinge" axis="1 0 0" stiffness="{p.twist_stiffness}"
-                 damping="{p.twist_damping}"/>
-          <inertial pos="0 0 0" mass="{p.mass}"
-                    diaginertia="{p.twist_inertia} {p.twist_inertia} {p.twist_inertia}"/>
-          <geom name="pad{k}" type="sphere" size="{p.radius}" contype="0" conaffinity="0"
-                rgba="0.2 0.4 0.8 1"/>
-        </body>
+        {pad_body_xml(pads_spec[k], quat=[float(v) for v in q.split()])}
       </body>"""
         )
+    pairs = "".join(pair_xml(ps, ["object"]) for ps in pads_spec)
     xml = f"""
 <mujoco model="lugrip_gripper">
   <option timestep="{spec.timestep}" cone="{spec.cone}" noslip_iterations="{spec.noslip_iterations}"
@@ -276,17 +317,12 @@ def build_scene(
       <joint name="hz" type="slide" axis="0 0 1" damping="50"/>
       <joint name="hroll" type="hinge" axis="1 0 0" damping="2"/>
       <inertial pos="0 0 0" mass="2.0" diaginertia="1e-2 1e-2 1e-2"/>
-      <geom type="box" pos="0 0 0.06" size="{x_pad + 0.02} 0.015 0.01" contype="0"
+      <geom type="box" pos="0 0 0.06" size="{x_face + 2 * r + 0.02} 0.015 0.01" contype="0"
             conaffinity="0" rgba="0.3 0.3 0.35 1"/>
       {''.join(pads)}
     </body>
   </worldbody>
-  <contact>
-    <pair name="pair0" geom1="pad0" geom2="object" condim="4" friction="{params.mu} {params.mu} {spin} 0 0"
-          solref="{p.solref[0]} {p.solref[1]}"/>
-    <pair name="pair1" geom1="pad1" geom2="object" condim="4" friction="{params.mu} {params.mu} {spin} 0 0"
-          solref="{p.solref[0]} {p.solref[1]}"/>
-  </contact>
+  <contact>{pairs}</contact>
   <actuator>
     <motor name="m0" joint="f0" gear="1" ctrllimited="true" ctrlrange="0 {spec.force_range}"/>
     <motor name="m1" joint="f1" gear="1" ctrllimited="true" ctrlrange="0 {spec.force_range}"/>
@@ -296,31 +332,9 @@ def build_scene(
   </actuator>
 </mujoco>
 """
-    return mujoco.MjModel.from_xml_string(xml)
-
-
-def pad_wrenches(m: mujoco.MjModel, d: mujoco.MjData, pad_geoms, object_geom: int) -> np.ndarray:
-    """Per pad: (f_n, f_y, f_z, tau, n_contacts) of the wrench the object exerts on the pad:
-    f_n along the pad's inward normal (+x for pad 0, -x for pad 1), the in-plane force in world
-    y, z, and tau the torsional moment about the inward normal [N, N, N, N m, -]."""
-    out = np.zeros((2, 5))
-    f6 = np.zeros(6)
-    for i in range(d.ncon):
-        c = d.contact[i]
-        g1, g2 = c.geom1, c.geom2
-        for k in (0, 1):
-            pad = pad_geoms[k]
-            if not ((g1 == pad and g2 == object_geom) or (g2 == pad and g1 == object_geom)):
-                continue
-            mujoco.mj_contactForce(m, d, i, f6)
-            frame = np.asarray(c.frame).reshape(3, 3)  # rows: normal (geom1 -> geom2), tangents
-            f_on_2 = frame.T @ f6[:3]  # force geom1 exerts on geom2, world coordinates
-            t_on_2 = f6[3] * frame[0]
-            f_pad, t_pad = (f_on_2, t_on_2) if g2 == pad else (-f_on_2, -t_on_2)
-            inward = 1.0 if k == 0 else -1.0
-            out[k, 0] += -f_pad[0] * inward
-            out[k, 1] += f_pad[1]
-            out[k, 2] += f_pad[2]
-            out[k, 3] += t_pad[0] * inward
-            out[k, 4] += 1.0
-    return out
+    m = mujoco.MjModel.from_xml_string(xml)
+    # the pad springs' damping, implicit (see PAD_DEFAULTS)
+    for k in (0, 1):
+        for j, value in zip(pads_spec[k].joint_names, (spec.pad_damping[0],) * 2 + (spec.pad_damping[1],)):
+            m.dof_damping[m.joint(j).dofadr[0]] = value
+    return m, [Pad(m, ps) for ps in pads_spec]

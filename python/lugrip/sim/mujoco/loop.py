@@ -5,8 +5,10 @@ limit to the finger motors.
 
 :func:`run_mujoco_loop` returns a :class:`~lugrip.sim.ClosedLoopRun` with the columns of the
 patch and lumped plants' runs (so one set of metrics serves every plant) plus MuJoCo's own:
-``omega_true_i`` is the true slip rate of the object relative to pad i about its inward normal,
-``v_slip_i`` the true in-plane slip speed at pad i [m/s], ``contact_i`` the number of MuJoCo
+the sensor reads the pad's wrench in the pad frame of :mod:`lugrip.sim.mujoco.pad` (torque about
+the pad axis, from the face into the finger); ``omega_true_i`` is the true slip rate of the
+object relative to pad i about that axis [rad/s], ``v_slip_i`` the true in-plane slip speed at
+the pad face [m/s], ``contact_i`` the number of MuJoCo
 contacts of pad i, ``pad_deflection_i`` the pad's in-plane spring deflection [m],
 ``pad_twist_i`` its twist [rad], ``roll`` the hand's roll [rad].
 
@@ -27,7 +29,7 @@ from ..._observer import Observer
 from ..._params import ContactParams
 from .._closed_loop import ClosedLoopRun, _schedule, estimator_params
 from .._plant import Disturbance, PlantConfig
-from .gripper import SceneSpec, build_scene, pad_wrenches, spin_coefficient
+from .gripper import SceneSpec, build_scene, spin_coefficient
 
 __all__ = [
     "SCENE_STATUS",
@@ -164,7 +166,7 @@ def run_mujoco_loop(
     """
     contact = plant.contact
     est = estimator_params(contact, estimator) or contact
-    m = build_scene(
+    m, pads = build_scene(
         scene,
         params=contact,
         mass=plant.object.mass,
@@ -190,12 +192,13 @@ def run_mujoco_loop(
     noise = np.array([plant.sensor.force_noise] * 3 + [plant.sensor.torque_noise])
 
     body = {n: mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_BODY, n) for n in ("object", "pad0", "pad1")}
-    pad_geoms = [mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_GEOM, f"pad{k}") for k in (0, 1)]
     obj_geom = mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_GEOM, "object")
     q = {j: int(m.joint(j).qposadr[0]) for j in ("oy", "oz", "otheta", "hy", "hz", "hroll", "f0", "f1")}
     for k in (0, 1):
-        for a in ("y", "z", "t"):
-            q[f"p{k}{a}"] = int(m.joint(f"p{k}{a}").qposadr[0])
+        jx, jy, jt = pads[k].spec.joint_names
+        q[f"p{k}x"], q[f"p{k}y"], q[f"p{k}t"] = (int(m.joint(j).qposadr[0]) for j in (jx, jy, jt))
+    #: the pad's twist axis (its z) along world x: -1 for pad 0, +1 for pad 1
+    twist_sign = (-1.0, 1.0)
     f0_range = m.jnt_range[m.joint("f0").id].copy()
     travel = float(f0_range[1])
     cog = np.asarray(plant.object.cog, dtype=float)
@@ -233,7 +236,7 @@ def run_mujoco_loop(
         col(f"contact_{k}", np.int64)
 
     acc = np.zeros((2, 5))
-    v6, p6 = np.zeros(6), np.zeros(6)
+    slip_v = np.zeros((2, 3))
     started = False
     ctrl_start = None
     contact_time = None
@@ -241,7 +244,7 @@ def run_mujoco_loop(
     touched = [False, False]
     lost_count = [0, 0]
     dropped = False
-    last_fn = np.zeros(2)
+    last_fn = np.zeros(2)  # normal force of each pad at the last step [N]
     ev = 0
     cone_sum = np.zeros((2, 2))
     cone_n = 0
@@ -267,15 +270,18 @@ def run_mujoco_loop(
         f_act = min(max(target, f_act - step_max), f_act + step_max)
         f_act = min(max(f_act, 0.0), f_cap)
         d.ctrl[0] = d.ctrl[1] = f_act
-        # torsional coefficient from the present normal force of each pad
+        # torsional coefficient from the last normal force of each pad
         for k in (0, 1):
-            m.pair_friction[k, 2] = spin_coefficient(contact, max(last_fn[k], scene.spin_force_floor))
+            pads[k].update(m, d, f_n=last_fn[k])
         mujoco.mj_step(m, d)
-        w = pad_wrenches(m, d, pad_geoms, obj_geom)
-        last_fn = np.maximum(w[:, 0], 0.0)
-        acc += w
+        for k in (0, 1):
+            acc[k, :4] += pads[k].wrench(m, d)
+            acc[k, 4] += len(pads[k].contacts(d))
+            last_fn[k] = max(pads[k].f_n_last, 0.0)
         if (n + 1) % ratio:
             continue
+        for k in (0, 1):
+            slip_v[k] = np.nan_to_num(pads[k].slip_velocity(m, d))
         i = (n + 1) // ratio - 1
         ts = i * T_s
         true = acc / ratio  # the sensor's average over its sample period (anti-alias)
@@ -371,7 +377,7 @@ def run_mujoco_loop(
         cr, sr = math.cos(roll), math.sin(roll)
         rel = gp - pads_c
         rel_h = np.array([cr * rel[0] + sr * rel[1], -sr * rel[0] + cr * rel[1]])
-        twist = [float(d.qpos[q[f"p{k}t"]]) for k in (0, 1)]
+        twist = [twist_sign[k] * float(d.qpos[q[f"p{k}t"]]) for k in (0, 1)]  # about world x
         theta = float(d.qpos[q["otheta"]])
         rot = theta - roll - 0.5 * (twist[0] + twist[1])
         if ref is None:
@@ -387,8 +393,6 @@ def run_mujoco_loop(
                 or status == "lost_contact"
             )
 
-        mujoco.mj_objectVelocity(m, d, mujoco.mjtObj.mjOBJ_BODY, body["object"], v6, 0)
-        om_obj, v_obj = float(v6[0]), v6[4:6].copy()
         cols["t"][i] = ts
         cols["command"][i] = command
         lug = kind == "lugrip" and started and out is not None
@@ -411,8 +415,6 @@ def run_mujoco_loop(
         cols["dropped"][i] = int(dropped)
         for k in (0, 1):
             o = samples[k]
-            inward = 1.0 if k == 0 else -1.0
-            mujoco.mj_objectVelocity(m, d, mujoco.mjtObj.mjOBJ_BODY, body[f"pad{k}"], p6, 0)
             cols[f"f_n_meas_{k}"][i] = meas[k, 0]
             cols[f"f_t_meas_{k}"][i] = ft_meas[k]
             cols[f"tau_meas_{k}"][i] = meas[k, 3]
@@ -422,13 +424,11 @@ def run_mujoco_loop(
             cols[f"S_{k}"][i] = o.S
             cols[f"c_tilde_{k}"][i] = o.c_tilde
             cols[f"observer_status_{k}"][i] = int(o.status)
-            # the object's motion relative to pad k: spin about the inward normal, and the
-            # in-plane speed of the object point at the pad centre
-            cols[f"omega_true_{k}"][i] = inward * (om_obj - float(p6[0])) if touched[k] else 0.0
-            r = d.xpos[body[f"pad{k}"]][1:] - d.xpos[body["object"]][1:]
-            v_pt = v_obj + om_obj * np.array([-r[1], r[0]])
-            cols[f"v_slip_{k}"][i] = float(np.hypot(*(v_pt - p6[4:6]))) if touched[k] else 0.0
-            cols[f"pad_deflection_{k}"][i] = math.hypot(d.qpos[q[f"p{k}y"]], d.qpos[q[f"p{k}z"]])
+            # the object's motion relative to pad k at the pad face: spin about the pad's z
+            # (the sensor's torque axis) and the in-plane slip speed
+            cols[f"omega_true_{k}"][i] = slip_v[k, 2] if in_contact[k] else 0.0
+            cols[f"v_slip_{k}"][i] = math.hypot(slip_v[k, 0], slip_v[k, 1]) if in_contact[k] else 0.0
+            cols[f"pad_deflection_{k}"][i] = math.hypot(d.qpos[q[f"p{k}x"]], d.qpos[q[f"p{k}y"]])
             cols[f"pad_twist_{k}"][i] = twist[k]
             cols[f"contact_{k}"][i] = int(true[k, 4])
         row_ok = math.isfinite(command) and all(math.isfinite(cols[c][i]) for c in ("slip", "theta"))
