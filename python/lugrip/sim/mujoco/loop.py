@@ -293,7 +293,7 @@ def run_mujoco_loop(
 
         # scene faults (never raise: the run goes on, the status says what happened)
         if status == "ok":
-            at_stop = [abs(float(d.qpos[q[f"f{k}"]]) - travel) < 2e-4 for k in (0, 1)]
+            at_stop = [float(d.qpos[q[f"f{k}"]]) >= travel - 2e-4 for k in (0, 1)]
             if not all(touched) and any(at_stop[k] and not touched[k] for k in (0, 1)):
                 k = next(k for k in (0, 1) if at_stop[k] and not touched[k])
                 between = _object_between(m, d, (body["pad0"], body["pad1"]), obj_geom)
