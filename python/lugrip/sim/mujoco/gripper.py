@@ -209,6 +209,17 @@ _PAD_FRAMES = (
 )
 
 
+class _ScenePad(Pad):
+    """The shared Pad with its contact lookup vectorised over MuJoCo's contact array (the
+    per-contact loop was half the closed loop's time)."""
+
+    def contacts(self, data) -> list[int]:
+        n = data.ncon
+        if n == 0:
+            return []
+        return np.flatnonzero((data.contact.geom[:n] == self.geom_id).any(axis=1)).tolist()
+
+
 def _quat(R: np.ndarray) -> np.ndarray:
     q = np.zeros(4)
     mujoco.mju_mat2Quat(q, np.ascontiguousarray(R).reshape(-1))
@@ -337,4 +348,4 @@ def build_scene(
     for k in (0, 1):
         for j, value in zip(pads_spec[k].joint_names, (spec.pad_damping[0],) * 2 + (spec.pad_damping[1],)):
             m.dof_damping[m.joint(j).dofadr[0]] = value
-    return m, [Pad(m, ps) for ps in pads_spec]
+    return m, [_ScenePad(m, ps) for ps in pads_spec]

@@ -8,9 +8,9 @@ patch and lumped plants' runs (so one set of metrics serves every plant) plus Mu
 the sensor reads the pad's wrench in the pad frame of :mod:`lugrip.sim.mujoco.pad` (torque about
 the pad axis, from the face into the finger); ``omega_true_i`` is the true slip rate of the
 object relative to pad i about that axis [rad/s], ``v_slip_i`` the true in-plane slip speed at
-the pad face [m/s], ``contact_i`` the number of MuJoCo
-contacts of pad i, ``pad_deflection_i`` the pad's in-plane spring deflection [m],
-``pad_twist_i`` its twist [rad], ``roll`` the hand's roll [rad].
+the pad face [m/s], ``contact_i`` 1 while pad i touches the object, ``pad_deflection_i`` the
+pad's in-plane spring deflection [m], ``pad_twist_i`` its twist about world x [rad], ``roll``
+the hand's roll [rad].
 
 Scene faults never raise; they set ``ClosedLoopRun.scene`` (see :data:`SCENE_STATUS`).
 """
@@ -275,13 +275,15 @@ def run_mujoco_loop(
             pads[k].update(m, d, f_n=last_fn[k])
         mujoco.mj_step(m, d)
         for k in (0, 1):
-            acc[k, :4] += pads[k].wrench(m, d)
-            acc[k, 4] += len(pads[k].contacts(d))
+            w = pads[k].wrench(m, d)
+            acc[k, :4] += w
+            acc[k, 4] += w[0] > 0.0  # in contact
             last_fn[k] = max(pads[k].f_n_last, 0.0)
         if (n + 1) % ratio:
             continue
         for k in (0, 1):
-            slip_v[k] = np.nan_to_num(pads[k].slip_velocity(m, d))
+            v = pads[k].slip_velocity(m, d)
+            slip_v[k] = 0.0 if np.isnan(v[0]) else v
         i = (n + 1) // ratio - 1
         ts = i * T_s
         true = acc / ratio  # the sensor's average over its sample period (anti-alias)
@@ -430,7 +432,7 @@ def run_mujoco_loop(
             cols[f"v_slip_{k}"][i] = math.hypot(slip_v[k, 0], slip_v[k, 1]) if in_contact[k] else 0.0
             cols[f"pad_deflection_{k}"][i] = math.hypot(d.qpos[q[f"p{k}x"]], d.qpos[q[f"p{k}y"]])
             cols[f"pad_twist_{k}"][i] = twist[k]
-            cols[f"contact_{k}"][i] = int(true[k, 4])
+            cols[f"contact_{k}"][i] = int(in_contact[k])
         row_ok = math.isfinite(command) and all(math.isfinite(cols[c][i]) for c in ("slip", "theta"))
         row_ok = row_ok and bool(np.all(np.isfinite(meas)))
         row_ok = row_ok and all(math.isfinite(x.omega_hat) and math.isfinite(x.S) for x in samples)
