@@ -156,17 +156,21 @@ void ClosedLoopLog::append(const ClosedLoopSample& s) {
 // --- loop ------------------------------------------------------------------------------------
 
 namespace {
+SlipControlSettings slip_settings(const ClosedLoopConfig& c) {
+  SlipControlSettings s;
+  s.observer = c.observer;
+  s.controller = c.controller;
+  s.fingers = 2;
+  return s;
+}
 // The plant's contact model (tables shared by copy) or one built from the estimator parameters.
-Observer make_observer(const ClosedLoopConfig& c, const GraspPlant& plant) {
-  return c.estimator ? Observer(*c.estimator, c.observer) : Observer(plant.contact_model(), c.observer);
+SlipControl make_slip_control(const ClosedLoopConfig& c, const GraspPlant& plant) {
+  return c.estimator ? SlipControl(*c.estimator, slip_settings(c)) : SlipControl(plant.contact_model(), slip_settings(c));
 }
 }  // namespace
 
 ClosedLoop::ClosedLoop(const ClosedLoopConfig& config)
-    : cfg_(sorted(checked(config))),
-      plant_(cfg_.plant),
-      obs_{make_observer(cfg_, plant_), make_observer(cfg_, plant_)},
-      ctrl_(cfg_.estimator.value_or(cfg_.plant.contact), cfg_.controller) {
+    : cfg_(sorted(checked(config))), plant_(cfg_.plant), sc_(make_slip_control(cfg_, plant_)) {
   dt_ = 1.0 / cfg_.plant.sensor.rate;
   ratio_ = cfg_.controller.command_ratio;
   reset();
@@ -174,13 +178,12 @@ ClosedLoop::ClosedLoop(const ClosedLoopConfig& config)
 
 void ClosedLoop::reset() noexcept {
   plant_.reset();
-  for (auto& o : obs_) o.reset();
   command_ = plant_.state().f_cmd;
-  ctrl_.reset(command_);
-  cout_ = GraspControllerOutput();
-  cout_.force = command_;
-  cout_.static_force = command_;
-  for (auto& o : oout_) o = ObserverOutput();
+  sc_.reset(command_);
+  sout_ = SlipControlOutput();
+  sout_.force = command_;
+  sout_.controller.force = command_;
+  sout_.controller.static_force = command_;
   n_ = 0;
   next_event_ = 0;
   started_ = false;
@@ -194,10 +197,10 @@ void ClosedLoop::apply_events(double t) noexcept {
   while (next_event_ < cfg_.schedule.size() && cfg_.schedule[next_event_].time <= t + 0.5 * dt_) {
     if (cfg_.kind == ControllerKind::Lugrip) {
       switch (cfg_.schedule[next_event_].action) {
-        case ModeAction::Pivot: ctrl_.request_pivoting(); break;
-        case ModeAction::SlippingAvoidance: ctrl_.request_slipping_avoidance(); break;
-        case ModeAction::DynamicOn: ctrl_.set_dynamic_enabled(true); break;
-        case ModeAction::DynamicOff: ctrl_.set_dynamic_enabled(false); break;
+        case ModeAction::Pivot: sc_.request_pivoting(); break;
+        case ModeAction::SlippingAvoidance: sc_.request_slipping_avoidance(); break;
+        case ModeAction::DynamicOn: sc_.set_dynamic_enabled(true); break;
+        case ModeAction::DynamicOff: sc_.set_dynamic_enabled(false); break;
       }
     }
     ++next_event_;
@@ -231,26 +234,24 @@ void ClosedLoop::step(ClosedLoopSample& out) noexcept {
   const bool tick = n_ % ratio_ == 0;
   if (!started_ && tick && t >= cfg_.controller_start - 0.5 * dt_) {
     started_ = true;
-    if (cfg_.kind == ControllerKind::Lugrip) ctrl_.reset(command_);
+    if (cfg_.kind == ControllerKind::Lugrip) sc_.reset(command_);
     if (cfg_.kind == ControllerKind::FrictionCone) command_ = cfg_.controller.f_min;  // starts at the floor
   }
 
-  GraspControllerInput cin;
+  // The observers run on every sample; the controller only while the lugrip law is active.
+  SlipControlInput sin;
   for (int i = 0; i < 2; ++i) {
     const FingerSample& s = plant_.sensor_sample(i);
-    const ObserverInput in = ObserverInput::from_force_vector(s.f_n, s.f_x, s.f_y, s.tau);
-    obs_[i].step(in, oout_[i]);
-    const ObserverOutput& o = oout_[i];
-    FingerInput& f = cin.fingers[i];
-    f.omega_hat = o.omega_hat;
-    f.omega_resolution = o.omega_resolution;
-    f.slippage = o.S;
-    f.c_tilde = o.c_tilde;
-    f.f_t = in.f_t;
-    f.status = o.status;
-    f.present = true;
+    sin.fingers[i] = FingerWrench{s.f_n, s.f_x, s.f_y, s.tau};
+  }
+  const bool lugrip_active = started_ && cfg_.kind == ControllerKind::Lugrip;
+  if (lugrip_active) sc_.step(sin, sout_);
+  else sc_.observe(sin, sout_);
+  for (int i = 0; i < 2; ++i) {
+    const FingerSample& s = plant_.sensor_sample(i);
+    const ObserverOutput& o = sout_.fingers[i];
     out.f_n_meas[i] = s.f_n;
-    out.f_t_meas[i] = in.f_t;
+    out.f_t_meas[i] = planar_norm(s.f_x, s.f_y);
     out.tau_meas[i] = s.tau;
     out.f_t_true[i] = planar_norm(s.true_f_x, s.true_f_y);
     out.tau_true[i] = s.true_tau;
@@ -268,11 +269,10 @@ void ClosedLoop::step(ClosedLoopSample& out) noexcept {
   if (started_) {
     switch (cfg_.kind) {
       case ControllerKind::Lugrip:
-        ctrl_.step(cin, cout_);
-        command_ = cout_.force;
-        out.command_issued = cout_.command_issued;
-        out.pivot_finished = cout_.pivot_finished;
-        out.pivot_end = static_cast<int>(cout_.pivot_end);
+        command_ = sout_.force;
+        out.command_issued = sout_.controller.command_issued;
+        out.pivot_finished = sout_.controller.pivot_finished;
+        out.pivot_end = static_cast<int>(sout_.controller.pivot_end);
         break;
       case ControllerKind::ConstantForce:
         if (tick) {
@@ -300,9 +300,9 @@ void ClosedLoop::step(ClosedLoopSample& out) noexcept {
   out.t = t;
   out.command = command_;
   const bool lugrip = cfg_.kind == ControllerKind::Lugrip && started_;
-  out.static_force = lugrip ? cout_.static_force : command_;
-  out.dynamic_force = lugrip ? cout_.dynamic_force : 0.0;
-  out.mode = lugrip ? static_cast<int>(cout_.mode) : 0;
+  out.static_force = lugrip ? sout_.controller.static_force : command_;
+  out.dynamic_force = lugrip ? sout_.controller.dynamic_force : 0.0;
+  out.mode = lugrip ? static_cast<int>(sout_.controller.mode) : 0;
   out.f_n = st.f_n;
   out.slip_x = st.slip_x;
   out.slip_y = st.slip_y;

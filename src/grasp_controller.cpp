@@ -198,6 +198,13 @@ void GraspController::set_settings(const GraspControllerSettings& settings) {
   last_.force = command_;
 }
 
+void GraspController::set_mu(double mu) {
+  ContactParams p = table1_params();
+  p.mu = mu;
+  validate_or_throw(p);
+  mu_ = mu;
+}
+
 void GraspController::end_pivot(PivotEnd why, GraspControllerOutput& out) noexcept {
   mode_ = ControllerMode::SlippingAvoidance;
   init_static_ = true;  // PI integrator = last command - k_p e at the next command
@@ -207,7 +214,7 @@ void GraspController::end_pivot(PivotEnd why, GraspControllerOutput& out) noexce
   out.pivot_end = why;
 }
 
-void GraspController::step(const GraspControllerInput& in, GraspControllerOutput& out) noexcept {
+Status GraspController::step(const GraspControllerInput& in, GraspControllerOutput& out) noexcept {
   out.pivot_finished = false;
   out.pivot_end = PivotEnd::None;
   out.command_issued = false;
@@ -302,6 +309,7 @@ void GraspController::step(const GraspControllerInput& in, GraspControllerOutput
   out.held = last_.held;
   out.dynamic_peak = peak_;
   out.mode = mode_;
+  return out.status;
 }
 
 void GraspController::issue_command(bool valid, double slip) noexcept {

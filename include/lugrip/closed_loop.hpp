@@ -18,6 +18,7 @@
 #include "lugrip/grasp_controller.hpp"
 #include "lugrip/grasp_plant.hpp"
 #include "lugrip/observer.hpp"
+#include "lugrip/slip_control.hpp"
 
 namespace lugrip {
 
@@ -153,8 +154,9 @@ class ClosedLoop {
 
   const ClosedLoopConfig& config() const noexcept { return cfg_; }
   const GraspPlant& plant() const noexcept { return plant_; }
-  const GraspController& controller() const noexcept { return ctrl_; }
-  const Observer& observer(int finger) const noexcept { return obs_[finger & 1]; }
+  const GraspController& controller() const noexcept { return sc_.controller(); }
+  const Observer& observer(int finger) const noexcept { return sc_.observer(finger); }
+  const SlipControl& slip_control() const noexcept { return sc_; }
   double time() const noexcept { return plant_.time(); }
   double sample_period() const noexcept { return dt_; }
   int64_t samples() const noexcept { return n_; }
@@ -162,8 +164,7 @@ class ClosedLoop {
  private:
   ClosedLoopConfig cfg_;
   GraspPlant plant_;
-  std::array<Observer, 2> obs_;
-  GraspController ctrl_;
+  SlipControl sc_;
   double dt_ = 0.002;
   int ratio_ = 10;
   int64_t n_ = 0;
@@ -172,8 +173,7 @@ class ClosedLoop {
   bool started_ = false;        // the controller/baseline is active
   std::array<double, 2> cone_fn_sum_{}, cone_ft_sum_{};  // friction cone: sums this period
   int cone_count_ = 0;
-  GraspControllerOutput cout_;
-  std::array<ObserverOutput, 2> oout_;
+  SlipControlOutput sout_;
 
   void apply_events(double t) noexcept;
   void cone_command() noexcept;

@@ -194,7 +194,8 @@ class GraspController {
   GraspController(const ContactParams& params, const GraspControllerSettings& settings = {});
 
   //! One sensor sample. Never throws, never allocates; out.force is finite, in [f_min, f_max].
-  void step(const GraspControllerInput& in, GraspControllerOutput& out) noexcept;
+  //! Returns out.status.
+  Status step(const GraspControllerInput& in, GraspControllerOutput& out) noexcept;
 
   //! Back to slipping avoidance with zeroed filters; current_force [N] (clipped to the range,
   //! f_min if not finite) is the command held until the next step(), which issues a command
@@ -211,6 +212,9 @@ class GraspController {
   //! Replaces the settings marked (*) (rates, C_d and force range must not change); throws
   //! std::invalid_argument when invalid or when a fixed field differs.
   void set_settings(const GraspControllerSettings& settings);
+  //! Replaces the friction coefficient used by the pivoting floor; throws std::invalid_argument
+  //! unless 0 < mu <= 10 (ContactParams::mu).
+  void set_mu(double mu);
 
   ControllerMode mode() const noexcept { return mode_; }
   double command() const noexcept { return command_; }

@@ -44,6 +44,7 @@ from ._controller import (
     static_grasp_force,
     static_slippage,
 )
+from ._slip_control import SlipControl, SlipControlRun
 from .io import LogError, LogWarning, SlidingLog, read_log, write_log
 from .sliding import simulate_sliding
 
@@ -76,6 +77,8 @@ __all__ = [
     "controller_settings",
     "static_grasp_force",
     "static_slippage",
+    "SlipControl",
+    "SlipControlRun",
     "SlidingLog",
     "LogError",
     "LogWarning",

@@ -33,15 +33,10 @@ __all__ = [
 #: Codes of the ``requests`` array of :meth:`GraspController.run`.
 REQUEST_NONE, REQUEST_PIVOTING, REQUEST_SLIPPING_AVOIDANCE = 0, 1, 2
 
-_SETTINGS_FIELDS = (
-    "sensor_rate", "command_ratio", "k_cd", "p_cd", "z_cd", "dynamic_enabled", "s_ref", "k_p",
-    "k_i", "anti_windup", "gain_schedule_force", "static_equivalent_slippage",
-    "omega_deadband", "f_min", "f_max",
-    "max_rate_up", "max_rate_down", "invalid_raise_step", "s_pivot", "tau_pivot", "k_f", "pivot_floor_factor",
-    "pivot_end_c_tilde", "pivot_end_samples", "pivot_timeout",
-)
-_INT_FIELDS = ("command_ratio", "pivot_end_samples")
-_BOOL_FIELDS = ("dynamic_enabled", "anti_windup", "static_equivalent_slippage")
+# Names and kinds from the C++ field table (bindings/tables.hpp); the defaults stay in C++.
+_SETTINGS_FIELDS = tuple(name for name, _kind, _doc in _core.GraspControllerSettings.fields)
+_INT_FIELDS = tuple(name for name, kind, _doc in _core.GraspControllerSettings.fields if kind == "int")
+_BOOL_FIELDS = tuple(name for name, kind, _doc in _core.GraspControllerSettings.fields if kind == "bool")
 
 
 class ControllerMode(enum.IntEnum):

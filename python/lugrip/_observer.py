@@ -42,25 +42,12 @@ INTEGRATORS = {
     "rosenbrock": _core.Integrator.Rosenbrock,
 }
 GAIN_MODES = {"fixed": _core.GainMode.Fixed, "bandwidth": _core.GainMode.Bandwidth}
-_COR_FIELDS = ("f_n_min", "force_limit", "torque_limit", "zero_force", "zero_torque")
-_OBS_FIELDS = (
-    "dt",
-    "gain",
-    "bandwidth",
-    "gain_min",
-    "gain_max",
-    "g_floor",
-    "torque_cutoff",
-    "filter_force",
-    "cor_sign_sigmas",
-    "max_invalid",
-    "max_dt_gap",
-    "torque_noise",
-    "resolution_max",
-    "omega_limit",
-    "substeps",
-    "max_substeps",
-)
+# Settings names and kinds from the C++ field tables (bindings/tables.hpp); defaults stay in C++.
+_COR_FIELDS = tuple(name for name, _kind, _doc in _core.CorSettings.fields)
+_OBS_KINDS = {
+    name: kind for name, kind, _doc in _core.ObserverSettings.fields if kind in ("float", "int", "bool")
+}
+_OBS_FIELDS = tuple(_OBS_KINDS)
 
 
 def _enum(table: dict, name: str, value):
@@ -83,77 +70,46 @@ def _enum_name(table: dict, value) -> str:
 # --------------------------------------------------------------------------------------------
 
 
-@dataclasses.dataclass(frozen=True)
-class ObserverSample:
-    """Observer output for one sample (fields as the C++ ObserverOutput, SI units).
+_SAMPLE_DOC = """Observer output for one sample (the C++ ObserverOutput, SI units).
 
-    omega_hat [rad/s], z_hat [rad], S [-] (eq. 37, in [0, 1]), c_tilde [-], c [m], g [N m],
-    sigma_1 [N m s/rad], y [N m] (tau - c f_t, raw torque), tau_cor [N m] and ft_cor [N] (the
-    filtered wrench used for the CoR), gain [1/(kg m^2)] (l used), omega_resolution [rad/s]
-    (torque_noise / sigma_1), speed_observable, inside, saturated (|c~| clipped), projected
-    (z_hat clipped), diverged (re-initialised by the guard), substeps_capped, substeps,
-    cor_iterations, status (Status).
+    ``omega_hat`` is the slip about the clipped CoR, the quantity the grasp controller's C_d
+    filters; on translation-dominated slides (|c~| clipped) it exceeds the object's angular
+    velocity, which ``omega_object`` estimates: with a viscous stress uniform over the patch,
+    omega_object = omega_hat (a^2 + 1/2) / (a a_u + 1/2) and v_slip = |omega_object| a_u rho,
+    a = |c_tilde|, a_u = |c_tilde_unclipped| (both equal omega_hat and |omega_hat c| below the
+    clip).
     """
 
-    omega_hat: float
-    z_hat: float
-    S: float
-    c_tilde: float
-    c: float
-    g: float
-    sigma_1: float
-    y: float
-    tau_cor: float
-    ft_cor: float
-    gain: float
-    omega_resolution: float
-    speed_observable: bool
-    inside: bool
-    saturated: bool
-    projected: bool
-    diverged: bool
-    substeps_capped: bool
-    substeps: int
-    cor_iterations: int
-    status: Status
+_KIND_TYPES = {"float": float, "int": int, "bool": bool}
 
-    @classmethod
-    def _from_core(cls, o) -> ObserverSample:
-        values = {f.name: getattr(o, f.name) for f in dataclasses.fields(cls) if f.name != "status"}
-        return cls(status=Status(o.status.value), **values)
+#: (name, kind, doc) of every ObserverOutput field, from the C++ field table (bindings/tables.hpp).
+OUTPUT_FIELDS = tuple(_core.ObserverOutput.fields)
 
 
-@dataclasses.dataclass(frozen=True)
-class ObserverRun:
-    """Observer outputs over a log, one entry per sample (arrays of shape (n,)).
+def _field_list(fields) -> str:
+    return "\n".join(f"        {name}: {doc}" for name, _kind, doc in fields)
 
-    Same fields as :class:`ObserverSample` (``status`` is an int array of Status values), plus
-    ``t`` [s] when the log had times.
-    """
 
-    omega_hat: np.ndarray
-    z_hat: np.ndarray
-    S: np.ndarray
-    c_tilde: np.ndarray
-    c: np.ndarray
-    g: np.ndarray
-    sigma_1: np.ndarray
-    y: np.ndarray
-    tau_cor: np.ndarray
-    ft_cor: np.ndarray
-    gain: np.ndarray
-    omega_resolution: np.ndarray
-    speed_observable: np.ndarray
-    inside: np.ndarray
-    saturated: np.ndarray
-    projected: np.ndarray
-    diverged: np.ndarray
-    substeps_capped: np.ndarray
-    substeps: np.ndarray
-    cor_iterations: np.ndarray
-    status: np.ndarray
-    t: np.ndarray | None = None
+def _sample_from_core(cls, o):
+    values = {name: getattr(o, name) for name, _k, _d in OUTPUT_FIELDS if name != "status"}
+    return cls(status=Status(o.status.value), **values)
 
+
+ObserverSample = dataclasses.make_dataclass(
+    "ObserverSample",
+    [(name, Status if name == "status" else _KIND_TYPES[kind]) for name, kind, _d in OUTPUT_FIELDS],
+    frozen=True,
+    namespace={"_from_core": classmethod(_sample_from_core), "__module__": __name__},
+)
+ObserverSample.__doc__ = (
+    _SAMPLE_DOC.rstrip()
+    + "\n\n    Attributes (generated from the C++ ObserverOutput):\n"
+    + _field_list(OUTPUT_FIELDS)
+    + "\n    "
+)
+
+
+class _RunMethods:
     def __len__(self) -> int:
         return len(self.omega_hat)
 
@@ -183,6 +139,21 @@ class ObserverRun:
         if not np.any(sel):
             return float("nan")
         return float(np.sqrt(np.mean((self.omega_hat[sel] - omega[sel]) ** 2)))
+
+
+ObserverRun = dataclasses.make_dataclass(
+    "ObserverRun",
+    [(name, np.ndarray) for name, _k, _d in OUTPUT_FIELDS]
+    + [("t", "np.ndarray | None", dataclasses.field(default=None))],
+    bases=(_RunMethods,),
+    frozen=True,
+    namespace={"__module__": __name__},
+)
+ObserverRun.__doc__ = """Observer outputs over a log, one entry per sample (arrays of shape (n,)).
+
+    Same fields as :class:`ObserverSample` (``status`` is an int array of Status values), plus
+    ``t`` [s] when the log had times.
+    """
 
 
 def _column(log, name: str):
@@ -266,8 +237,8 @@ class Observer:
                 given["gain_mode"] = "bandwidth" if "bandwidth" in given else "fixed"
             given = {k: v for k, v in {**block, **given}.items() if v is not None}
         s = _core.ObserverSettings()
-        s.dt = float(given.pop("dt", 0.002))
-        s.integrator = _enum(INTEGRATORS, "integrator", given.pop("integrator", "rosenbrock"))
+        if "integrator" in given:
+            s.integrator = _enum(INTEGRATORS, "integrator", given.pop("integrator"))
         gain, bandwidth = given.pop("gain", None), given.pop("bandwidth", None)
         gain_mode = given.pop("gain_mode", None)
         if gain_mode is None:
@@ -282,11 +253,12 @@ class Observer:
             if name in _COR_FIELDS:
                 setattr(cor, name, float(value))
             elif name in _OBS_FIELDS:
-                if name in ("max_invalid", "substeps", "max_substeps"):
+                kind = _OBS_KINDS[name]
+                if kind == "int":
                     if isinstance(value, bool) or int(value) != value:
                         raise ValueError(f"{name} = {value!r}: must be an integer")
                     value = int(value)
-                elif name == "filter_force":
+                elif kind == "bool":
                     value = bool(value)
                 else:
                     value = float(value)

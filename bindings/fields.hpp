@@ -1,0 +1,143 @@
+// Field tables: each bound struct is described once (name, member, short doc) in tables.hpp;
+// the helpers here turn a table into the nanobind attributes, the `fields` tuple Python builds
+// its views and conversions from, and the columns of the batch calls.
+#pragma once
+
+#include <nanobind/nanobind.h>
+#include <nanobind/stl/string.h>
+
+#include <array>
+#include <cstdint>
+#include <string>
+#include <tuple>
+#include <type_traits>
+#include <vector>
+
+#include "common.hpp"
+
+namespace lugrip_bind {
+
+template <class S, class T>
+struct Field {
+  const char* name;
+  T S::*member;
+  const char* doc;
+};
+
+template <class S, class T>
+constexpr Field<S, T> field(const char* name, T S::*member, const char* doc) {
+  return Field<S, T>{name, member, doc};
+}
+
+//! Specialised in tables.hpp: `static constexpr auto fields = std::make_tuple(field(...), ...);`
+template <class S>
+struct Table;
+
+template <class S, class Fn>
+void for_each_field(Fn&& fn) {
+  std::apply([&](const auto&... f) { (fn(f), ...); }, Table<S>::fields);
+}
+
+using Pair = std::array<double, 2>;
+
+//! Kind of a field for the Python side: float, int, bool, enum, pair (two floats) or struct.
+template <class T>
+constexpr const char* kind_name() {
+  if constexpr (std::is_same_v<T, bool>) return "bool";
+  else if constexpr (std::is_floating_point_v<T>) return "float";
+  else if constexpr (std::is_integral_v<T>) return "int";
+  else if constexpr (std::is_enum_v<T>) return "enum";
+  else if constexpr (std::is_same_v<T, Pair>) return "pair";
+  else return "struct";
+}
+
+template <class S, class T>
+constexpr const char* kind_of(const Field<S, T>&) {
+  return kind_name<T>();
+}
+
+//! ((name, kind, doc), ...) of a table.
+template <class S>
+nb::tuple field_tuple() {
+  nb::list out;
+  for_each_field<S>([&](const auto& f) { out.append(nb::make_tuple(f.name, kind_of(f), f.doc)); });
+  return nb::tuple(out);
+}
+
+//! Read-only attributes of every field, plus `fields` on the class.
+template <class S, class... Opts>
+void def_fields_ro(nb::class_<S, Opts...>& cls) {
+  for_each_field<S>([&](const auto& f) {
+    using T = std::decay_t<decltype(std::declval<S>().*(f.member))>;
+    if constexpr (std::is_same_v<T, Pair>) {
+      auto m = f.member;
+      cls.def_prop_ro(f.name, [m](const S& s) { return nb::make_tuple((s.*m)[0], (s.*m)[1]); }, f.doc);
+    } else {
+      cls.def_ro(f.name, f.member, f.doc);
+    }
+  });
+  cls.attr("fields") = field_tuple<S>();
+}
+
+//! Read-write attributes of every field, plus `fields` on the class.
+template <class S, class... Opts>
+void def_fields_rw(nb::class_<S, Opts...>& cls) {
+  for_each_field<S>([&](const auto& f) { cls.def_rw(f.name, f.member, f.doc); });
+  cls.attr("fields") = field_tuple<S>();
+}
+
+//! One numpy array per scalar field of S (two for a pair, none for a nested struct), named
+//! <field><suffix> (a pair: <field>_0<suffix>, <field>_1<suffix>). set() only writes into the
+//! arrays, so it runs with the GIL released.
+template <class S>
+class Columns {
+ public:
+  explicit Columns(size_t n, const std::string& suffix = "") {
+    for_each_field<S>([&](const auto& f) {
+      using T = std::decay_t<decltype(std::declval<S>().*(f.member))>;
+      const std::string name = f.name;
+      if constexpr (std::is_same_v<T, bool>) add(name + suffix, new_array<bool>(n));
+      else if constexpr (std::is_floating_point_v<T>) add(name + suffix, new_array<double>(n));
+      else if constexpr (std::is_same_v<T, int64_t>) add(name + suffix, new_array<int64_t>(n));
+      else if constexpr (std::is_integral_v<T> || std::is_enum_v<T>) add(name + suffix, new_array<int32_t>(n));
+      else if constexpr (std::is_same_v<T, Pair>) {
+        add(name + "_0" + suffix, new_array<double>(n));
+        add(name + "_1" + suffix, new_array<double>(n));
+      }
+    });
+  }
+
+  void set(size_t i, const S& s) noexcept {
+    size_t j = 0;
+    for_each_field<S>([&](const auto& f) {
+      using T = std::decay_t<decltype(std::declval<S>().*(f.member))>;
+      const T& v = s.*(f.member);
+      if constexpr (std::is_same_v<T, bool>) static_cast<bool*>(ptr_[j++])[i] = v;
+      else if constexpr (std::is_floating_point_v<T>) static_cast<double*>(ptr_[j++])[i] = v;
+      else if constexpr (std::is_same_v<T, int64_t>) static_cast<int64_t*>(ptr_[j++])[i] = v;
+      else if constexpr (std::is_integral_v<T> || std::is_enum_v<T>)
+        static_cast<int32_t*>(ptr_[j++])[i] = static_cast<int32_t>(v);
+      else if constexpr (std::is_same_v<T, Pair>) {
+        static_cast<double*>(ptr_[j++])[i] = v[0];
+        static_cast<double*>(ptr_[j++])[i] = v[1];
+      }
+    });
+  }
+
+  void into(nb::dict& d) const {
+    for (size_t k = 0; k < names_.size(); ++k) d[names_[k].c_str()] = arrays_[k];
+  }
+
+ private:
+  template <class T>
+  void add(const std::string& name, Out1<T> a) {
+    ptr_.push_back(a.data());
+    arrays_.push_back(nb::cast(a));
+    names_.push_back(name);
+  }
+  std::vector<std::string> names_;
+  std::vector<nb::object> arrays_;
+  std::vector<void*> ptr_;
+};
+
+}  // namespace lugrip_bind

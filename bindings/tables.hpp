@@ -1,0 +1,378 @@
+// The one description of every struct the Python module exposes: field name, member and a
+// short doc with the unit. The nanobind attributes, the `fields` tuples (from which the Python
+// dataclasses, settings conversions and batch outputs are built) and the batch columns all
+// come from these tables, so a field added here appears everywhere at once.
+#pragma once
+
+#include <tuple>
+
+#include "fields.hpp"
+#include "lugrip/closed_loop.hpp"
+#include "lugrip/contact.hpp"
+#include "lugrip/grasp_controller.hpp"
+#include "lugrip/grasp_plant.hpp"
+#include "lugrip/identification.hpp"
+#include "lugrip/observer.hpp"
+#include "lugrip/params.hpp"
+#include "lugrip/slider_model.hpp"
+#include "lugrip/slip_control.hpp"
+
+namespace lugrip_bind {
+
+using namespace lugrip;
+
+// --- parameters and settings ----------------------------------------------------------------
+
+template <>
+struct Table<ContactParams> {
+  using S = ContactParams;
+  static constexpr auto fields = std::make_tuple(
+      field("mu", &S::mu, "Coulomb friction coefficient [-]"),
+      field("beta_a", &S::beta_a, "viscous friction per unit area and speed [N s/m^3]"),
+      field("sigma0", &S::sigma0, "bristle stiffness [N m/rad]"),
+      field("sigma_z", &S::sigma_z, "bristle damping [N m s/rad]"),
+      field("delta", &S::delta, "contact-radius law rho = delta f_n^gamma [m/N^gamma]"),
+      field("gamma", &S::gamma, "contact-radius exponent [-]"),
+      field("k", &S::k, "pressure exponent [-]"),
+      field("c_max", &S::c_max, "saturation of the normalized CoR |c~| [-]"));
+};
+
+template <>
+struct Table<CorSettings> {
+  using S = CorSettings;
+  static constexpr auto fields = std::make_tuple(
+      field("f_n_min", &S::f_n_min, "below this normal force: NoContact [N]"),
+      field("force_limit", &S::force_limit, "|f_n| or |f_t| above: InvalidSample [N]"),
+      field("torque_limit", &S::torque_limit, "|tau| above: InvalidSample [N m]"),
+      field("zero_force", &S::zero_force, "normalized f_t below this counts as zero [-]"),
+      field("zero_torque", &S::zero_torque, "normalized |tau| below this counts as zero [-]"));
+};
+
+template <>
+struct Table<SliderSettings> {
+  using S = SliderSettings;
+  static constexpr auto fields = std::make_tuple(
+      field("integrator", &S::integrator, "discretisation of the slider"),
+      field("max_substep", &S::max_substep, "longest internal step [s]"),
+      field("max_substeps", &S::max_substeps, "cap on substeps per step"),
+      field("g_floor", &S::g_floor, "lower bound on g [N m]"));
+};
+
+template <>
+struct Table<ObserverSettings> {
+  using S = ObserverSettings;
+  static constexpr auto fields = std::make_tuple(
+      field("dt", &S::dt, "nominal sample period [s]"),
+      field("integrator", &S::integrator, "discretisation (Integrator)"),
+      field("gain_mode", &S::gain_mode, "Fixed or Bandwidth (GainMode)"),
+      field("gain", &S::gain, "l in Fixed mode [1/(kg m^2)]"),
+      field("bandwidth", &S::bandwidth, "l sigma_1 in Bandwidth mode [1/s]"),
+      field("gain_min", &S::gain_min, "lower clip of l in Bandwidth mode [1/(kg m^2)]"),
+      field("gain_max", &S::gain_max, "upper clip of l in Bandwidth mode [1/(kg m^2)]"),
+      field("g_floor", &S::g_floor, "lower bound on g [N m]"),
+      field("torque_cutoff", &S::torque_cutoff, "low-pass of the CoR torque (0: off) [Hz]"),
+      field("filter_force", &S::filter_force, "also low-pass f_t for the CoR"),
+      field("cor_sign_sigmas", &S::cor_sign_sigmas, "CoR side hysteresis in noise standard deviations [-]"),
+      field("max_invalid", &S::max_invalid, "consecutive invalid samples before SensorFault"),
+      field("max_dt_gap", &S::max_dt_gap, "longer gaps re-initialise [s]"),
+      field("torque_noise", &S::torque_noise, "torque noise std of the sensor [N m]"),
+      field("resolution_max", &S::resolution_max, "speed_observable below this resolution [rad/s]"),
+      field("omega_limit", &S::omega_limit, "divergence guard on |omega_hat| [rad/s]"),
+      field("substeps", &S::substeps, "minimum substeps per sample"),
+      field("max_substeps", &S::max_substeps, "cap of adaptive substeps per sample"),
+      field("cor", &S::cor, "CoR estimator settings (CorSettings)"));
+};
+
+template <>
+struct Table<GraspControllerSettings> {
+  using S = GraspControllerSettings;
+  static constexpr auto fields = std::make_tuple(
+      field("sensor_rate", &S::sensor_rate, "rate of step() calls [Hz]"),
+      field("command_ratio", &S::command_ratio, "step() calls per force command"),
+      field("k_cd", &S::k_cd, "C_d high-frequency gain [N s/rad]"),
+      field("p_cd", &S::p_cd, "C_d pole [rad/s]"),
+      field("z_cd", &S::z_cd, "C_d zero [rad/s]"),
+      field("dynamic_enabled", &S::dynamic_enabled, "dynamic part active in slipping avoidance"),
+      field("s_ref", &S::s_ref, "reference of the slippage indicator [-]"),
+      field("k_p", &S::k_p, "proportional gain [N]"),
+      field("k_i", &S::k_i, "integral gain [N/s]"),
+      field("anti_windup", &S::anti_windup, "back-calculation anti-windup"),
+      field("gain_schedule_force", &S::gain_schedule_force, "gain scheduling force (0: off) [N]"),
+      field("static_equivalent_slippage", &S::static_equivalent_slippage,
+            "integrate the slippage of the static part alone"),
+      field("omega_deadband", &S::omega_deadband, "C_d dead band in speed resolutions [-]"),
+      field("f_min", &S::f_min, "minimum force [N]"),
+      field("f_max", &S::f_max, "maximum force [N]"),
+      field("max_rate_up", &S::max_rate_up, "command increase limit (inf: off) [N/s]"),
+      field("max_rate_down", &S::max_rate_down, "command decrease limit (inf: off) [N/s]"),
+      field("invalid_raise_step", &S::invalid_raise_step, "raise per command on invalid input [N]"),
+      field("s_pivot", &S::s_pivot, "pivoting slippage reference (> 1) [-]"),
+      field("tau_pivot", &S::tau_pivot, "pivoting filter time constant [s]"),
+      field("k_f", &S::k_f, "pivoting filter gain [N]"),
+      field("pivot_floor_factor", &S::pivot_floor_factor, "pivoting floor factor on f_t / mu [-]"),
+      field("pivot_end_c_tilde", &S::pivot_end_c_tilde, "pivoting ends above this mean |c~| [-]"),
+      field("pivot_end_samples", &S::pivot_end_samples, "consecutive samples above the threshold"),
+      field("pivot_timeout", &S::pivot_timeout, "pivoting timeout (inf: off) [s]"));
+};
+
+template <>
+struct Table<SlipControlSettings> {
+  using S = SlipControlSettings;
+  static constexpr auto fields = std::make_tuple(
+      field("observer", &S::observer, "settings of each finger's observer (ObserverSettings)"),
+      field("controller", &S::controller, "controller settings (GraspControllerSettings)"),
+      field("fingers", &S::fingers, "fingertips measured: 1 or 2"));
+};
+
+template <>
+struct Table<IdentificationSettings> {
+  using S = IdentificationSettings;
+  static constexpr auto fields = std::make_tuple(
+      field("observer", &S::observer, "observer inside the cost (ObserverSettings)"),
+      field("loss", &S::loss, "loss of the residuals (IdLoss)"),
+      field("huber_scale", &S::huber_scale, "Huber transition [rad/s]"),
+      field("threads", &S::threads, "worker threads (0: hardware)"),
+      field("sensitivity_limit", &S::sensitivity_limit, "bound of the sensitivity states"));
+};
+
+// --- per-sample outputs ---------------------------------------------------------------------
+
+template <>
+struct Table<CorOutput> {
+  using S = CorOutput;
+  static constexpr auto fields = std::make_tuple(
+      field("c_tilde", &S::c_tilde, "signed normalized CoR [-], |c~| <= c_max"),
+      field("c", &S::c, "signed CoR position [m]"),
+      field("ft_tilde", &S::ft_tilde, "f_t / (mu f_n) [-]"),
+      field("tau_tilde", &S::tau_tilde, "tau / tau_max [-]"),
+      field("sigma", &S::sigma, "eq. 14 ratio [-]"),
+      field("rho", &S::rho, "contact radius [m]"),
+      field("g", &S::g, "dry torque capacity about the CoR [N m]"),
+      field("sigma_1", &S::sigma_1, "viscous coefficient about the CoR [N m s/rad]"),
+      field("y", &S::y, "friction torque about the CoR [N m]"),
+      field("inside", &S::inside, "wrench strictly inside the limit surface"),
+      field("saturated", &S::saturated, "|c~| clipped at c_max"),
+      field("iterations", &S::iterations, "root-finding iterations"),
+      field("status", &S::status, "Status"),
+      field("c_tilde_unclipped", &S::c_tilde_unclipped, "normalized CoR before the clip [-]"));
+};
+
+template <>
+struct Table<SliderOutput> {
+  using S = SliderOutput;
+  static constexpr auto fields = std::make_tuple(
+      field("z", &S::z, "bristle state [rad]"),
+      field("omega", &S::omega, "angular velocity about the CoR [rad/s]"),
+      field("zdot", &S::zdot, "bristle rate [rad/s]"),
+      field("g", &S::g, "dry torque capacity [N m]"),
+      field("sigma_1", &S::sigma_1, "viscous coefficient [N m s/rad]"),
+      field("dry_torque", &S::dry_torque, "sigma0 z + sigma_z zdot [N m]"),
+      field("friction_torque", &S::friction_torque, "total friction torque [N m]"),
+      field("slip", &S::slip, "sigma0 |z| / g [-]"),
+      field("substeps", &S::substeps, "internal steps used"),
+      field("projected", &S::projected, "|z| clipped to g / sigma0"),
+      field("status", &S::status, "Status"));
+};
+
+template <>
+struct Table<ObserverOutput> {
+  using S = ObserverOutput;
+  static constexpr auto fields = std::make_tuple(
+      field("omega_hat", &S::omega_hat, "estimated slip velocity about the clipped CoR [rad/s]"),
+      field("z_hat", &S::z_hat, "estimated bristle state [rad]"),
+      field("S", &S::S, "slippage indicator sigma0 |z_hat| / g [-] (eq. 37)"),
+      field("c_tilde", &S::c_tilde, "normalized CoR [-]"),
+      field("c", &S::c, "CoR position [m]"),
+      field("g", &S::g, "dry torque capacity about the CoR [N m]"),
+      field("sigma_1", &S::sigma_1, "viscous coefficient about the CoR [N m s/rad]"),
+      field("y", &S::y, "measured friction torque about the CoR, tau - c f_t [N m]"),
+      field("tau_cor", &S::tau_cor, "filtered torque used for the CoR [N m]"),
+      field("ft_cor", &S::ft_cor, "tangential force used for the CoR [N]"),
+      field("gain", &S::gain, "observer gain l used [1/(kg m^2)]"),
+      field("omega_resolution", &S::omega_resolution, "speed resolution torque_noise / sigma_1 [rad/s]"),
+      field("speed_observable", &S::speed_observable, "omega_resolution <= resolution_max"),
+      field("inside", &S::inside, "CoR wrench strictly inside the limit surface"),
+      field("saturated", &S::saturated, "|c~| clipped at c_max"),
+      field("projected", &S::projected, "z_hat clipped to +-g/sigma0"),
+      field("cor_side_flipped", &S::cor_side_flipped, "the CoR changed side: state mirrored"),
+      field("diverged", &S::diverged, "re-initialised by the divergence guard"),
+      field("substeps_capped", &S::substeps_capped, "adaptive substeps hit max_substeps"),
+      field("substeps", &S::substeps, "integrator substeps on this sample"),
+      field("cor_iterations", &S::cor_iterations, "root-finding iterations of the CoR"),
+      field("status", &S::status, "Status"),
+      field("c_tilde_unclipped", &S::c_tilde_unclipped, "normalized CoR before the clip [-]"),
+      field("omega_object", &S::omega_object, "slip velocity about the unclipped CoR [rad/s]"),
+      field("v_slip", &S::v_slip, "slip speed of the patch centre [m/s]"));
+};
+
+template <>
+struct Table<GraspControllerOutput> {
+  using S = GraspControllerOutput;
+  static constexpr auto fields = std::make_tuple(
+      field("force", &S::force, "commanded grasp force [N]"),
+      field("static_force", &S::static_force, "static part f_ns at the last command [N]"),
+      field("dynamic_force", &S::dynamic_force, "dynamic part f_nd at the last command [N]"),
+      field("floor", &S::floor, "lower bound applied at the last command [N]"),
+      field("slippage", &S::slippage, "combined S = max_i S_i at the last command [-]"),
+      field("error", &S::error, "S - S_ref at the last command [-]"),
+      field("integrator", &S::integrator, "PI integrator [N]"),
+      field("dynamic_sample", &S::dynamic_sample, "signed C_d omega_hat per finger at this sample [N]"),
+      field("dynamic_peak", &S::dynamic_peak, "peak of max_i |C_d omega_hat_i| since the last command [N]"),
+      field("mean_c_tilde", &S::mean_c_tilde, "mean |c~_i| of the valid fingers [-]"),
+      field("pivot_time", &S::pivot_time, "time in the current pivoting manoeuvre [s]"),
+      field("mode", &S::mode, "ControllerMode after this call"),
+      field("pivot_end", &S::pivot_end, "PivotEnd, when pivoting ended in this call"),
+      field("pivot_finished", &S::pivot_finished, "pivoting ended in this call"),
+      field("command_issued", &S::command_issued, "a new command was computed in this call"),
+      field("saturated", &S::saturated, "last command clipped at a limit"),
+      field("rate_limited", &S::rate_limited, "last command rate limited"),
+      field("held", &S::held, "last command held because of invalid input"),
+      field("status", &S::status, "Ok or the worst finger status of this sample"));
+};
+
+template <>
+struct Table<SlipControlOutput> {
+  using S = SlipControlOutput;
+  static constexpr auto fields = std::make_tuple(
+      field("force", &S::force, "grasp-force command to send [N]"),
+      field("status", &S::status, "Ok or the worst status of this cycle (command held otherwise)"),
+      field("controller", &S::controller, "controller output (GraspControllerOutput)"));
+};
+
+// --- simulator ------------------------------------------------------------------------------
+
+template <>
+struct Table<ObjectConfig> {
+  using S = ObjectConfig;
+  static constexpr auto fields = std::make_tuple(
+      field("mass", &S::mass, "[kg]"), field("inertia", &S::inertia, "about the CoG [kg m^2]"),
+      field("cog_x", &S::cog_x, "CoG relative to the grasp point [m]"), field("cog_y", &S::cog_y, "[m]"),
+      field("theta0", &S::theta0, "initial angle [rad]"));
+};
+
+template <>
+struct Table<GripperMove> {
+  using S = GripperMove;
+  static constexpr auto fields = std::make_tuple(
+      field("t_start", &S::t_start, "[s]"), field("duration", &S::duration, "[s]"),
+      field("dx", &S::dx, "total displacement [m]"), field("dy", &S::dy, "[m]"));
+};
+
+template <>
+struct Table<Disturbance> {
+  using S = Disturbance;
+  static constexpr auto fields = std::make_tuple(
+      field("t_start", &S::t_start, "[s]"), field("duration", &S::duration, "[s]"),
+      field("shape", &S::shape, "PulseShape"), field("force_x", &S::force_x, "peak force [N]"),
+      field("force_y", &S::force_y, "[N]"), field("torque", &S::torque, "peak torque [N m]"),
+      field("point_x", &S::point_x, "application point relative to the CoG [m]"),
+      field("point_y", &S::point_y, "[m]"));
+};
+
+template <>
+struct Table<ActuatorConfig> {
+  using S = ActuatorConfig;
+  static constexpr auto fields = std::make_tuple(
+      field("f_init", &S::f_init, "force at t = 0 [N]"), field("f_max", &S::f_max, "saturation [N]"),
+      field("time_constant", &S::time_constant, "first-order lag [s]"),
+      field("rate_limit", &S::rate_limit, "|df/dt| limit [N/s]"),
+      field("command_rate", &S::command_rate, "command ZOH rate [Hz]"));
+};
+
+template <>
+struct Table<SensorConfig> {
+  using S = SensorConfig;
+  static constexpr auto fields = std::make_tuple(
+      field("rate", &S::rate, "sampling rate [Hz]"), field("force_noise", &S::force_noise, "[N]"),
+      field("torque_noise", &S::torque_noise, "[N m]"),
+      field("force_resolution", &S::force_resolution, "quantisation step [N]"),
+      field("torque_resolution", &S::torque_resolution, "quantisation step [N m]"),
+      field("filter_time_constant", &S::filter_time_constant, "low-pass before sampling [s]"));
+};
+
+template <>
+struct Table<PatchSettings> {
+  using S = PatchSettings;
+  static constexpr auto fields = std::make_tuple(
+      field("rings", &S::rings, "rings of cells"),
+      field("bristle_stiffness", &S::bristle_stiffness, "[1/m]"),
+      field("bristle_damping", &S::bristle_damping, "[s/m]"),
+      field("static_ratio", &S::static_ratio, "static / Coulomb friction [-]"),
+      field("stribeck_velocity", &S::stribeck_velocity, "[m/s]"));
+};
+
+template <>
+struct Table<DropConfig> {
+  using S = DropConfig;
+  static constexpr auto fields = std::make_tuple(
+      field("slip_limit", &S::slip_limit, "[m]"), field("rotation_limit", &S::rotation_limit, "[rad]"),
+      field("contact_force_min", &S::contact_force_min, "[N]"));
+};
+
+template <>
+struct Table<PlantConfig> {
+  using S = PlantConfig;
+  static constexpr auto fields = std::make_tuple(
+      field("contact", &S::contact, "ContactParams of both fingertips"), field("model", &S::model, "PlantModel"),
+      field("object", &S::object, "ObjectConfig"), field("actuator", &S::actuator, "ActuatorConfig"),
+      field("sensor", &S::sensor, "SensorConfig"), field("patch", &S::patch, "PatchSettings"),
+      field("drop", &S::drop, "DropConfig"), field("gravity", &S::gravity, "[m/s^2]"),
+      field("rate", &S::rate, "plant step rate [Hz]"), field("substeps", &S::substeps, "per plant step"),
+      field("support", &S::support, "a support under the object"), field("seed", &S::seed, "noise seed"));
+};
+
+template <>
+struct Table<FingerSample> {
+  using S = FingerSample;
+  static constexpr auto fields = std::make_tuple(
+      field("index", &S::index, "sample number"), field("t", &S::t, "[s]"), field("f_n", &S::f_n, "[N]"),
+      field("f_x", &S::f_x, "[N]"), field("f_y", &S::f_y, "[N]"), field("tau", &S::tau, "[N m]"),
+      field("true_f_n", &S::true_f_n, "[N]"), field("true_f_x", &S::true_f_x, "[N]"),
+      field("true_f_y", &S::true_f_y, "[N]"), field("true_tau", &S::true_tau, "[N m]"),
+      field("slip_x", &S::slip_x, "[m]"), field("slip_y", &S::slip_y, "[m]"),
+      field("slip_angle", &S::slip_angle, "[rad]"), field("slip_vx", &S::slip_vx, "[m/s]"),
+      field("slip_vy", &S::slip_vy, "[m/s]"), field("omega", &S::omega, "[rad/s]"),
+      field("c_tilde", &S::c_tilde, "[-]"), field("rho", &S::rho, "[m]"));
+};
+
+template <>
+struct Table<PlantState> {
+  using S = PlantState;
+  static constexpr auto fields = std::make_tuple(
+      field("t", &S::t, "[s]"), field("f_cmd", &S::f_cmd, "[N]"), field("f_held", &S::f_held, "[N]"),
+      field("f_n", &S::f_n, "[N]"), field("gripper_x", &S::gripper_x, "[m]"),
+      field("gripper_y", &S::gripper_y, "[m]"), field("gripper_vx", &S::gripper_vx, "[m/s]"),
+      field("gripper_vy", &S::gripper_vy, "[m/s]"), field("x", &S::x, "[m]"), field("y", &S::y, "[m]"),
+      field("vx", &S::vx, "[m/s]"), field("vy", &S::vy, "[m/s]"), field("theta", &S::theta, "[rad]"),
+      field("omega", &S::omega, "[rad/s]"), field("slip_x", &S::slip_x, "[m]"),
+      field("slip_y", &S::slip_y, "[m]"), field("slip_angle", &S::slip_angle, "[rad]"),
+      field("max_slip", &S::max_slip, "[m]"), field("max_rotation", &S::max_rotation, "[rad]"),
+      field("contact_fx", &S::contact_fx, "[N]"), field("contact_fy", &S::contact_fy, "[N]"),
+      field("contact_tau", &S::contact_tau, "[N m]"), field("ext_fx", &S::ext_fx, "[N]"),
+      field("ext_fy", &S::ext_fy, "[N]"), field("ext_tau", &S::ext_tau, "[N m]"),
+      field("supported", &S::supported, ""), field("dropped", &S::dropped, ""),
+      field("drop_time", &S::drop_time, "[s]"), field("drop_reason", &S::drop_reason, "bit mask"),
+      field("steps", &S::steps, "plant steps since reset"));
+};
+
+template <>
+struct Table<ModeEvent> {
+  using S = ModeEvent;
+  static constexpr auto fields =
+      std::make_tuple(field("time", &S::time, "[s]"), field("action", &S::action, "ModeAction"));
+};
+
+template <>
+struct Table<ClosedLoopConfig> {
+  using S = ClosedLoopConfig;
+  static constexpr auto fields = std::make_tuple(
+      field("plant", &S::plant, "PlantConfig"), field("observer", &S::observer, "ObserverSettings"),
+      field("estimator", &S::estimator, "ContactParams of the estimator side (None: the plant's)"),
+      field("controller", &S::controller, "GraspControllerSettings"),
+      field("kind", &S::kind, "ControllerKind"),
+      field("controller_start", &S::controller_start, "[s]"),
+      field("constant_force", &S::constant_force, "[N]"), field("cone_margin", &S::cone_margin, "[-]"),
+      field("cone_release_rate", &S::cone_release_rate, "[N/s]"));
+};
+
+}  // namespace lugrip_bind
