@@ -17,7 +17,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 import yaml
-from hypothesis import given, settings
+from hypothesis import assume, given, settings
 from hypothesis import strategies as st
 from lugrip.cli import main
 from lugrip.sim import GraspPlant, PlantConfig
@@ -182,8 +182,11 @@ def test_disturbance_pulses_equal_the_cpp_plants(shape, t, theta, fx, fy, tz, px
     t=st.floats(0.0, 2.5),
 )
 def test_trapezoid_expansion_is_the_trapezoid(t0, dur, edge_frac, amp, t):
-    """Consistency: the ramp + rectangle - ramp expansion equals the trapezoid at any time."""
+    """Consistency: the ramp + rectangle - ramp expansion equals the trapezoid at any time but
+    the pulse's end instant itself, where the rectangle's and the falling ramp's ends (computed
+    from different starts) can differ by one rounding."""
     edge = edge_frac * dur
+    assume(abs(t - (t0 + dur)) > 1e-9)
     items = sc.expand_disturbances(
         [{"t_start": t0, "duration": dur, "shape": "trapezoid", "edge": edge, "force": [amp, 0.0]}]
     )
