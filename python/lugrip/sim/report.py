@@ -525,10 +525,12 @@ def mujoco_markdown(data: dict[str, Any], base: Path) -> str:
     res = data["results"]
     n_pass = sum(r.passed for r in res.values())
     lines = [
-        f"**MuJoCo: {n_pass}/{len(res)} scenarios pass on the file's seed with today's "
-        "controller** (lugrip.SlipControl: each finger's observer and the GraspController, "
-        "with each scenario's own controller block). The table says which criterion fails; "
-        "the patch rows are judged by the file's own criteria for that plant.",
+        (
+            f"**MuJoCo: {n_pass}/{len(res)} scenarios pass on the file's seed with today's "
+            "controller** (lugrip.SlipControl: each finger's observer and the GraspController, "
+            "with each scenario's own controller block). The table says which criterion fails; "
+            "the patch rows are judged by the file's own criteria for that plant."
+        ),
         "",
         "Plant: MuJoCo " + _mujoco_version() + ", two force-controlled fingers with compliant "
         "12 mm spherical pads (4 N/mm in-plane and 2 N m/rad twist springs between finger and "

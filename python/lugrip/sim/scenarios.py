@@ -50,11 +50,13 @@ from ._plant import PlantConfig
 
 __all__ = [
     "CRITERIA",
+    "PLANT_MODELS",
     "Scenario",
     "ScenarioResult",
     "compute_metrics",
     "constant_force_search",
     "evaluate_cross",
+    "expand_disturbances",
     "find_scenario",
     "list_scenarios",
     "load_scenario",
@@ -62,8 +64,6 @@ __all__ = [
     "run_scenario",
     "scenario_dir",
     "simulate",
-    "expand_disturbances",
-    "PLANT_MODELS",
 ]
 
 #: Criteria a scenario may list, with their meaning (value compared with the YAML limit).

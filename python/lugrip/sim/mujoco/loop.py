@@ -184,16 +184,23 @@ def run_mujoco_loop(
     obs_kw.update(dict(observer_settings or {}))
     # the baselines command by their own law; SlipControl's observers still run for the log
     ctrl = SlipControl(est, fingers=2, observer=obs_kw, **ctrl_s)
-    limits = {k: getattr(ctrl.settings.controller, k) for k in
-              ("f_min", "f_max", "max_rate_up", "max_rate_down")}
+    limits = {
+        k: getattr(ctrl.settings.controller, k)
+        for k in ("f_min", "f_max", "max_rate_up", "max_rate_down")
+    }
     events = sorted(_schedule(mode_schedule), key=lambda e: e[0]) if kind == "lugrip" else []
     rng = np.random.default_rng(plant.seed)
     bias = np.asarray(plant.sensor.bias, dtype=float)  # per finger f_n, f_x, f_y, tau
     noise = np.array([plant.sensor.force_noise] * 3 + [plant.sensor.torque_noise])
 
-    body = {n: mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_BODY, n) for n in ("object", "pad0", "pad1")}
+    body = {
+        n: mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_BODY, n) for n in ("object", "pad0", "pad1")
+    }
     obj_geom = mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_GEOM, "object")
-    q = {j: int(m.joint(j).qposadr[0]) for j in ("oy", "oz", "otheta", "hy", "hz", "hroll", "f0", "f1")}
+    q = {
+        j: int(m.joint(j).qposadr[0])
+        for j in ("oy", "oz", "otheta", "hy", "hz", "hroll", "f0", "f1")
+    }
     for k in (0, 1):
         jx, jy, jt = pads[k].spec.joint_names
         q[f"p{k}x"], q[f"p{k}y"], q[f"p{k}t"] = (int(m.joint(j).qposadr[0]) for j in (jx, jy, jt))
@@ -218,18 +225,33 @@ def run_mujoco_loop(
         cols[name] = np.zeros(n_samples, dtype=dtype)
         return cols[name]
 
-    names_f = (
-        "t command static_force dynamic_force f_n slip_x slip_y slip rotation theta cog_x cog_y "
-        "gripper_y ext_fx ext_fy ext_tau roll"
-    ).split()
+    names_f = ["t", "command", "static_force", "dynamic_force", "f_n", "slip_x", "slip_y", "slip", "rotation", "theta", "cog_x", "cog_y", "gripper_y", "ext_fx", "ext_fy", "ext_tau", "roll"]
     for name in names_f:
         col(name)
-    for name in ("mode", "command_issued", "pivot_finished", "pivot_end", "supported", "dropped", "finite"):
+    for name in (
+        "mode",
+        "command_issued",
+        "pivot_finished",
+        "pivot_end",
+        "supported",
+        "dropped",
+        "finite",
+    ):
         col(name, np.int64)
     for k in (0, 1):
         for name in (
-            "f_n_meas", "f_t_meas", "tau_meas", "f_t_true", "tau_true", "omega_hat", "S",
-            "c_tilde", "omega_true", "v_slip", "pad_deflection", "pad_twist",
+            "f_n_meas",
+            "f_t_meas",
+            "tau_meas",
+            "f_t_true",
+            "tau_true",
+            "omega_hat",
+            "S",
+            "c_tilde",
+            "omega_true",
+            "v_slip",
+            "pad_deflection",
+            "pad_twist",
         ):
             col(f"{name}_{k}")
         col(f"observer_status_{k}", np.int64)
@@ -300,9 +322,8 @@ def run_mujoco_loop(
                 k = next(k for k in (0, 1) if at_stop[k] and not touched[k])
                 between = _object_between(m, d, (body["pad0"], body["pad1"]), obj_geom)
                 status = "closed_on_nothing" if between else "object_not_reached"
-                detail = (
-                    f"finger {k} closed to its stop without contact"
-                    + ("" if between else "; the object is not between the fingers")
+                detail = f"finger {k} closed to its stop without contact" + (
+                    "" if between else "; the object is not between the fingers"
                 )
                 status_time = ts
             elif not all(touched) and ts >= lift_start:
@@ -362,8 +383,14 @@ def run_mujoco_loop(
                 if tick:
                     mean = cone_sum / cone_n
                     command = _cone_command(
-                        command, mean[:, 0], mean[:, 1], est.mu, cone_margin,
-                        cone_release_rate, n_cmd * T_s, limits,
+                        command,
+                        mean[:, 0],
+                        mean[:, 1],
+                        est.mu,
+                        cone_margin,
+                        cone_release_rate,
+                        n_cmd * T_s,
+                        limits,
                     )
                     cone_sum[:] = 0.0
                     cone_n = 0
@@ -399,7 +426,9 @@ def run_mujoco_loop(
         lug = kind == "lugrip" and started and out is not None
         cols["static_force"][i] = out.controller.static_force if lug else command
         cols["dynamic_force"][i] = out.controller.dynamic_force if lug else 0.0
-        cols["mode"][i] = int(getattr(out.controller.mode, "value", out.controller.mode)) if lug else 0
+        cols["mode"][i] = (
+            int(getattr(out.controller.mode, "value", out.controller.mode)) if lug else 0
+        )
         cols["command_issued"][i] = issued
         cols["pivot_finished"][i] = pf
         cols["pivot_end"][i] = pend
@@ -431,11 +460,15 @@ def run_mujoco_loop(
             # the object's motion relative to pad k at the pad face: spin about the pad's z
             # (the sensor's torque axis) and the in-plane slip speed
             cols[f"omega_true_{k}"][i] = slip_v[k, 2] if in_contact[k] else 0.0
-            cols[f"v_slip_{k}"][i] = math.hypot(slip_v[k, 0], slip_v[k, 1]) if in_contact[k] else 0.0
+            cols[f"v_slip_{k}"][i] = (
+                math.hypot(slip_v[k, 0], slip_v[k, 1]) if in_contact[k] else 0.0
+            )
             cols[f"pad_deflection_{k}"][i] = math.hypot(d.qpos[q[f"p{k}x"]], d.qpos[q[f"p{k}y"]])
             cols[f"pad_twist_{k}"][i] = twist[k]
             cols[f"contact_{k}"][i] = int(in_contact[k])
-        row_ok = math.isfinite(command) and all(math.isfinite(cols[c][i]) for c in ("slip", "theta"))
+        row_ok = math.isfinite(command) and all(
+            math.isfinite(cols[c][i]) for c in ("slip", "theta")
+        )
         row_ok = row_ok and bool(np.all(np.isfinite(meas)))
         if samples is not None:
             row_ok = row_ok and all(
