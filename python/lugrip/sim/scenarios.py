@@ -478,9 +478,13 @@ def compute_metrics(
         # the held object with the hand
         i_hang = len(t) - 1
         if "roll" in run:
-            rolled = np.flatnonzero(np.abs(run["roll"]) > 1e-4)
-            if rolled.size:
-                i_hang = max(int(rolled[0]) - 1, 0)
+            rolls = [
+                float(w["t_start"])
+                for w in scenario.mujoco.get("wrist") or []
+                if float(w.get("roll_deg", 0.0)) != 0.0
+            ]
+            if rolls:
+                i_hang = max(run.index(min(rolls)) - 1, 0)
         m.update(
             pivot_start=p0,
             pivot_end=p1 if math.isfinite(p1) else None,
