@@ -288,9 +288,9 @@ TEST(LimitSurfaceProperties, AsymptoticConstants) {
   EXPECT_NEAR(surface(4.0).small_slope(), 1.0606601718, 1e-9);
   EXPECT_NEAR(surface(4.0).tail_force(), 0.114414, 1e-6);
   EXPECT_NEAR(surface(4.0).tail_torque(), 0.3601265, 1e-7);
-  // MODEL.md quotes tau~* ~ 1 - 0.834635 c~^2; s_k / (2 xi) = 1.0606601718 / 1.2708196272
-  // = 0.8346268, so the spec's sixth digit is off by 8e-6 (the slope and xi are right).
-  EXPECT_NEAR(surface(4.0).small_slope() / (2.0 * surface(4.0).xi()), 0.834635, 1e-5);
+  // tau~* ~ 1 - (s_k / (2 xi)) c~^2 with s_k / (2 xi) = 1.0606601718 / 1.2708196272 = 0.8346268
+  // (docs/model.md §3.2).
+  EXPECT_NEAR(surface(4.0).small_slope() / (2.0 * surface(4.0).xi()), 0.8346268, 1e-7);
   EXPECT_NEAR(surface(2.0).small_slope(), 3.0 * kPi / 8.0, 1e-14);
   EXPECT_DOUBLE_EQ(surface(kInf).small_slope(), 1.0);
   EXPECT_DOUBLE_EQ(surface(kInf).tail_force(), 0.125);
@@ -455,7 +455,7 @@ TEST(LimitSurfaceProperties, TorqueCapacityDerivativeIsF) {
 }
 
 TEST(LimitSurfaceProperties, CustomTableResolutionConverges) {
-  // A finer table is at least as accurate against the k = 4 spec table.
+  // A finer table is at least as accurate against the k = 4 table of docs/model.md §3.4.
   const LimitSurface fine(4.0, 1024);
   EXPECT_EQ(fine.intervals(), 1024);
   for (const SpecRow& r : kSpecTable) {

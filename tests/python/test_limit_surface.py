@@ -1,5 +1,5 @@
-"""lugrip.LimitSurface against the independent reference, the spec tables and closed forms;
-vectorization and shapes; parity and monotonicity."""
+"""lugrip.LimitSurface against the independent reference, the tables and closed forms of
+docs/model.md; vectorization and shapes; parity and monotonicity."""
 
 from __future__ import annotations
 

@@ -315,8 +315,9 @@ def test_slip_onset_follows_the_plant():
 
 
 def test_table1_rmse_below_the_paper():
-    """Table 1 parameters, true parameters, default settings, noise at the spec default: RMSE of
-    omega_hat over 60 maneuvers (rotation- to translation-dominated, 1-10 N) <= 0.0222 rad/s."""
+    """Table 1 parameters, true parameters, default settings, noise at the default of
+    docs/model.md §10.1: RMSE of omega_hat over 60 maneuvers (rotation- to translation-dominated,
+    1-10 N) <= 0.0222 rad/s."""
     ms = maneuvers(TABLE1, 60, seed=1)
     log = concat(ms)
     run = Observer(TABLE1).run(log)
