@@ -31,7 +31,7 @@ from pathlib import Path
 
 import lugrip
 import numpy as np
-from lugrip.identify import IdentificationWarning
+from lugrip.identification import IdentificationWarning
 from lugrip.sim import PatchContact
 from lugrip.sliding import simulate_sliding
 

@@ -47,8 +47,8 @@ from ._controller import (
 from .io import LogError, LogWarning, SlidingLog, read_log, write_log
 from .sliding import simulate_sliding
 
-# lugrip.identify is the function (the subpackage stays importable: from lugrip.identify import ...)
-from .identify import (
+# lugrip.identify is the function; its subpackage is lugrip.identification
+from .identification import (
     IdentificationError,
     IdentificationResult,
     RubbingEstimate,

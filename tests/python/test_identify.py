@@ -15,7 +15,7 @@ import lugrip
 import numpy as np
 import pytest
 from lugrip import ContactParams, IdentificationError
-from lugrip.identify import (
+from lugrip.identification import (
     PARAMETERS,
     IdentifiabilityWarning,
     IdentificationWarning,
@@ -247,7 +247,7 @@ def test_gaps_split_segments_and_are_never_integrated_across():
 
 def test_maneuver_weighting_makes_short_maneuvers_count():
     """weighting='maneuver': every maneuver carries the same total weight."""
-    from lugrip.identify._fit import _observer_settings, _Problem, load_maneuvers
+    from lugrip.identification._data import _observer_settings, _Problem, load_maneuvers
 
     log = simulate_sliding(TABLE1, 5, seed=2, hold=(0.05, 2.0))
     mans = load_maneuvers(log)

@@ -279,7 +279,7 @@ def write_report(result, out_dir: Path, *, title: str | None = None) -> list[Pat
 def run(args) -> int:
     import warnings
 
-    from ..identify import IdentificationError, estimate_rubbing, identify
+    from ..identification import IdentificationError, estimate_rubbing, identify
     from ..io import read_log
 
     for path in args.logs:

@@ -25,7 +25,7 @@ import numpy as np
 from .._contact import _as_params
 from .._params import ContactParams
 from ..io import SlidingLog
-from ._fit import IdentificationError
+from ._common import IdentificationError
 
 __all__ = ["RubbingEstimate", "estimate_rubbing"]
 

@@ -13,20 +13,18 @@ given). The parameters are identified FOR that observer: the result records its 
 ``lugrip observe --params`` runs with them.
 """
 
-from ._fit import (
+from .._params import read_observer_settings
+from ._common import (
     DEFAULT_BOUNDS,
     PARAMETERS,
     IdentifiabilityWarning,
     IdentificationError,
-    IdentificationResult,
     IdentificationWarning,
-    InitialGuess,
-    ParameterEstimate,
-    identify,
-    initial_guess,
-    load_maneuvers,
 )
-from .._params import read_observer_settings
+from ._data import load_maneuvers
+from ._driver import identify
+from ._guess import InitialGuess, initial_guess
+from ._result import IdentificationResult, ParameterEstimate
 from ._rubbing import RubbingEstimate, estimate_rubbing
 
 __all__ = [
