@@ -26,6 +26,8 @@ class _Maneuver:
     omega: np.ndarray
     t: np.ndarray
     starts: np.ndarray  # segment starts within the maneuver (first 0), plus its length
+    f_x: np.ndarray | None = None  # in-plane force components [N] when the log has them
+    f_y: np.ndarray | None = None
 
     @property
     def n(self) -> int:
@@ -124,6 +126,8 @@ def load_maneuvers(
                     omega=np.asarray(omega[idx], dtype=float),
                     t=log.t[idx],
                     starts=np.asarray(starts, dtype=np.int64),
+                    f_x=None if log.f_x is None else log.f_x[idx],
+                    f_y=None if log.f_y is None else log.f_y[idx],
                 )
             )
     if not out:
