@@ -1,4 +1,4 @@
-"""Offline identification of the contact parameters (paper Section 4, MODEL.md 8) and the
+"""Offline identification of the contact parameters (paper Section 4, docs/model.md §8) and the
 per-object "rubbing" estimate of mu and beta_A (paper Section 6).
 
     >>> import lugrip
@@ -26,6 +26,7 @@ from ._driver import identify
 from ._guess import InitialGuess, initial_guess
 from ._result import IdentificationResult, ParameterEstimate
 from ._rubbing import RubbingEstimate, estimate_rubbing
+from ._start import StageEstimate
 
 __all__ = [
     "DEFAULT_BOUNDS",
@@ -37,6 +38,7 @@ __all__ = [
     "InitialGuess",
     "ParameterEstimate",
     "RubbingEstimate",
+    "StageEstimate",
     "estimate_rubbing",
     "identify",
     "initial_guess",

@@ -120,3 +120,124 @@ def _refit(prob: _Problem, p_start: ContactParams, free_t, bnds, max_iterations,
         tolerance=max(tolerance, 1e-8),
     )
     return at(np.asarray(res.x))
+
+
+@dataclasses.dataclass
+class Minimum:
+    """Outcome of :func:`minimise`: the parameters, x = ln(p / p0) of the free ones, the
+    log-bounds, the optimiser's result, the cost trace, the prior's weight and fit time."""
+
+    params: ContactParams
+    x: np.ndarray
+    lo: np.ndarray
+    hi: np.ndarray
+    result: object
+    trace: list
+    iterations: int
+    fit_time: float
+    prior_weight: float
+    c0: float
+    precision: np.ndarray  # regularisation weight / s^2 per free log-parameter
+
+
+def minimise(
+    train: _Problem,
+    p0: ContactParams,
+    free_t: tuple,
+    bnds: dict,
+    *,
+    method: str,
+    max_iterations: int,
+    tolerance: float,
+    prior: dict | None = None,
+    prior_weight: float = 0.0,
+    progress=None,
+) -> Minimum:
+    """Minimise cost / cost(p0) + prior_weight * sum(((ln p - ln v) / s)^2) over the free
+    log-parameters; ``prior`` maps names to (v, s) (s: relative spread), missing names are
+    unregularised."""
+    import time
+    import warnings
+
+    from scipy.optimize import Bounds, minimize
+
+    idx = [PARAMETERS.index(n) for n in free_t]
+    scale = np.array([getattr(p0, n) for n in free_t])
+    lo = np.log(np.array([bnds[n][0] for n in free_t]) / scale)
+    hi = np.log(np.array([bnds[n][1] for n in free_t]) / scale)
+    prior = prior or {}
+    centre = np.array([math.log(prior[n][0] / getattr(p0, n)) if n in prior else 0.0
+                       for n in free_t])
+    prec = np.array([prior_weight / prior[n][1] ** 2 if n in prior else 0.0 for n in free_t])
+
+    def params_at(x) -> ContactParams:
+        vals = scale * np.exp(np.clip(x, lo, hi))
+        return p0.replace(**{n: float(v) for n, v in zip(free_t, vals)})
+
+    cache: dict[bytes, dict] = {}
+
+    def ev_at(x):
+        key = np.asarray(x, dtype=float).tobytes()
+        if key not in cache:
+            if len(cache) > 4:
+                cache.clear()
+            cache[key] = train.evaluate(params_at(x), True)
+        return cache[key]
+
+    c0 = float(ev_at(np.zeros(len(free_t)))["cost"])
+    if not (math.isfinite(c0) and c0 > 0.0):
+        from ._common import IdentificationError
+
+        raise IdentificationError(
+            f"the cost at the start point is {c0!r}: no scored samples? "
+            "(check that omega is finite where the sensor is in contact)"
+        )
+
+    def fun(x):
+        d = x - centre
+        return float(ev_at(x)["cost"]) / c0 + float(np.sum(prec * d * d))
+
+    def jac(x):
+        g = np.asarray(ev_at(x)["gradient"])[idx]
+        return g * (scale * np.exp(x)) / c0 + 2.0 * prec * (x - centre)
+
+    def hess(x):
+        H = np.asarray(ev_at(x)["gauss_newton"]).reshape(6, 6)[np.ix_(idx, idx)]
+        s = scale * np.exp(x)
+        return H * np.outer(s, s) / c0 + np.diag(2.0 * prec)
+
+    trace = [c0]
+    it = [0]
+    if progress is not None:
+        progress(0, c0, p0)
+
+    def callback(xk, *args):
+        it[0] += 1
+        c = float(ev_at(xk)["cost"])
+        trace.append(c)
+        if progress is not None:
+            progress(it[0], c, params_at(xk))
+
+    t_fit = time.perf_counter()
+    x0 = np.zeros(len(free_t))
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", RuntimeWarning)
+        if method == "gauss-newton":
+            res = _gauss_newton(lambda x: (fun(x), jac(x), hess(x)), x0, lo, hi,
+                                max_iterations=max_iterations, tolerance=tolerance,
+                                callback=callback)
+        elif method == "slsqp":
+            res = minimize(fun, x0, jac=jac, method="SLSQP", bounds=list(zip(lo, hi)),
+                           callback=callback,
+                           options={"maxiter": int(max_iterations), "ftol": float(tolerance)})
+        else:
+            res = minimize(fun, x0, jac=jac, hess=hess, method="trust-constr",
+                           bounds=Bounds(lo, hi), callback=lambda u, state: callback(u),
+                           options={"maxiter": int(max_iterations), "gtol": 1e-8, "xtol": 1e-10})
+    fit_time = time.perf_counter() - t_fit
+    x = np.clip(np.asarray(res.x, dtype=float), lo, hi)
+    if fun(x) > fun(x0):  # never return worse than the start
+        x = x0
+    return Minimum(params=params_at(x), x=x, lo=lo, hi=hi, result=res, trace=trace,
+                   iterations=int(getattr(res, "nit", it[0]) or it[0]), fit_time=fit_time,
+                   prior_weight=prior_weight, c0=c0, precision=prec)

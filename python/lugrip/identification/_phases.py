@@ -7,8 +7,9 @@ the friction first builds up (presliding, the bristles load) and then stops grow
 motion goes on (gross sliding). The build-up is measured against the slip angle
 s = integral |omega| dt since the run start: a load signal (the in-plane force along its
 direction in the run, or the torque, whichever stands further above the noise, per unit
-normal force) reaches 90 % of its plateau at s90, and the samples beyond 2 s90 count as gross
-sliding when the load no longer grows there. No speed threshold decides where sliding starts:
+normal force) rises from zero (or from the opposite load after a reversal: from its zero
+crossing) to 90 % of its plateau over a slip angle s_b, and the samples beyond twice that
+count as gross sliding when the load no longer grows there. No speed threshold decides where sliding starts:
 a robot that prescribes the motion moves from the first sample on, while the friction only
 reaches the limit surface after the presliding distance.
 """
@@ -86,7 +87,7 @@ def estimate_noise(mans: list[_Maneuver], phases: list[np.ndarray]) -> Noise:
         still = ph == STILL
         edge = np.flatnonzero(np.diff(still.astype(np.int8)) != 0) + 1
         bounds = np.concatenate([[0], edge, [still.size]])
-        seg_start = set(int(v) for v in m.starts[1:-1])
+        seg_start = {int(v) for v in m.starts[1:-1]}
         for a, b in zip(bounds[:-1], bounds[1:]):
             if not still[a] or b - a < _MIN_STILL:
                 continue
@@ -151,12 +152,18 @@ def find_phases(m: _Maneuver, noise: Noise) -> np.ndarray:
         if not s[-1] > 0:
             continue
         load = _load_signal(m, a, b, s, noise)
-        reached = np.flatnonzero(load >= _REACHED)
-        if reached.size == 0:
+        # the build-up starts at the lowest load of the first half (zero, or the opposite
+        # load after a reversal); its length is measured from the zero crossing to 90 %
+        first = np.flatnonzero(s <= 0.5 * s[-1])
+        j_min = int(first[np.argmin(load[first])]) if first.size else 0
+        up = np.flatnonzero(load[j_min:] >= 0.0)
+        reached = np.flatnonzero(load[j_min:] >= _REACHED)
+        if reached.size == 0 or up.size == 0:
             continue
-        s90 = s[reached[0]]
-        slide = s >= max(_SETTLE * s90, s[min(_SMOOTH, b - a - 1)])
-        if not slide.any() or _SETTLE * s90 > 0.75 * s[-1]:
+        s0, s90 = s[j_min + up[0]], s[j_min + reached[0]]
+        s_slide = s90 + (_SETTLE - 1.0) * (s90 - s0)
+        slide = s >= max(s_slide, s[min(_SMOOTH, b - a - 1)])
+        if not slide.any() or s_slide > 0.75 * s[-1]:
             continue
         part = load[slide]
         q = max(part.size // 4, 1)

@@ -6,6 +6,7 @@ import dataclasses
 import math
 import os
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 
@@ -49,7 +50,9 @@ class IdentificationResult:
     """Result of :func:`identify`.
 
     Attributes:
-        status: "converged", "max_iterations" or "failed"; success: status == "converged".
+        status: "converged", "stages" (no refinement asked), "max_iterations" or "failed"
+            (the optimiser failed, or a parameter ended at a bound); success: "converged" or
+            "stages".
         message: the optimiser's message.
         params: identified :class:`lugrip.ContactParams`; params0: the start point.
         estimates: per parameter (:class:`ParameterEstimate`), in :data:`PARAMETERS` order.
@@ -76,7 +79,12 @@ class IdentificationResult:
             the observer's CoR was clipped at c_max there (``score_saturated=False``).
         settings: loss, weighting, method, observer settings, ...
         validation_trace: arrays for the Figure-5 plot of the validation maneuvers (t, omega,
-            omega_hat, maneuver index) or None.
+            omega_hat, maneuver index, f_n, f_t, tau) or None.
+        stages: the staged estimate (:class:`lugrip.identification.StageEstimate`: phases,
+            noise, limit-surface and presliding fits, observability, per-stage report) or None
+            (params0 start).
+        warnings: warnings that look at the data and the fit (also issued as
+            :class:`IdentificationWarning`).
     """
 
     status: str
@@ -106,10 +114,17 @@ class IdentificationResult:
     settings: dict
     validation_trace: dict | None = None
     samples_saturated: int = 0
+    stages: Any = None
+    warnings: tuple[str, ...] = ()
 
     @property
     def success(self) -> bool:
-        return self.status == "converged"
+        return self.status in ("converged", "stages")
+
+    @property
+    def speed_observable(self) -> bool | None:
+        """Whether the stages found the sliding speed observable (None: no stages)."""
+        return None if self.stages is None else bool(self.stages.speed_observable)
 
     @property
     def observer(self) -> dict:
@@ -165,6 +180,12 @@ class IdentificationResult:
             ),
             self.table(),
         ]
+        if self.stages is not None:
+            out.append("stages:")
+            out.extend(f"  {line}" for line in self.stages.report)
+        if self.warnings:
+            out.append("warnings:")
+            out.extend(f"  - {w}" for w in self.warnings)
         if self.identifiability:
             out.append("identifiability:")
             out.extend(f"  - {s}" for s in self.identifiability)
@@ -197,7 +218,7 @@ class IdentificationResult:
                 },
                 "c_max": {"value": self.params.c_max, "unit": "-"},
             },
-            # the observer inside the cost: the parameters are identified FOR it (MODEL.md
+            # the observer inside the cost: the parameters are identified FOR it (docs/model.md
             # 8.1), so online use must run the same one (lugrip observe --params reads this)
             "observer": dict(self.observer),
             "identification": {
@@ -226,6 +247,8 @@ class IdentificationResult:
                     "matrix": np.round(self.correlation, 6).tolist(),
                 },
                 "identifiability": list(self.identifiability),
+                "warnings": list(self.warnings),
+                "stages": None if self.stages is None else _stage_dict(self.stages),
                 "truncated_gradient_samples": self.truncated,
                 "saturated_samples_unscored": self.samples_saturated,
                 "settings": self.settings,
@@ -243,7 +266,7 @@ class IdentificationResult:
         path = Path(path)
         path.parent.mkdir(parents=True, exist_ok=True)
         text = (
-            "# lugrip identification (paper Section 4, MODEL.md 8): contact parameters\n"
+            "# lugrip identification (paper Section 4, docs/model.md §8): contact parameters\n"
             "# value [unit], standard error, bounds; the observer they were identified with\n"
             "# (use it online: lugrip observe --params reads the observer block); fit summary\n"
             + yaml.safe_dump(_plain(self.to_dict()), sort_keys=False)
@@ -252,6 +275,32 @@ class IdentificationResult:
         tmp.write_text(text)
         os.replace(tmp, path)
         return path
+
+
+def _stage_dict(st) -> dict:
+    ls = st.ls
+    d = {
+        "report": list(st.report),
+        "samples": dict(st.counts),
+        "noise": {"torque": st.noise.torque, "force": st.noise.force,
+                  "samples": int(st.noise.samples)},
+        "speed_observable": bool(st.speed_observable),
+        "omega_resolution": st.omega_resolution,
+        "limit_surface": {
+            "mu": ls.mu, "delta": ls.delta, "gamma": ls.gamma,
+            "k": ls.k if math.isfinite(ls.k) else ".inf",
+            "beta_a": ls.beta_a, "viscous_t": ls.viscous_t,
+            "stderr": {k: v for k, v in ls.stderr.items()},
+            "points": len(ls.points), "at_bound": list(ls.at_bound),
+            "rms_distance": ls.residual_rms,
+        },
+    }
+    if st.presliding is not None:
+        pr = st.presliding
+        d["presliding"] = {"sigma0": pr.sigma0, "sigma_z": pr.sigma_z, "stderr": dict(pr.stderr),
+                           "runs": pr.runs, "samples": pr.samples,
+                           "rms_residual": pr.residual_rms}
+    return d
 
 
 def _plain(obj):
@@ -270,3 +319,84 @@ def _plain(obj):
     if isinstance(obj, np.bool_):
         return bool(obj)
     return obj
+
+
+def evaluate_split(train, val, train_m, val_m, p_hat):
+    """Final evaluation at p_hat: RMSE per maneuver and per split, the validation trace."""
+    ev = train.evaluate(p_hat, True, True)
+    if not math.isfinite(ev["cost"]):
+        from ._common import IdentificationError
+
+        raise IdentificationError("the cost at the identified point is not finite")
+    sse, cnt = train.per_maneuver(ev)
+    m_rmse = {m.key: float(math.sqrt(s / c)) if c else math.nan
+              for m, s, c in zip(train_m, sse, cnt)}
+    out = {
+        "sse": sse,
+        "n_train": int(cnt.sum()),
+        "rmse_train": float(math.sqrt(sse.sum() / max(cnt.sum(), 1))),
+        "rms_train": float(np.sqrt(np.nanmean(train.omega[np.isfinite(train.omega)] ** 2))),
+        "rmse_val": math.nan, "rms_val": math.nan, "trace": None, "n_val": 0,
+    }
+    if val is not None:
+        evv = val.evaluate(p_hat, False, True)
+        s_v, c_v = val.per_maneuver(evv)
+        m_rmse.update({m.key: float(math.sqrt(s / c)) if c else math.nan
+                       for m, s, c in zip(val_m, s_v, c_v)})
+        out["n_val"] = int(c_v.sum())
+        out["rmse_val"] = float(math.sqrt(s_v.sum() / max(out["n_val"], 1)))
+        fin = np.isfinite(val.omega)
+        out["rms_val"] = float(np.sqrt(np.mean(val.omega[fin] ** 2))) if fin.any() else math.nan
+        out["trace"] = {
+            "t": np.concatenate([m.t for m in val_m]),
+            "omega": val.omega,
+            "omega_hat": np.asarray(evv["omega_hat"]),
+            "maneuver": np.repeat(np.arange(len(val_m)), [m.n for m in val_m]),
+            "keys": [m.key for m in val_m],
+            "f_n": np.concatenate([m.f_n for m in val_m]),
+            "f_t": np.concatenate([m.f_t for m in val_m]),
+            "tau": np.concatenate([m.tau for m in val_m]),
+        }
+    out["maneuver_rmse"] = m_rmse
+    return ev, out
+
+
+def estimates_of(p_hat, p0, free_t, mn, bnds, stderr_log, guess_notes, fixed_notes, stage):
+    """Per-parameter estimates (standard errors from the refinement, or from the stages for
+    parameters the refinement did not move) and the at-bound notes."""
+    from .._params import _UNITS
+    from ._common import PARAMETERS
+
+    out, notes = [], []
+    for n in PARAMETERS:
+        v = getattr(p_hat, n)
+        if n in free_t:
+            i = free_t.index(n)
+            lo_n, hi_n = bnds[n]
+            x, lo, hi = mn.x, mn.lo, mn.hi
+            at = "lower" if x[i] <= lo[i] + 1e-6 else "upper" if x[i] >= hi[i] - 1e-6 else None
+            if at:
+                notes.append(f"{n} at its {at} bound ({v:.4g}): the data push it outside the "
+                             "physical range, or the bound is too tight (a failure)")
+            out.append(ParameterEstimate(n, _UNITS[n], v, getattr(p0, n), lo_n, hi_n, True, at,
+                                         float(v * stderr_log[i]), guess_notes.get(n, "")))
+        else:
+            se = math.nan
+            at = None
+            if stage is not None and n in fixed_notes and n != "beta_a":
+                se = stage_stderr(stage, n)
+            out.append(ParameterEstimate(n, _UNITS[n], v, getattr(p0, n), math.nan, math.nan,
+                                         False, at, se, fixed_notes.get(n, "fixed (params0)")))
+    if stage is not None:
+        for name in stage.ls.at_bound:
+            notes.append(f"limit-surface stage: {name} at the bound of its range (a failure)")
+            out = [dataclasses.replace(e, at_bound="stage") if e.name == name else e for e in out]
+    return out, notes
+
+
+def stage_stderr(stage, n: str) -> float:
+    if n in ("mu", "delta", "gamma", "beta_a"):
+        return float(stage.ls.stderr.get(n, math.nan))
+    if stage.presliding is not None and n in ("sigma0", "sigma_z"):
+        return float(stage.presliding.stderr.get(n, math.nan))
+    return math.nan

@@ -77,3 +77,42 @@ def _split(keys: Sequence[str], validation, seed) -> list[int]:
     if len(set(chosen)) >= m:
         raise ValueError("validation: leave at least one maneuver for training")
     return sorted(set(chosen))
+
+
+def check_options(*, loss, weighting, method, tolerance, uncertainty) -> float:
+    """Raise ValueError on a bad option; return the tolerance (method default when None)."""
+    if loss not in ("squared", "huber"):
+        raise ValueError(f"loss = {loss!r}: 'squared' or 'huber'")
+    if weighting not in ("maneuver", "sample"):
+        raise ValueError(f"weighting = {weighting!r}: 'maneuver' or 'sample'")
+    if method not in ("slsqp", "trust-constr", "gauss-newton"):
+        raise ValueError(f"method = {method!r}: 'gauss-newton', 'slsqp' or 'trust-constr'")
+    if uncertainty not in ("gauss-newton", "sandwich", "bootstrap"):
+        raise ValueError(
+            f"uncertainty = {uncertainty!r}: 'gauss-newton', 'sandwich' or 'bootstrap'"
+        )
+    if tolerance is None:
+        return 1e-8 if method == "gauss-newton" else 1e-10
+    return float(tolerance)
+
+
+def read_params0(params0, observer):
+    """(ContactParams or None, observer settings): a YAML params0 also supplies the observer
+    block (without its dt: the nominal sample period is the data's) unless one is given."""
+    import os
+    from pathlib import Path
+
+    from .._contact import _as_params
+    from .._params import ContactParams, read_observer_settings
+
+    if (
+        params0 is not None
+        and isinstance(params0, (str, os.PathLike))
+        and Path(params0).suffix in (".yaml", ".yml")
+    ):
+        if observer is None:
+            observer = read_observer_settings(params0)
+            if observer is not None:
+                observer.pop("dt", None)
+        params0 = ContactParams.from_yaml(params0)
+    return (None if params0 is None else _as_params(params0)), observer

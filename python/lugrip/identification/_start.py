@@ -1,0 +1,202 @@
+"""The staged estimate as a start point and prior for the eq. 32 refinement, with the
+decision whether the sliding speed is observable on the data (docs/model.md §8)."""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+
+import numpy as np
+
+from .._contact import sigma_1 as _sigma_1
+from .._params import ContactParams
+from ._common import DEFAULT_BOUNDS, IdentificationError
+from ._data import _Maneuver
+from ._phases import LOADING, SLIDING, STILL, Noise, estimate_noise, find_phases
+from ._stages import (
+    LimitSurfaceFit,
+    PreslidingFit,
+    fit_limit_surface,
+    fit_presliding,
+    sliding_points,
+)
+
+__all__ = ["StageEstimate", "staged_estimate"]
+
+VISCOUS_T = 3.0  # one-sided t statistic above which the viscous excess counts as measured
+RESOLUTION_MAX = 0.02  # [rad/s] the observer's default speed_observable threshold
+_REL_FLOOR = 0.02  # smallest relative prior spread of a stage value in the refinement [-]
+
+
+@dataclasses.dataclass(frozen=True)
+class StageEstimate:
+    """What the stages found.
+
+    Attributes:
+        params: the staged parameters (beta_A set by the observability rule when the speed is
+            not observable).
+        prior: {name: (value, relative spread)} for the refinement's regularisation.
+        fixed: {name: reason} parameters the refinement must not move.
+        noise: sensor noise from the still samples.
+        speed_observable: the viscous excess is significant and the resolution
+            torque_noise / sigma_1 is below ``resolution_max`` on most sliding samples.
+        omega_resolution: median torque_noise / sigma_1 over the gross-sliding samples [rad/s].
+        ls: stage (a)+(c) fit; presliding: stage (b) fit (None when no loading run was usable).
+        counts: samples per phase found (still, loading, sliding); maneuvers with sliding.
+        phases: per maneuver, the phase of every sample.
+        report: per-stage lines (which samples, what was found).
+    """
+
+    params: ContactParams
+    prior: dict
+    fixed: dict
+    noise: Noise
+    speed_observable: bool
+    omega_resolution: float
+    ls: LimitSurfaceFit
+    presliding: PreslidingFit | None
+    counts: dict
+    phases: list
+    report: tuple
+
+
+def _beta_unobservable(noise_torque: float, ls: LimitSurfaceFit, f_max: float, c_max: float,
+                       resolution_max: float) -> float:
+    """beta_A whose sigma_1 at the largest force and the CoR clip gives a speed resolution
+    of twice resolution_max: the observer then reports speed_observable = False everywhere
+    in the data's range."""
+    rho = ls.delta * f_max**ls.gamma
+    return noise_torque / (2.0 * resolution_max * math.pi * rho**4 * (c_max**2 + 0.5))
+
+
+def staged_estimate(
+    mans: list[_Maneuver],
+    *,
+    k: float | None,
+    c_max: float,
+    fix_gamma: float | None,
+    resolution_max: float = RESOLUTION_MAX,
+) -> StageEstimate:
+    """Run stages (a)-(c) and (b) on the maneuvers.
+
+    Raises:
+        IdentificationError: no gross sliding found, or sliding in fewer than three maneuvers
+            (the limit surface needs several CoRs and forces).
+    """
+    lines: list[str] = []
+    ph0 = [find_phases(m, Noise(math.nan, math.nan, 0)) for m in mans]
+    noise = estimate_noise(mans, ph0)
+    phases = [find_phases(m, noise) for m in mans]
+    allph = np.concatenate(phases)
+    counts = {
+        "still": int(np.count_nonzero(allph == STILL)),
+        "loading": int(np.count_nonzero(allph == LOADING)),
+        "sliding": int(np.count_nonzero(allph == SLIDING)),
+        "maneuvers_sliding": int(sum(bool(np.any(p == SLIDING)) for p in phases)),
+    }
+    lines.append(
+        f"phases (from the wrench and the motion): {counts['still']} still, "
+        f"{counts['loading']} loading (presliding), {counts['sliding']} gross-sliding samples; "
+        f"gross sliding in {counts['maneuvers_sliding']} of {len(mans)} maneuvers"
+    )
+    if math.isfinite(noise.torque):
+        lines.append(
+            f"noise (still samples, {noise.samples}): torque {noise.torque:.3g} N m, "
+            f"in-plane force {noise.force:.3g} N"
+        )
+    else:
+        lines.append("noise: no still stretch of >= 20 samples; the observer default is kept")
+    if counts["sliding"] == 0:
+        raise IdentificationError(
+            "no gross sliding found: in no run of motion did the friction stop growing "
+            "while the motion went on (all presliding or stick); mu and the limit surface "
+            "cannot be identified: rub further (beyond the presliding distance)"
+        )
+    if counts["maneuvers_sliding"] < 3:
+        raise IdentificationError(
+            f"gross sliding in only {counts['maneuvers_sliding']} maneuver(s): the limit "
+            "surface needs several CoRs and normal forces; record more maneuvers"
+        )
+    pts = sliding_points(mans, phases)
+    ls = fit_limit_surface(pts, gamma=fix_gamma, k=k, viscous=True)
+    kk = "inf" if math.isinf(ls.k) else f"{ls.k:.3g}"
+    lines.append(
+        f"(a) limit surface from {len(pts)} sliding points ({int(pts.samples.sum())} samples, "
+        f"{np.unique(pts.maneuver).size} maneuvers, |c~| {np.min(ls.c_abs):.2g}-"
+        f"{np.max(ls.c_abs):.2g}, f_n {pts.f_n.min():.3g}-{pts.f_n.max():.3g} N): "
+        f"mu {ls.mu:.4g} +- {ls.stderr['mu']:.2g}, delta {ls.delta:.4g} +- "
+        f"{ls.stderr['delta']:.2g}, gamma {ls.gamma:.4g}"
+        + ("" if fix_gamma is None else " (fixed)")
+        + f", k {kk}; RMS distance to the surface {ls.residual_rms:.3g} (normalised)"
+    )
+    # (c) viscous shear: significance and observability
+    significant = ls.kappa > 0 and math.isfinite(ls.viscous_t) and ls.viscous_t >= VISCOUS_T
+    tn = noise.torque if math.isfinite(noise.torque) else 1.0e-5
+    probe = ContactParams(mu=ls.mu, beta_a=max(ls.beta_a, 1.0), sigma0=1.0, sigma_z=0.01,
+                          delta=ls.delta, gamma=ls.gamma, k=ls.k, c_max=c_max)
+    c_pts = np.minimum(ls.c_abs, c_max)
+    res_pts = tn / np.maximum(np.asarray(_sigma_1(probe, pts.f_n, c_pts), float), 1e-300)
+    resolution = float(np.median(np.repeat(res_pts, pts.samples)))
+    observable = bool(significant and resolution <= resolution_max)
+    if observable:
+        beta = ls.beta_a
+        lines.append(
+            f"(c) viscous shear measured: beta_A {beta:.4g} +- {ls.stderr['beta_a']:.2g} "
+            f"N s/m^3 (t = {ls.viscous_t:.1f}); speed resolution torque_noise/sigma_1 "
+            f"{resolution:.3g} rad/s (median over the sliding samples): sliding speed observable"
+        )
+    else:
+        why = (
+            f"no significant speed dependence of the sliding wrench (t = {ls.viscous_t:.1f} "
+            f"< {VISCOUS_T:g})" if not significant else
+            f"the viscous part is too small against the torque noise (resolution "
+            f"{resolution:.3g} rad/s > {resolution_max:g})"
+        )
+        beta = _beta_unobservable(tn, ls, float(pts.f_n.max()) * 1.5, c_max, resolution_max)
+        if significant:
+            beta = min(beta, ls.beta_a)
+        lo_b = DEFAULT_BOUNDS["beta_a"][0]
+        beta = max(beta, 1.001 * lo_b)
+        lines.append(
+            f"(c) sliding speed not observable on these data: {why}; beta_A set to "
+            f"{beta:.3g} N s/m^3, which makes the observer report speed_observable = False"
+        )
+    p_ls = probe.replace(beta_a=beta)
+    pre = fit_presliding(mans, phases, p_ls)
+    prior: dict = {}
+    fixed: dict = {}
+    if pre is None:
+        sigma0, sigma_z = 1.0, 0.01
+        lines.append("(b) no usable loading run: sigma0 and sigma_z not identified (1, 0.01)")
+        fixed["sigma0"] = fixed["sigma_z"] = "no usable loading run"
+    else:
+        sigma0 = pre.sigma0
+        sz_sig = pre.stderr["sigma_z"] > 0 and pre.sigma_z >= 2.0 * pre.stderr["sigma_z"]
+        # without measurable micro-damping keep the observer's stick mode damped: sigma_z at
+        # the upper 2-sigma value of the fit, never below 1 % of sigma0 x 1 s
+        sigma_z = pre.sigma_z if sz_sig else max(pre.sigma_z + 2.0 * pre.stderr["sigma_z"],
+                                                 0.01 * sigma0)
+        lines.append(
+            f"(b) presliding from {pre.runs} loading runs ({pre.samples} samples): sigma0 "
+            f"{sigma0:.4g} +- {pre.stderr['sigma0']:.2g} N m/rad, sigma_z "
+            f"{pre.sigma_z:.3g} +- {pre.stderr['sigma_z']:.2g} N m s/rad"
+            + ("" if sz_sig else f" (not significant: set to {sigma_z:.3g})")
+            + f"; RMS residual {pre.residual_rms:.3g} of g"
+        )
+        prior["sigma0"] = (sigma0, max(pre.stderr["sigma0"] / sigma0, _REL_FLOOR))
+        prior["sigma_z"] = (sigma_z, max(pre.stderr["sigma_z"] / max(sigma_z, 1e-300), 0.5)
+                            if sz_sig else 1.0)
+    params = p_ls.replace(sigma0=sigma0, sigma_z=sigma_z)
+    prior["mu"] = (ls.mu, max(ls.stderr["mu"] / ls.mu, _REL_FLOOR))
+    prior["delta"] = (ls.delta, max(ls.stderr["delta"] / ls.delta, _REL_FLOOR))
+    if fix_gamma is None:
+        prior["gamma"] = (ls.gamma, max(ls.stderr["gamma"] / max(ls.gamma, 1e-6), _REL_FLOOR))
+    if observable:
+        prior["beta_a"] = (beta, max(ls.stderr["beta_a"] / beta, _REL_FLOOR))
+    else:
+        fixed["beta_a"] = "sliding speed not observable on these data"
+    return StageEstimate(
+        params=params, prior=prior, fixed=fixed, noise=noise, speed_observable=observable,
+        omega_resolution=resolution, ls=ls, presliding=pre, counts=counts, phases=phases,
+        report=tuple(lines),
+    )
