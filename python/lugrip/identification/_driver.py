@@ -165,17 +165,17 @@ def identify(
         if not (lo < v < hi):
             p0 = p0.replace(**{n: _clip(n, v, bnds)})
             notes.append(f"{n}: start {v:.4g} outside the bounds [{lo:.3g}, {hi:.3g}], moved inside")
-    if "delta" in free_list and ("mu" in free_list or "beta_a" in free_list) and not staged:
-        if rotation_only(mans, p0, slip_threshold):
-            msg = ("the data hold only rotations (estimated |c~| < 0.15 on 95 % of the sliding "
-                   "samples): mu and delta enter only as mu delta (tau_max) and beta_A only as "
-                   "beta_A delta^4, so delta is not separately identifiable")
-            if fix_unidentifiable:
-                free_list.remove("delta")
-                fixed_notes["delta"] = f"fixed at {p0.delta:.4g}: rotation-only data"
-                msg += f"; delta fixed at {p0.delta:.4g}"
-            warnings.warn(msg, IdentifiabilityWarning, stacklevel=2)
-            notes.append(msg)
+    if ("delta" in free_list and ("mu" in free_list or "beta_a" in free_list) and not staged
+            and rotation_only(mans, p0, slip_threshold)):
+        msg = ("the data hold only rotations (estimated |c~| < 0.15 on 95 % of the sliding "
+               "samples): mu and delta enter only as mu delta (tau_max) and beta_A only as "
+               "beta_A delta^4, so delta is not separately identifiable")
+        if fix_unidentifiable:
+            free_list.remove("delta")
+            fixed_notes["delta"] = f"fixed at {p0.delta:.4g}: rotation-only data"
+            msg += f"; delta fixed at {p0.delta:.4g}"
+        warnings.warn(msg, IdentifiabilityWarning, stacklevel=2)
+        notes.append(msg)
     free_t = tuple(n for n in PARAMETERS if n in free_list)
     if not free_t and refine:
         refine = False

@@ -138,9 +138,13 @@ def _load_signal(m: _Maneuver, a: int, b: int, s: np.ndarray, noise: Noise) -> n
     return q_t / p_t if p_t != 0 else np.zeros_like(q_t)
 
 
-def find_phases(m: _Maneuver, noise: Noise) -> np.ndarray:
+def find_phases(m: _Maneuver, noise: Noise, min_slip=None) -> np.ndarray:
     """Per sample of a maneuver: STILL (0), LOADING (1: moving, friction still building up)
-    or SLIDING (2: moving, the friction has stopped growing)."""
+    or SLIDING (2: moving, the friction has stopped growing).
+
+    ``min_slip(m, a, b)``, when given, is the slip angle [rad] a run [a, b) needs beyond the
+    start of its build-up before it can slide (e.g. 4.6 g / sigma0 once sigma0 is known: the
+    bristles within 1 % of their bound even where a viscous part dominates the load)."""
     ph = np.zeros(m.n, dtype=np.int8)
     for a, b in runs(m):
         ph[a:b] = LOADING
@@ -162,6 +166,10 @@ def find_phases(m: _Maneuver, noise: Noise) -> np.ndarray:
             continue
         s0, s90 = s[j_min + up[0]], s[j_min + reached[0]]
         s_slide = s90 + (_SETTLE - 1.0) * (s90 - s0)
+        if min_slip is not None:
+            req = min_slip(m, a, b)
+            if req is not None and math.isfinite(req):
+                s_slide = max(s_slide, s[j_min] + req)
         slide = s >= max(s_slide, s[min(_SMOOTH, b - a - 1)])
         if not slide.any() or s_slide > 0.75 * s[-1]:
             continue

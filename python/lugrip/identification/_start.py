@@ -119,50 +119,42 @@ def staged_estimate(
         )
     pts = sliding_points(mans, phases)
     ls = fit_limit_surface(pts, gamma=fix_gamma, k=k, viscous=True)
-    kk = "inf" if math.isinf(ls.k) else f"{ls.k:.3g}"
-    lines.append(
-        f"(a) limit surface from {len(pts)} sliding points ({int(pts.samples.sum())} samples, "
-        f"{np.unique(pts.maneuver).size} maneuvers, |c~| {np.min(ls.c_abs):.2g}-"
-        f"{np.max(ls.c_abs):.2g}, f_n {pts.f_n.min():.3g}-{pts.f_n.max():.3g} N): "
-        f"mu {ls.mu:.4g} +- {ls.stderr['mu']:.2g}, delta {ls.delta:.4g} +- "
-        f"{ls.stderr['delta']:.2g}, gamma {ls.gamma:.4g}"
-        + ("" if fix_gamma is None else " (fixed)")
-        + f", k {kk}; RMS distance to the surface {ls.residual_rms:.3g} (normalised)"
-    )
+    lines.append(_ls_line(ls, pts, fix_gamma))
     # (c) viscous shear: significance and observability
-    significant = ls.kappa > 0 and math.isfinite(ls.viscous_t) and ls.viscous_t >= VISCOUS_T
     tn = noise.torque if math.isfinite(noise.torque) else 1.0e-5
+    significant, resolution, observable, beta, line = _viscous(ls, pts, tn, c_max, resolution_max)
+    lines.append(line)
     probe = ContactParams(mu=ls.mu, beta_a=max(ls.beta_a, 1.0), sigma0=1.0, sigma_z=0.01,
                           delta=ls.delta, gamma=ls.gamma, k=ls.k, c_max=c_max)
-    c_pts = np.minimum(ls.c_abs, c_max)
-    res_pts = tn / np.maximum(np.asarray(_sigma_1(probe, pts.f_n, c_pts), float), 1e-300)
-    resolution = float(np.median(np.repeat(res_pts, pts.samples)))
-    observable = bool(significant and resolution <= resolution_max)
-    if observable:
-        beta = ls.beta_a
-        lines.append(
-            f"(c) viscous shear measured: beta_A {beta:.4g} +- {ls.stderr['beta_a']:.2g} "
-            f"N s/m^3 (t = {ls.viscous_t:.1f}); speed resolution torque_noise/sigma_1 "
-            f"{resolution:.3g} rad/s (median over the sliding samples): sliding speed observable"
-        )
-    else:
-        why = (
-            f"no significant speed dependence of the sliding wrench (t = {ls.viscous_t:.1f} "
-            f"< {VISCOUS_T:g})" if not significant else
-            f"the viscous part is too small against the torque noise (resolution "
-            f"{resolution:.3g} rad/s > {resolution_max:g})"
-        )
-        beta = _beta_unobservable(tn, ls, float(pts.f_n.max()) * 1.5, c_max, resolution_max)
-        if significant:
-            beta = min(beta, ls.beta_a)
-        lo_b = DEFAULT_BOUNDS["beta_a"][0]
-        beta = max(beta, 1.001 * lo_b)
-        lines.append(
-            f"(c) sliding speed not observable on these data: {why}; beta_A set to "
-            f"{beta:.3g} N s/m^3, which makes the observer report speed_observable = False"
-        )
     p_ls = probe.replace(beta_a=beta)
     pre = fit_presliding(mans, phases, p_ls)
+    if pre is not None:
+        # second pass: every run must have slipped far enough for the bristles to reach their
+        # bound (4.6 g / sigma0 from the start of its build-up), which the load alone cannot
+        # show where a viscous part dominates it; then stages (a), (c), (b) again
+        p_pre = p_ls.replace(sigma0=pre.sigma0, sigma_z=max(pre.sigma_z, 1e-6))
+        phases = [find_phases(m, noise, _min_slip(p_pre)) for m in mans]
+        n_before = counts["sliding"]
+        counts["sliding"] = int(sum(int(np.count_nonzero(p == SLIDING)) for p in phases))
+        counts["loading"] += n_before - counts["sliding"]
+        counts["maneuvers_sliding"] = int(sum(bool(np.any(p == SLIDING)) for p in phases))
+        lines.append(
+            f"phases, second pass (slip >= 4.6 g/sigma0 with sigma0 {pre.sigma0:.3g}): "
+            f"{counts['sliding']} gross-sliding samples in {counts['maneuvers_sliding']} maneuvers"
+        )
+        if counts["maneuvers_sliding"] < 3:
+            raise IdentificationError(
+                f"gross sliding in only {counts['maneuvers_sliding']} maneuver(s) once the "
+                "presliding distance is accounted for: rub further"
+            )
+        pts = sliding_points(mans, phases)
+        ls = fit_limit_surface(pts, gamma=fix_gamma, k=k, viscous=True)
+        lines.append(_ls_line(ls, pts, fix_gamma))
+        _, resolution, observable, beta, line = _viscous(ls, pts, tn, c_max, resolution_max)
+        lines.append(line)
+        probe = probe.replace(mu=ls.mu, delta=ls.delta, gamma=ls.gamma, k=ls.k)
+        p_ls = probe.replace(beta_a=beta)
+        pre = fit_presliding(mans, phases, p_ls)
     prior: dict = {}
     fixed: dict = {}
     if pre is None:
@@ -200,3 +192,64 @@ def staged_estimate(
         omega_resolution=resolution, ls=ls, presliding=pre, counts=counts, phases=phases,
         report=tuple(lines),
     )
+
+
+def _ls_line(ls: LimitSurfaceFit, pts, fix_gamma) -> str:
+    kk = "inf" if math.isinf(ls.k) else f"{ls.k:.3g}"
+    return (
+        f"(a) limit surface from {len(pts)} sliding points ({int(pts.samples.sum())} samples, "
+        f"{np.unique(pts.maneuver).size} maneuvers, |c~| {np.min(ls.c_abs):.2g}-"
+        f"{np.max(ls.c_abs):.2g}, f_n {pts.f_n.min():.3g}-{pts.f_n.max():.3g} N): "
+        f"mu {ls.mu:.4g} +- {ls.stderr['mu']:.2g}, delta {ls.delta:.4g} +- "
+        f"{ls.stderr['delta']:.2g}, gamma {ls.gamma:.4g}"
+        + ("" if fix_gamma is None else " (fixed)")
+        + f", k {kk}; RMS distance to the surface {ls.residual_rms:.3g} (normalised)"
+    )
+
+
+def _viscous(ls: LimitSurfaceFit, pts, tn: float, c_max: float, resolution_max: float):
+    """(significant, resolution, observable, beta_A, report line) of stage (c)."""
+    significant = ls.kappa > 0 and math.isfinite(ls.viscous_t) and ls.viscous_t >= VISCOUS_T
+    probe = ContactParams(mu=ls.mu, beta_a=max(ls.beta_a, 1.0), sigma0=1.0, sigma_z=0.01,
+                          delta=ls.delta, gamma=ls.gamma, k=ls.k, c_max=c_max)
+    c_pts = np.minimum(ls.c_abs, c_max)
+    res_pts = tn / np.maximum(np.asarray(_sigma_1(probe, pts.f_n, c_pts), float), 1e-300)
+    resolution = float(np.median(np.repeat(res_pts, pts.samples)))
+    observable = bool(significant and resolution <= resolution_max)
+    if observable:
+        beta = ls.beta_a
+        line = (
+            f"(c) viscous shear measured: beta_A {beta:.4g} +- {ls.stderr['beta_a']:.2g} "
+            f"N s/m^3 (t = {ls.viscous_t:.1f}); speed resolution torque_noise/sigma_1 "
+            f"{resolution:.3g} rad/s (median over the sliding samples): sliding speed observable"
+        )
+        return significant, resolution, observable, beta, line
+    why = (
+        f"no significant speed dependence of the sliding wrench (t = {ls.viscous_t:.1f} "
+        f"< {VISCOUS_T:g})" if not significant else
+        f"the viscous part is too small against the torque noise (resolution "
+        f"{resolution:.3g} rad/s > {resolution_max:g})"
+    )
+    beta = _beta_unobservable(tn, ls, float(pts.f_n.max()) * 1.5, c_max, resolution_max)
+    if significant:
+        beta = min(beta, ls.beta_a)
+    beta = max(beta, 1.001 * DEFAULT_BOUNDS["beta_a"][0])
+    line = (
+        f"(c) sliding speed not observable on these data: {why}; beta_A set to "
+        f"{beta:.3g} N s/m^3, which makes the observer report speed_observable = False"
+    )
+    return significant, resolution, observable, beta, line
+
+
+def _min_slip(p: ContactParams):
+    """Slip angle a run needs from the start of its build-up: 4.6 g / sigma0 at its plateau
+    wrench (the mean of its second half)."""
+    from .._contact import estimate_cor
+
+    def req(m, a, b):
+        h = a + (b - a) // 2
+        est = estimate_cor(p, np.array([np.mean(m.f_n[h:b])]), np.array([np.mean(m.f_t[h:b])]),
+                           np.array([np.mean(m.tau[h:b])]))
+        return 4.6 * float(np.asarray(est.g)[0]) / p.sigma0
+
+    return req
