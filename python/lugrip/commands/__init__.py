@@ -34,6 +34,7 @@ COMMANDS: list[str] = [
     "ls",
     "params",
     "simulate_sliding",
+    "simulate_rubbing",
     "observe",
     "identify",
     "simulate",

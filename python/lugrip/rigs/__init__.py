@@ -7,6 +7,8 @@ that a robot would rub against a fingertip, producing sliding logs with ground t
   :class:`RigTruth`);
 * :mod:`lugrip.rigs.grid`: a distributed grid-of-cells LuGre contact (Stribeck friction,
   Hertzian pressure, optional viscous shear);
+* :mod:`lugrip.rigs.model_rigs`: lugrip's lumped model and the simulator's pressure patch
+  under the same prescribed motion (for comparison);
 * :mod:`lugrip.rigs.mujoco_rig`: a MuJoCo pad rubbing a fixed slider (needs ``mujoco``).
 
 See docs/rigs.md.
@@ -14,13 +16,18 @@ See docs/rigs.md.
 
 from ._data import PHASES, RigTruth, RubbingData
 from .motion import ManeuverPlan, RubbingDesign, plan_maneuvers, stack_times
+from .grid import GridContactRig
+from .registry import PLANTS, make_rig
 
 __all__ = [
+    "GridContactRig",
     "PHASES",
+    "PLANTS",
     "ManeuverPlan",
     "RigTruth",
     "RubbingData",
     "RubbingDesign",
+    "make_rig",
     "plan_maneuvers",
     "stack_times",
 ]

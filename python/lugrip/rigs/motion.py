@@ -42,7 +42,12 @@ class RubbingDesign:
     Attributes:
         c_tilde_range: |CoR distance from the patch centre| / true contact radius, drawn
             log-uniform (rotation-dominated to translation-dominated) [-].
-        omega_range: peak |omega| of the pad, drawn log-uniform [rad/s].
+        omega_range: peak |omega| of the pad in pure rotation, drawn log-uniform [rad/s].
+        equal_patch_speed: when True (default) the peak |omega| of a maneuver about a CoR
+            at c~ is the drawn value divided by sqrt(1 + 2 c~^2), so that the RMS sliding
+            speed over the patch, omega rho sqrt(c~^2 + 1/2), does not depend on the CoR
+            (a robot rubbing at similar speeds in every direction; translation-dominated
+            rubs turn slowly); when False the drawn value is used for every CoR.
         v_max: cap on the patch-centre speed |omega| |c| at the peak [m/s]; the peak
             |omega| of a maneuver is lowered to respect it.
         f_n_range: nominal normal force, drawn uniform (stratified) [N].
@@ -67,6 +72,7 @@ class RubbingDesign:
 
     c_tilde_range: tuple[float, float] = (0.05, 20.0)
     omega_range: tuple[float, float] = (0.2, 2.0)
+    equal_patch_speed: bool = True
     v_max: float = 0.1
     f_n_range: tuple[float, float] = (1.0, 10.0)
     approach: float = 0.1
@@ -105,6 +111,7 @@ class RubbingDesign:
             if not (math.isfinite(v) and v >= 0.0):
                 raise ValueError(f"RubbingDesign.{name} = {v!r}: must be finite and >= 0")
             object.__setattr__(self, name, v)
+        object.__setattr__(self, "equal_patch_speed", bool(self.equal_patch_speed))
         if not 0.0 < self.f_n_start <= 1.0:
             raise ValueError(f"RubbingDesign.f_n_start = {self.f_n_start!r}: must be in (0, 1]")
         if not 0.0 <= self.reverse_fraction <= 1.0:
@@ -306,7 +313,10 @@ def plan_maneuvers(design: RubbingDesign, n: int, seed: int = 0, *,
             raise ValueError(f"plan_maneuvers: radius law gave rho = {rho!r} at f_n = "
                              f"{f_nom[i]:.3g} N")
         c = float(c_tilde[i]) * rho
-        peak = min(float(w_peak[i]), design.v_max / c)
+        peak = float(w_peak[i])
+        if design.equal_patch_speed:
+            peak /= math.sqrt(1.0 + 2.0 * float(c_tilde[i]) ** 2)
+        peak = min(peak, design.v_max / c)
         accel = float(np.exp(r.uniform(a_lo, a_hi)))
         legs = int(n_rev[i]) + 1
         holds = r.uniform(*design.hold_range, legs)
