@@ -122,6 +122,21 @@ def _refit(prob: _Problem, p_start: ContactParams, free_t, bnds, max_iterations,
     return at(np.asarray(res.x))
 
 
+@dataclasses.dataclass(frozen=True)
+class Prior:
+    """A Gaussian regularisation of log-parameters: centre ``values`` and covariance ``cov``
+    of (ln p for p in ``names``)."""
+
+    names: tuple
+    values: np.ndarray
+    cov: np.ndarray
+
+    def spread(self, name: str) -> float:
+        """Relative spread (standard deviation of ln p) of one parameter."""
+        i = self.names.index(name)
+        return float(math.sqrt(max(self.cov[i, i], 0.0)))
+
+
 @dataclasses.dataclass
 class Minimum:
     """Outcome of :func:`minimise`: the parameters, x = ln(p / p0) of the free ones, the
@@ -137,7 +152,7 @@ class Minimum:
     fit_time: float
     prior_weight: float
     c0: float
-    precision: np.ndarray  # regularisation weight / s^2 per free log-parameter
+    precision: np.ndarray  # regularisation weight x C^-1 over the free log-parameters
 
 
 def minimise(
@@ -149,13 +164,13 @@ def minimise(
     method: str,
     max_iterations: int,
     tolerance: float,
-    prior: dict | None = None,
+    prior: Prior | None = None,
     prior_weight: float = 0.0,
     progress=None,
 ) -> Minimum:
-    """Minimise cost / cost(p0) + prior_weight * sum(((ln p - ln v) / s)^2) over the free
-    log-parameters; ``prior`` maps names to (v, s) (s: relative spread), missing names are
-    unregularised."""
+    """Minimise cost / cost(p0) + prior_weight * d^T C^-1 d over the free log-parameters,
+    d = ln p - ln v for the free parameters the ``prior`` names (C: its covariance,
+    marginalised to them); the other free parameters are unregularised."""
     import time
     import warnings
 
@@ -165,10 +180,15 @@ def minimise(
     scale = np.array([getattr(p0, n) for n in free_t])
     lo = np.log(np.array([bnds[n][0] for n in free_t]) / scale)
     hi = np.log(np.array([bnds[n][1] for n in free_t]) / scale)
-    prior = prior or {}
-    centre = np.array([math.log(prior[n][0] / getattr(p0, n)) if n in prior else 0.0
-                       for n in free_t])
-    prec = np.array([prior_weight / prior[n][1] ** 2 if n in prior else 0.0 for n in free_t])
+    centre = np.zeros(len(free_t))
+    prec = np.zeros((len(free_t), len(free_t)))
+    if prior is not None and prior_weight > 0:
+        sel = [i for i, n in enumerate(free_t) if n in prior.names]
+        if sel:
+            j = [prior.names.index(free_t[i]) for i in sel]
+            for i, jj in zip(sel, j):
+                centre[i] = math.log(prior.values[jj] / getattr(p0, free_t[i]))
+            prec[np.ix_(sel, sel)] = prior_weight * np.linalg.pinv(prior.cov[np.ix_(j, j)])
 
     def params_at(x) -> ContactParams:
         vals = scale * np.exp(np.clip(x, lo, hi))
@@ -195,16 +215,16 @@ def minimise(
 
     def fun(x):
         d = x - centre
-        return float(ev_at(x)["cost"]) / c0 + float(np.sum(prec * d * d))
+        return float(ev_at(x)["cost"]) / c0 + float(d @ prec @ d)
 
     def jac(x):
         g = np.asarray(ev_at(x)["gradient"])[idx]
-        return g * (scale * np.exp(x)) / c0 + 2.0 * prec * (x - centre)
+        return g * (scale * np.exp(x)) / c0 + 2.0 * prec @ (x - centre)
 
     def hess(x):
         H = np.asarray(ev_at(x)["gauss_newton"]).reshape(6, 6)[np.ix_(idx, idx)]
         s = scale * np.exp(x)
-        return H * np.outer(s, s) / c0 + np.diag(2.0 * prec)
+        return H * np.outer(s, s) / c0 + 2.0 * prec
 
     trace = [c0]
     it = [0]
@@ -223,21 +243,50 @@ def minimise(
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", RuntimeWarning)
         if method == "gauss-newton":
-            res = _gauss_newton(lambda x: (fun(x), jac(x), hess(x)), x0, lo, hi,
-                                max_iterations=max_iterations, tolerance=tolerance,
-                                callback=callback)
+            res = _gauss_newton(
+                lambda x: (fun(x), jac(x), hess(x)),
+                x0,
+                lo,
+                hi,
+                max_iterations=max_iterations,
+                tolerance=tolerance,
+                callback=callback,
+            )
         elif method == "slsqp":
-            res = minimize(fun, x0, jac=jac, method="SLSQP", bounds=list(zip(lo, hi)),
-                           callback=callback,
-                           options={"maxiter": int(max_iterations), "ftol": float(tolerance)})
+            res = minimize(
+                fun,
+                x0,
+                jac=jac,
+                method="SLSQP",
+                bounds=list(zip(lo, hi)),
+                callback=callback,
+                options={"maxiter": int(max_iterations), "ftol": float(tolerance)},
+            )
         else:
-            res = minimize(fun, x0, jac=jac, hess=hess, method="trust-constr",
-                           bounds=Bounds(lo, hi), callback=lambda u, state: callback(u),
-                           options={"maxiter": int(max_iterations), "gtol": 1e-8, "xtol": 1e-10})
+            res = minimize(
+                fun,
+                x0,
+                jac=jac,
+                hess=hess,
+                method="trust-constr",
+                bounds=Bounds(lo, hi),
+                callback=lambda u, state: callback(u),
+                options={"maxiter": int(max_iterations), "gtol": 1e-8, "xtol": 1e-10},
+            )
     fit_time = time.perf_counter() - t_fit
     x = np.clip(np.asarray(res.x, dtype=float), lo, hi)
     if fun(x) > fun(x0):  # never return worse than the start
         x = x0
-    return Minimum(params=params_at(x), x=x, lo=lo, hi=hi, result=res, trace=trace,
-                   iterations=int(getattr(res, "nit", it[0]) or it[0]), fit_time=fit_time,
-                   prior_weight=prior_weight, c0=c0, precision=prec)
+    return Minimum(
+        params=params_at(x),
+        x=x,
+        lo=lo,
+        hi=hi,
+        result=res,
+        trace=trace,
+        iterations=int(getattr(res, "nit", it[0]) or it[0]),
+        fit_time=fit_time,
+        prior_weight=prior_weight,
+        c0=c0,
+        precision=prec,
+    )

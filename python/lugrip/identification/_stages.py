@@ -30,8 +30,14 @@ from .._params import ContactParams
 from ._data import _Maneuver
 from ._phases import LOADING, SLIDING, runs
 
-__all__ = ["LimitSurfaceFit", "PreslidingFit", "SlidingPoints", "fit_limit_surface",
-           "fit_presliding", "sliding_points"]
+__all__ = [
+    "LimitSurfaceFit",
+    "PreslidingFit",
+    "SlidingPoints",
+    "fit_limit_surface",
+    "fit_presliding",
+    "sliding_points",
+]
 
 _INV_K = np.linspace(0.0, 2.0, 21)  # table nodes of 1/k (k = inf .. 0.5)
 _A = np.concatenate([[0.0], np.geomspace(1e-3, 400.0, 500)])  # |c~| nodes
@@ -57,7 +63,11 @@ def _curves(inv_k: float):
     x = float(np.clip(inv_k, 0.0, 2.0)) / (_INV_K[1] - _INV_K[0])
     j = min(int(x), _INV_K.size - 2)
     w = x - j
-    return (1 - w) * F[j] + w * F[j + 1], (1 - w) * T[j] + w * T[j + 1], (1 - w) * xi[j] + w * xi[j + 1]
+    return (
+        (1 - w) * F[j] + w * F[j + 1],
+        (1 - w) * T[j] + w * T[j + 1],
+        (1 - w) * xi[j] + w * xi[j + 1],
+    )
 
 
 def k_of(inv_k: float) -> float:
@@ -112,8 +122,12 @@ def sliding_points(mans: list[_Maneuver], phases: list[np.ndarray], bins: int = 
                 cols["omega_abs"].append(float(np.mean(np.abs(m.omega[sel]))))
                 cols["samples"].append(int(sel.size))
                 cols["maneuver"].append(i)
-    return SlidingPoints(**{k: np.asarray(v, dtype=float if k not in ("samples", "maneuver")
-                                           else np.int64) for k, v in cols.items()})
+    return SlidingPoints(
+        **{
+            k: np.asarray(v, dtype=float if k not in ("samples", "maneuver") else np.int64)
+            for k, v in cols.items()
+        }
+    )
 
 
 def _nearest(ft, tt, lam, F, T, xi):
@@ -127,8 +141,8 @@ def _nearest(ft, tt, lam, F, T, xi):
     x0, x1, x2 = _A[jj - 1], _A[jj], _A[jj + 1]
     y0, y1, y2 = d2[r, jj - 1], d2[r, jj], d2[r, jj + 1]
     den = (x0 - x1) * (x0 - x2) * (x1 - x2)
-    A2 = (x2 * (y1 - y0) + x1 * (y0 - y2) + x0 * (y2 - y1))
-    B2 = (x2 * x2 * (y0 - y1) + x1 * x1 * (y2 - y0) + x0 * x0 * (y1 - y2))
+    A2 = x2 * (y1 - y0) + x1 * (y0 - y2) + x0 * (y2 - y1)
+    B2 = x2 * x2 * (y0 - y1) + x1 * x1 * (y2 - y0) + x0 * x0 * (y1 - y2)
     with np.errstate(divide="ignore", invalid="ignore"):
         a = np.where((A2 / den) > 0, -B2 / (2.0 * A2), x1)
     a = np.clip(np.where(np.isfinite(a), a, x1), x0, x2)
@@ -166,26 +180,42 @@ class LimitSurfaceFit:
     residual_rms: float
     viscous_t: float
     xi: float
+    cov: (
+        np.ndarray
+    )  # sandwich covariance of the fitted variables (ln mu, ln delta, gamma, 1/k, kappa)
 
     def tau_max(self, f_n) -> np.ndarray:
         return self.mu * self.xi * self.delta * np.asarray(f_n, float) ** (1.0 + self.gamma)
 
 
 _LO = {"mu": math.log(0.05), "delta": math.log(1e-4), "gamma": 0.0, "inv_k": 0.0, "kappa": 0.0}
-_HI = {"mu": math.log(2.0), "delta": math.log(1e-2), "gamma": 1.0 / 3.0, "inv_k": 2.0,
-       "kappa": np.inf}
+_HI = {
+    "mu": math.log(2.0),
+    "delta": math.log(1e-2),
+    "gamma": 1.0 / 3.0,
+    "inv_k": 2.0,
+    "kappa": np.inf,
+}
 
 
-def fit_limit_surface(pts: SlidingPoints, *, gamma: float | None = None, k: float | None = None,
-                      viscous: bool = True) -> LimitSurfaceFit:
+def fit_limit_surface(
+    pts: SlidingPoints, *, gamma: float | None = None, k: float | None = None, viscous: bool = True
+) -> LimitSurfaceFit:
     """Fit stage (a) (and (c) with ``viscous``) to the sliding points. ``gamma`` / ``k``
     given: held at that value."""
     if len(pts) < 3:
         raise ValueError("fewer than 3 gross-sliding points")
-    names = ["mu", "delta"] + (["gamma"] if gamma is None else []) + \
-        (["inv_k"] if k is None else []) + (["kappa"] if viscous else [])
-    fixed = {"gamma": gamma, "inv_k": None if k is None else (0.0 if math.isinf(k) else 1.0 / k),
-             "kappa": 0.0}
+    names = (
+        ["mu", "delta"]
+        + (["gamma"] if gamma is None else [])
+        + (["inv_k"] if k is None else [])
+        + (["kappa"] if viscous else [])
+    )
+    fixed = {
+        "gamma": gamma,
+        "inv_k": None if k is None else (0.0 if math.isinf(k) else 1.0 / k),
+        "kappa": 0.0,
+    }
     fn, ft_raw, tau, w = pts.f_n, pts.f_t, pts.tau_abs, pts.omega_abs
 
     def unpack(x):
@@ -212,16 +242,22 @@ def fit_limit_surface(pts: SlidingPoints, *, gamma: float | None = None, k: floa
     d0 = float(np.percentile(tau / (mu0 * xi0 * fn ** (1.0 + g0)), 90))
     d0 = min(max(d0, 2e-4), 5e-3)
     best = None
-    for ik0 in ((0.25, 1.0) if k is None else (None,)):
+    for ik0 in (0.25, 1.0) if k is None else (None,):
         x0 = []
         for n in names:
-            x0.append({"mu": math.log(min(max(mu0, 0.06), 1.9)), "delta": math.log(d0), "gamma": g0,
-                       "inv_k": ik0, "kappa": 0.0}[n])
+            x0.append(
+                {
+                    "mu": math.log(min(max(mu0, 0.06), 1.9)),
+                    "delta": math.log(d0),
+                    "gamma": g0,
+                    "inv_k": ik0,
+                    "kappa": 0.0,
+                }[n]
+            )
         lo = [_LO[n] for n in names]
         hi = [_HI[n] for n in names]
         x0 = np.clip(x0, np.array(lo) + 1e-9, np.array(hi) - 1e-9)
-        r = least_squares(resid, x0, bounds=(lo, hi), x_scale="jac", diff_step=1e-4,
-                          max_nfev=200)
+        r = least_squares(resid, x0, bounds=(lo, hi), x_scale="jac", diff_step=1e-4, max_nfev=200)
         if best is None or r.cost < best.cost:
             best = r
     x = best.x
@@ -267,11 +303,21 @@ def fit_limit_surface(pts: SlidingPoints, *, gamma: float | None = None, k: floa
     lam = kap * fn ** (3.0 * g_ - 1.0) * w / (2.0 * xi)
     a, r1, r2 = _nearest(ft, tt, lam, F, T, xi)
     return LimitSurfaceFit(
-        mu=mu, delta=delta, gamma=float(g_), k=k_of(ik), kappa=float(kap), beta_a=float(beta),
-        stderr=stderr, free=tuple(names), at_bound=tuple(at), points=pts, c_abs=a,
+        mu=mu,
+        delta=delta,
+        gamma=float(g_),
+        k=k_of(ik),
+        kappa=float(kap),
+        beta_a=float(beta),
+        stderr=stderr,
+        free=tuple(names),
+        at_bound=tuple(at),
+        points=pts,
+        c_abs=a,
         residual_rms=float(np.sqrt(np.mean(np.concatenate([r1, r2]) ** 2))),
         viscous_t=(kap / stderr["kappa"]) if viscous and stderr["kappa"] > 0 else math.nan,
         xi=float(xi),
+        cov=cov,
     )
 
 
@@ -288,8 +334,14 @@ class PreslidingFit:
     residual_rms: float
 
 
-def fit_presliding(mans: list[_Maneuver], phases: list[np.ndarray], params: ContactParams,
-                   *, tail: int = 20, max_len: int = 400) -> PreslidingFit | None:
+def fit_presliding(
+    mans: list[_Maneuver],
+    phases: list[np.ndarray],
+    params: ContactParams,
+    *,
+    tail: int = 20,
+    max_len: int = 400,
+) -> PreslidingFit | None:
     """Fit sigma0 and sigma_z on every run's loading samples (plus ``tail`` sliding samples);
     None when no run has a loading phase of >= 3 samples."""
     wins = []
@@ -307,9 +359,16 @@ def fit_presliding(mans: list[_Maneuver], phases: list[np.ndarray], params: Cont
             est = estimate_cor(params, m.f_n[sl], m.f_t[sl], m.tau[sl])
             if np.any(np.asarray(est.saturated, bool)[1:]):
                 continue  # CoR clipped at c_max: y is not the torque about the true CoR
-            wins.append((i, np.nan_to_num(m.omega[sl]), np.concatenate([[0.0], m.dt[a0 + 1:end]]),
-                         np.asarray(est.y, float), np.asarray(est.g, float),
-                         np.asarray(est.sigma_1, float)))
+            wins.append(
+                (
+                    i,
+                    np.nan_to_num(m.omega[sl]),
+                    np.concatenate([[0.0], m.dt[a0 + 1 : end]]),
+                    np.asarray(est.y, float),
+                    np.asarray(est.g, float),
+                    np.asarray(est.sigma_1, float),
+                )
+            )
     if not wins:
         return None
     L = max(len(wv[1]) for wv in wins)
@@ -355,9 +414,14 @@ def fit_presliding(mans: list[_Maneuver], phases: list[np.ndarray], params: Cont
     best = None
     for f0 in (1.0,):
         for sz0 in (0.0, 0.01 * s0_0 * f0):
-            r = least_squares(resid, [math.log(s0_0 * f0), sz0],
-                              bounds=([math.log(1e-3), 0.0], [math.log(1e4), np.inf]),
-                              x_scale="jac", diff_step=1e-4, max_nfev=60)
+            r = least_squares(
+                resid,
+                [math.log(s0_0 * f0), sz0],
+                bounds=([math.log(1e-3), 0.0], [math.log(1e4), np.inf]),
+                x_scale="jac",
+                diff_step=1e-4,
+                max_nfev=60,
+            )
             if best is None or r.cost < best.cost:
                 best = r
     J, res = best.jac, best.fun
@@ -372,7 +436,11 @@ def fit_presliding(mans: list[_Maneuver], phases: list[np.ndarray], params: Cont
     cov = bread @ meat @ bread * (groups.size / max(groups.size - 1, 1))
     sd = np.sqrt(np.abs(np.diag(cov)))
     s0 = math.exp(best.x[0])
-    return PreslidingFit(sigma0=s0, sigma_z=float(best.x[1]),
-                         stderr={"sigma0": s0 * float(sd[0]), "sigma_z": float(sd[1])},
-                         runs=R, samples=int(mask.sum()),
-                         residual_rms=float(np.sqrt(np.mean(res**2))))
+    return PreslidingFit(
+        sigma0=s0,
+        sigma_z=float(best.x[1]),
+        stderr={"sigma0": s0 * float(sd[0]), "sigma_z": float(sd[1])},
+        runs=R,
+        samples=int(mask.sum()),
+        residual_rms=float(np.sqrt(np.mean(res**2))),
+    )

@@ -12,6 +12,7 @@ from .._contact import sigma_1 as _sigma_1
 from .._params import ContactParams
 from ._common import DEFAULT_BOUNDS, IdentificationError
 from ._data import _Maneuver
+from ._optimize import Prior
 from ._phases import LOADING, SLIDING, STILL, Noise, estimate_noise, find_phases
 from ._stages import (
     LimitSurfaceFit,
@@ -35,7 +36,10 @@ class StageEstimate:
     Attributes:
         params: the staged parameters (beta_A set by the observability rule when the speed is
             not observable).
-        prior: {name: (value, relative spread)} for the refinement's regularisation.
+        prior: the refinement's regularisation (:class:`Prior`): the limit-surface stage's
+            sandwich covariance at its k (mu, delta, gamma and beta_A jointly, so that a
+            well-determined combination such as tau_max stays put) plus a 2 % floor, and the
+            presliding stage's spreads.
         fixed: {name: reason} parameters the refinement must not move.
         noise: sensor noise from the still samples.
         speed_observable: the viscous excess is significant and the resolution
@@ -48,7 +52,7 @@ class StageEstimate:
     """
 
     params: ContactParams
-    prior: dict
+    prior: Prior
     fixed: dict
     noise: Noise
     speed_observable: bool
@@ -60,8 +64,9 @@ class StageEstimate:
     report: tuple
 
 
-def _beta_unobservable(noise_torque: float, ls: LimitSurfaceFit, f_max: float, c_max: float,
-                       resolution_max: float) -> float:
+def _beta_unobservable(
+    noise_torque: float, ls: LimitSurfaceFit, f_max: float, c_max: float, resolution_max: float
+) -> float:
     """beta_A whose sigma_1 at the largest force and the CoR clip gives a speed resolution
     of twice resolution_max: the observer then reports speed_observable = False everywhere
     in the data's range."""
@@ -122,10 +127,18 @@ def staged_estimate(
     lines.append(_ls_line(ls, pts, fix_gamma))
     # (c) viscous shear: significance and observability
     tn = noise.torque if math.isfinite(noise.torque) else 1.0e-5
-    significant, resolution, observable, beta, line = _viscous(ls, pts, tn, c_max, resolution_max)
+    _, resolution, observable, beta, line = _viscous(ls, pts, tn, c_max, resolution_max)
     lines.append(line)
-    probe = ContactParams(mu=ls.mu, beta_a=max(ls.beta_a, 1.0), sigma0=1.0, sigma_z=0.01,
-                          delta=ls.delta, gamma=ls.gamma, k=ls.k, c_max=c_max)
+    probe = ContactParams(
+        mu=ls.mu,
+        beta_a=max(ls.beta_a, 1.0),
+        sigma0=1.0,
+        sigma_z=0.01,
+        delta=ls.delta,
+        gamma=ls.gamma,
+        k=ls.k,
+        c_max=c_max,
+    )
     p_ls = probe.replace(beta_a=beta)
     pre = fit_presliding(mans, phases, p_ls)
     if pre is not None:
@@ -155,7 +168,7 @@ def staged_estimate(
         probe = probe.replace(mu=ls.mu, delta=ls.delta, gamma=ls.gamma, k=ls.k)
         p_ls = probe.replace(beta_a=beta)
         pre = fit_presliding(mans, phases, p_ls)
-    prior: dict = {}
+    diag: dict = {}
     fixed: dict = {}
     if pre is None:
         sigma0, sigma_z = 1.0, 0.01
@@ -166,8 +179,9 @@ def staged_estimate(
         sz_sig = pre.stderr["sigma_z"] > 0 and pre.sigma_z >= 2.0 * pre.stderr["sigma_z"]
         # without measurable micro-damping keep the observer's stick mode damped: sigma_z at
         # the upper 2-sigma value of the fit, never below 1 % of sigma0 x 1 s
-        sigma_z = pre.sigma_z if sz_sig else max(pre.sigma_z + 2.0 * pre.stderr["sigma_z"],
-                                                 0.01 * sigma0)
+        sigma_z = (
+            pre.sigma_z if sz_sig else max(pre.sigma_z + 2.0 * pre.stderr["sigma_z"], 0.01 * sigma0)
+        )
         lines.append(
             f"(b) presliding from {pre.runs} loading runs ({pre.samples} samples): sigma0 "
             f"{sigma0:.4g} +- {pre.stderr['sigma0']:.2g} N m/rad, sigma_z "
@@ -175,21 +189,26 @@ def staged_estimate(
             + ("" if sz_sig else f" (not significant: set to {sigma_z:.3g})")
             + f"; RMS residual {pre.residual_rms:.3g} of g"
         )
-        prior["sigma0"] = (sigma0, max(pre.stderr["sigma0"] / sigma0, _REL_FLOOR))
-        prior["sigma_z"] = (sigma_z, max(pre.stderr["sigma_z"] / max(sigma_z, 1e-300), 0.5)
-                            if sz_sig else 1.0)
+        diag["sigma0"] = (sigma0, max(pre.stderr["sigma0"] / sigma0, _REL_FLOOR))
+        diag["sigma_z"] = (
+            sigma_z,
+            max(pre.stderr["sigma_z"] / max(sigma_z, 1e-300), 0.5) if sz_sig else 1.0,
+        )
     params = p_ls.replace(sigma0=sigma0, sigma_z=sigma_z)
-    prior["mu"] = (ls.mu, max(ls.stderr["mu"] / ls.mu, _REL_FLOOR))
-    prior["delta"] = (ls.delta, max(ls.stderr["delta"] / ls.delta, _REL_FLOOR))
-    if fix_gamma is None:
-        prior["gamma"] = (ls.gamma, max(ls.stderr["gamma"] / max(ls.gamma, 1e-6), _REL_FLOOR))
-    if observable:
-        prior["beta_a"] = (beta, max(ls.stderr["beta_a"] / beta, _REL_FLOOR))
-    else:
+    if not observable:
         fixed["beta_a"] = "sliding speed not observable on these data"
+    prior = _prior(ls, beta, observable, fix_gamma, diag)
     return StageEstimate(
-        params=params, prior=prior, fixed=fixed, noise=noise, speed_observable=observable,
-        omega_resolution=resolution, ls=ls, presliding=pre, counts=counts, phases=phases,
+        params=params,
+        prior=prior,
+        fixed=fixed,
+        noise=noise,
+        speed_observable=observable,
+        omega_resolution=resolution,
+        ls=ls,
+        presliding=pre,
+        counts=counts,
+        phases=phases,
         report=tuple(lines),
     )
 
@@ -210,8 +229,16 @@ def _ls_line(ls: LimitSurfaceFit, pts, fix_gamma) -> str:
 def _viscous(ls: LimitSurfaceFit, pts, tn: float, c_max: float, resolution_max: float):
     """(significant, resolution, observable, beta_A, report line) of stage (c)."""
     significant = ls.kappa > 0 and math.isfinite(ls.viscous_t) and ls.viscous_t >= VISCOUS_T
-    probe = ContactParams(mu=ls.mu, beta_a=max(ls.beta_a, 1.0), sigma0=1.0, sigma_z=0.01,
-                          delta=ls.delta, gamma=ls.gamma, k=ls.k, c_max=c_max)
+    probe = ContactParams(
+        mu=ls.mu,
+        beta_a=max(ls.beta_a, 1.0),
+        sigma0=1.0,
+        sigma_z=0.01,
+        delta=ls.delta,
+        gamma=ls.gamma,
+        k=ls.k,
+        c_max=c_max,
+    )
     c_pts = np.minimum(ls.c_abs, c_max)
     res_pts = tn / np.maximum(np.asarray(_sigma_1(probe, pts.f_n, c_pts), float), 1e-300)
     resolution = float(np.median(np.repeat(res_pts, pts.samples)))
@@ -226,8 +253,9 @@ def _viscous(ls: LimitSurfaceFit, pts, tn: float, c_max: float, resolution_max: 
         return significant, resolution, observable, beta, line
     why = (
         f"no significant speed dependence of the sliding wrench (t = {ls.viscous_t:.1f} "
-        f"< {VISCOUS_T:g})" if not significant else
-        f"the viscous part is too small against the torque noise (resolution "
+        f"< {VISCOUS_T:g})"
+        if not significant
+        else f"the viscous part is too small against the torque noise (resolution "
         f"{resolution:.3g} rad/s > {resolution_max:g})"
     )
     beta = _beta_unobservable(tn, ls, float(pts.f_n.max()) * 1.5, c_max, resolution_max)
@@ -248,8 +276,61 @@ def _min_slip(p: ContactParams):
 
     def req(m, a, b):
         h = a + (b - a) // 2
-        est = estimate_cor(p, np.array([np.mean(m.f_n[h:b])]), np.array([np.mean(m.f_t[h:b])]),
-                           np.array([np.mean(m.tau[h:b])]))
+        est = estimate_cor(
+            p,
+            np.array([np.mean(m.f_n[h:b])]),
+            np.array([np.mean(m.f_t[h:b])]),
+            np.array([np.mean(m.tau[h:b])]),
+        )
         return 4.6 * float(np.asarray(est.g)[0]) / p.sigma0
 
     return req
+
+
+def _prior(ls: LimitSurfaceFit, beta: float, observable: bool, fix_gamma, diag: dict) -> Prior:
+    """Joint log-space prior of (mu, delta, gamma[, beta_A]) from the limit-surface fit,
+    conditioned on its k (k is not refined), plus the diagonal entries in ``diag``."""
+    fitted = list(ls.free)
+    keep = [n for n in ("mu", "delta", "gamma", "kappa") if n in fitted]
+    if not observable and "kappa" in keep:
+        keep.remove("kappa")
+    cov = np.asarray(ls.cov, dtype=float)
+    if np.all(np.isfinite(cov)):
+        P = np.linalg.pinv(cov)
+        idx = [fitted.index(n) for n in keep]
+        cond = np.linalg.pinv(P[np.ix_(idx, idx)])  # covariance given the fitted 1/k
+    else:
+        cond = np.diag([1.0] * len(keep))
+    # to ln-space of the parameters: gamma -> ln gamma, kappa -> ln beta_A
+    names, values = [], []
+    J = np.zeros((len(keep), len(keep)))
+    for r, n in enumerate(keep):
+        if n == "mu":
+            names.append("mu")
+            values.append(ls.mu)
+            J[r, r] = 1.0
+        elif n == "delta":
+            names.append("delta")
+            values.append(ls.delta)
+            J[r, r] = 1.0
+        elif n == "gamma":
+            names.append("gamma")
+            values.append(ls.gamma)
+            J[r, r] = 1.0 / max(ls.gamma, 1e-6)
+        else:  # ln beta = ln kappa + ln mu - 3 ln delta
+            names.append("beta_a")
+            values.append(beta)
+            J[r, r] = 1.0 / max(ls.kappa, 1e-300)
+            if "mu" in keep:
+                J[r, keep.index("mu")] = 1.0
+            if "delta" in keep:
+                J[r, keep.index("delta")] = -3.0
+    C = J @ cond @ J.T + _REL_FLOOR**2 * np.eye(len(keep))
+    full = len(names) + len(diag)
+    cov_all = np.zeros((full, full))
+    cov_all[: len(names), : len(names)] = C
+    for i, (n, (v, s)) in enumerate(diag.items()):
+        names.append(n)
+        values.append(v)
+        cov_all[len(keep) + i, len(keep) + i] = s * s
+    return Prior(names=tuple(names), values=np.asarray(values, float), cov=cov_all)

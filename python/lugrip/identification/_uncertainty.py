@@ -69,8 +69,8 @@ def covariance(train, ev, mn, free_t, *, loss: str, uncertainty: str, sse, refit
     wsum = float(ev["weight_sum"])
     dof = max(n_sc - len(free_t), 1)
     # Hessian of the regularisation in units of the cost's Hessian
-    # (mn.precision: weight / s^2 per log-parameter of the normalised objective cost / c0)
-    P = np.diag(2.0 * mn.c0 * np.asarray(mn.precision, dtype=float))
+    # (mn.precision: weight x C^-1 of the normalised objective cost / c0)
+    P = 2.0 * mn.c0 * np.asarray(mn.precision, dtype=float)
     cov = np.full((len(free_t), len(free_t)), np.nan)
     inner = np.array([lo[i] + 1e-6 < x[i] < hi[i] - 1e-6 for i in range(len(free_t))])
     ii = np.ix_(inner, inner)
