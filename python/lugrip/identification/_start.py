@@ -189,10 +189,13 @@ def staged_estimate(
             + ("" if sz_sig else f" (not significant: set to {sigma_z:.3g})")
             + f"; RMS residual {pre.residual_rms:.3g} of g"
         )
-        diag["sigma0"] = (sigma0, max(pre.stderr["sigma0"] / sigma0, _REL_FLOOR))
+        # the spread includes the misfit of the one-state bristle model to the loading runs
+        # (twice the RMS residual, relative to g), not only the statistical error
+        misfit = 2.0 * pre.residual_rms
+        diag["sigma0"] = (sigma0, max(pre.stderr["sigma0"] / sigma0, misfit, _REL_FLOOR))
         diag["sigma_z"] = (
             sigma_z,
-            max(pre.stderr["sigma_z"] / max(sigma_z, 1e-300), 0.5) if sz_sig else 1.0,
+            max(pre.stderr["sigma_z"] / max(sigma_z, 1e-300), misfit, 0.5) if sz_sig else 1.0,
         )
     params = p_ls.replace(sigma0=sigma0, sigma_z=sigma_z)
     if not observable:
