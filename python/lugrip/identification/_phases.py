@@ -9,7 +9,8 @@ s = integral |omega| dt since the run start: a load signal (the in-plane force a
 direction in the run, or the torque, whichever stands further above the noise, per unit
 normal force) rises from zero (or from the opposite load after a reversal: from its zero
 crossing) to 90 % of its plateau over a slip angle s_b, and the samples beyond twice that
-count as gross sliding when the load no longer grows there. No speed threshold decides where sliding starts:
+count as gross sliding when the load no longer grows there and the run slips on over at least
+another s_b (a creep that dies out under a held load is not sliding). No speed threshold decides where sliding starts:
 a robot that prescribes the motion moves from the first sample on, while the friction only
 reaches the limit surface after the presliding distance.
 """
@@ -33,6 +34,7 @@ _SMOOTH = 7  # samples of the centred moving average of the load signal
 _REACHED = 0.9  # fraction of the plateau that ends the build-up [-]
 _SETTLE = 2.0  # gross sliding from this multiple of the build-up slip angle [-]
 _GROWTH = 0.1  # largest rise of the load over the sliding part, as a fraction of it [-]
+_UNLOADED = 3.0  # a run whose load exceeds its plateau this many times is an unloading [-]
 _MIN_RUN = 10  # samples of a run (shorter ones are loading at most)
 _MIN_STILL = 20  # samples of a still block used for the noise
 
@@ -158,6 +160,8 @@ def find_phases(m: _Maneuver, noise: Noise, min_slip=None) -> np.ndarray:
         load = _load_signal(m, a, b, s, noise)
         # the build-up starts at the lowest load of the first half (zero, or the opposite
         # load after a reversal); its length is measured from the zero crossing to 90 %
+        if not np.all(np.isfinite(load)) or float(np.max(np.abs(load))) > _UNLOADED:
+            continue  # the plateau is small against earlier loads: an unloading, not sliding
         first = np.flatnonzero(s <= 0.5 * s[-1])
         j_min = int(first[np.argmin(load[first])]) if first.size else 0
         up = np.flatnonzero(load[j_min:] >= 0.0)
@@ -171,8 +175,8 @@ def find_phases(m: _Maneuver, noise: Noise, min_slip=None) -> np.ndarray:
             if req is not None and math.isfinite(req):
                 s_slide = max(s_slide, s[j_min] + req)
         slide = s >= max(s_slide, s[min(_SMOOTH, b - a - 1)])
-        if not slide.any() or s_slide > 0.75 * s[-1]:
-            continue
+        if not slide.any() or s_slide > 0.75 * s[-1] or s[-1] - s_slide < s90 - s0:
+            continue  # no plateau, or it slipped less than the build-up: creep, not sliding
         part = load[slide]
         q = max(part.size // 4, 1)
         if float(np.median(part[-q:])) - float(np.median(part[:q])) > _GROWTH:

@@ -26,6 +26,12 @@ __all__ = ["StageEstimate", "staged_estimate"]
 
 VISCOUS_T = 3.0  # one-sided t statistic above which the viscous excess counts as measured
 RESOLUTION_MAX = 0.02  # [rad/s] the observer's default speed_observable threshold
+_NO_SLIDING = (
+    "no gross sliding in the data (all-stick or presliding only): in no run of motion did "
+    "the friction stop growing while the motion went on, so mu and the limit surface are not "
+    "identifiable (stick gives only a lower bound on mu); rub beyond the presliding distance, "
+    "or fit only sigma0/sigma_z with free=('sigma0', 'sigma_z') and params0"
+)
 _REL_FLOOR = 0.02  # smallest relative prior spread of a stage value in the refinement [-]
 
 
@@ -112,11 +118,7 @@ def staged_estimate(
     else:
         lines.append("noise: no still stretch of >= 20 samples; the observer default is kept")
     if counts["sliding"] == 0:
-        raise IdentificationError(
-            "no gross sliding found: in no run of motion did the friction stop growing "
-            "while the motion went on (all presliding or stick); mu and the limit surface "
-            "cannot be identified: rub further (beyond the presliding distance)"
-        )
+        raise IdentificationError(_NO_SLIDING)
     if counts["maneuvers_sliding"] < 3:
         raise IdentificationError(
             f"gross sliding in only {counts['maneuvers_sliding']} maneuver(s): the limit "
@@ -141,25 +143,30 @@ def staged_estimate(
     )
     p_ls = probe.replace(beta_a=beta)
     pre = fit_presliding(mans, phases, p_ls)
+    second = False
     if pre is not None:
         # second pass: every run must have slipped far enough for the bristles to reach their
         # bound (4.6 g / sigma0 from the start of its build-up), which the load alone cannot
         # show where a viscous part dominates it; then stages (a), (c), (b) again
         p_pre = p_ls.replace(sigma0=pre.sigma0, sigma_z=max(pre.sigma_z, 1e-6))
-        phases = [find_phases(m, noise, _min_slip(p_pre)) for m in mans]
-        n_before = counts["sliding"]
-        counts["sliding"] = int(sum(int(np.count_nonzero(p == SLIDING)) for p in phases))
-        counts["loading"] += n_before - counts["sliding"]
-        counts["maneuvers_sliding"] = int(sum(bool(np.any(p == SLIDING)) for p in phases))
-        lines.append(
-            f"phases, second pass (slip >= 4.6 g/sigma0 with sigma0 {pre.sigma0:.3g}): "
-            f"{counts['sliding']} gross-sliding samples in {counts['maneuvers_sliding']} maneuvers"
-        )
-        if counts["maneuvers_sliding"] < 3:
-            raise IdentificationError(
-                f"gross sliding in only {counts['maneuvers_sliding']} maneuver(s) once the "
-                "presliding distance is accounted for: rub further"
+        phases2 = [find_phases(m, noise, _min_slip(p_pre)) for m in mans]
+        n2 = int(sum(int(np.count_nonzero(p == SLIDING)) for p in phases2))
+        m2 = int(sum(bool(np.any(p == SLIDING)) for p in phases2))
+        second = m2 >= 3
+        if second:
+            phases = phases2
+            counts["loading"] += counts["sliding"] - n2
+            counts["sliding"], counts["maneuvers_sliding"] = n2, m2
+            lines.append(
+                f"phases, second pass (slip >= 4.6 g/sigma0 with sigma0 {pre.sigma0:.3g}): "
+                f"{n2} gross-sliding samples in {m2} maneuvers"
             )
+        else:
+            lines.append(
+                f"phases, second pass (slip >= 4.6 g/sigma0 with sigma0 {pre.sigma0:.3g}) "
+                f"would leave gross sliding in {m2} maneuver(s): the first pass is kept"
+            )
+    if pre is not None and second:
         pts = sliding_points(mans, phases)
         ls = fit_limit_surface(pts, gamma=fix_gamma, k=k, viscous=True)
         lines.append(_ls_line(ls, pts, fix_gamma))
