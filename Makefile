@@ -57,6 +57,7 @@ bench: install
 	$(VPY) benchmarks/observer_report.py --cpp-dir $(CPP_BUILD)/benchmarks --out BENCHMARKS.md
 	$(VPY) benchmarks/bench_identify.py --out BENCHMARKS.md
 	$(VPY) benchmarks/bench_rigs.py --out BENCHMARKS.md
+	$(VPY) benchmarks/bench_mujoco_rig.py --out BENCHMARKS.md
 	$(CPP_BUILD)/benchmarks/bench_closed_loop --markdown > build/issue5.md
 	$(VPY) benchmarks/sections.py BENCHMARKS.md issue5 build/issue5.md
 

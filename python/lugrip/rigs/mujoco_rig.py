@@ -24,6 +24,7 @@ from __future__ import annotations
 import dataclasses
 import math
 import time
+import warnings
 from dataclasses import asdict, dataclass
 
 import numpy as np
@@ -33,7 +34,11 @@ from ..sim.mujoco.pad import CONTACT_OPTIONS, Pad, PadSpec, model_xml, pad_body_
 from ._data import RigTruth, RubbingData
 from .motion import ManeuverPlan, RubbingDesign, plan_maneuvers, stack_times
 
-__all__ = ["MujocoRubbingRig", "RigSettings", "mount_pose"]
+__all__ = ["MujocoRubbingRig", "RigSettings", "mount_pose", "mount_poses"]
+
+#: largest relative departure of the true normal force from the plan while the pad moves
+#: before :meth:`MujocoRubbingRig.simulate` warns
+_BOUNCE = 0.1
 
 
 def _default_pad() -> PadSpec:
@@ -77,6 +82,26 @@ def _theta_at(t: float, kt, kw, cum) -> float:
     x = (t - kt[j]) / span
     dw = kw[j + 1] - kw[j]
     return cum[j] + span * (kw[j] * x + dw * (0.5 * x - math.sin(math.pi * x) / (2 * math.pi)))
+
+
+def _theta_many(t: np.ndarray, kt, kw, cum) -> np.ndarray:
+    """:func:`_theta_at` at many times (the same closed form, vectorised) [rad]."""
+    t = np.asarray(t, dtype=float)
+    j = np.clip(np.searchsorted(kt, t, side="right") - 1, 0, len(kt) - 2)
+    span = kt[j + 1] - kt[j]
+    x = np.clip((t - kt[j]) / span, 0.0, 1.0)
+    dw = kw[j + 1] - kw[j]
+    inner = cum[j] + span * (kw[j] * x + dw * (0.5 * x - np.sin(np.pi * x) / (2 * np.pi)))
+    before = kw[0] * (t - kt[0])
+    after = cum[-1] + kw[-1] * (t - kt[-1])
+    return np.where(t <= kt[0], before, np.where(t >= kt[-1], after, inner))
+
+
+def mount_poses(cor: np.ndarray, theta: np.ndarray) -> np.ndarray:
+    """(n, 3) planar poses (x, y, theta) of :func:`mount_pose` for many angles."""
+    c, s = np.cos(theta), np.sin(theta)
+    cx, cy = float(cor[0]), float(cor[1])
+    return np.stack([cx - (c * cx - s * cy), cy - (s * cx + c * cy), theta], axis=1)
 
 
 def mount_pose(cor: np.ndarray, theta: float, omega: float) -> tuple[np.ndarray, np.ndarray]:
@@ -221,39 +246,42 @@ class MujocoRubbingRig:
         acc = np.zeros(7)
         slide_all = True
         util_max = 0.0
-        pad.update(m, f_n=float(plan.f_n_at(0.0)))
-        # the mount's pose at each step start; its velocity over a step is the secant to the
-        # next pose, so that the Euler position update lands on the planned pose (no drift)
-        pos_next = mount_pose(cor, _theta_at(max(t0, 0.0), kt, kw, cum), 0.0)[0]
+        # per step n (start time t0 + n h): the normal force command and the mount's pose; its
+        # velocity over a step is the secant to the next pose, so that the Euler position
+        # update lands on the planned pose (no drift)
+        t_steps = np.maximum(t0 + np.arange(n_steps + 1) * h, 0.0)
+        f_cmd = np.asarray(plan.f_n_at(t_steps[:-1]), dtype=float)
+        poses = mount_poses(cor, _theta_many(t_steps, kt, kw, cum))
+        vels = np.diff(poses, axis=0) / h
+        jq = np.asarray(jq)
+        jv = np.asarray(jv)
+        law = self.pad
+        r_coef, r_floor, r_exp = law.delta, law.f_n_floor, law.gamma
+        tol = 1.0 - s.cone_tolerance
+        f_n_now = float(f_cmd[0])
         for n in range(n_steps):
-            t = t0 + n * h
-            tm = max(t, 0.0)
-            pos = pos_next
-            pos_next = mount_pose(cor, _theta_at(max(t + h, 0.0), kt, kw, cum), 0.0)[0]
-            vel = (pos_next - pos) / h
-            for k in range(3):
-                d.qpos[jq[k]] = pos[k]
-                d.qvel[jv[k]] = vel[k]
-            d.ctrl[0] = -float(plan.f_n_at(tm))
-            spin = pad.update(m, d)
+            d.qpos[jq] = poses[n]
+            d.qvel[jv] = vels[n]
+            d.ctrl[0] = -f_cmd[n]
+            spin = pad.update(m, d, f_n=f_n_now)
             mujoco.mj_step(m, d)
             w = pad.wrench(m, d)
-            rel = pad.slip_velocity(m, d)
+            f_n_now = w[0]
             i_rel = n - n_settle - ratio  # steps of sample k: i_rel in ((k-1) ratio, k ratio]
             if i_rel < -ratio:
                 continue
+            rel = pad.slip_velocity(m, d)
             fn = w[0]
             if fn > 0.0:
                 u = math.hypot(math.hypot(w[1], w[2]) / (mu * fn), w[3] / (spin * fn))
-                speed = math.hypot(rel[0], rel[1]) + abs(rel[2]) * float(
-                    pad.spec.contact_radius(fn)
-                )
-                slipping = u >= 1.0 - s.cone_tolerance and speed > s.slip_speed
+                rho = r_coef * max(fn, r_floor) ** r_exp
+                v_t = math.hypot(rel[0], rel[1])
+                slipping = u >= tol and v_t + abs(rel[2]) * rho > s.slip_speed
+                acc[4] += rel[2]
+                acc[5] += v_t
             else:
                 u, slipping = 0.0, False
             acc[:4] += w
-            acc[4] += rel[2] if np.isfinite(rel[2]) else 0.0
-            acc[5] += math.hypot(rel[0], rel[1]) if np.isfinite(rel[0]) else 0.0
             # the CoR seen from the contact point: the pad's springs shift the pad (and its
             # contact) from the mount-frame origin by their deflection
             acc[6] += math.hypot(cor[0] - d.qpos[qx], cor[1] - d.qpos[qy])
@@ -296,7 +324,7 @@ class MujocoRubbingRig:
         utilisation; ``c_tilde_true`` in gross sliding the CoR of the pad's actual slip over
         rho(f_n) (from MuJoCo's state), elsewhere the distance from the contact point to the
         prescribed CoR over rho(f_n), signed -sign(omega) (the two agree once the pad's slip
-        has settled; at small c~ that takes about a second, longer than most legs);
+        has settled, about 0.2 s into a leg);
         ``v_true`` the contact's slip speed and the
         log's ``omega`` the slider's angular velocity relative to the pad, both from MuJoCo's
         state (averages over each sample period)."""
@@ -312,8 +340,11 @@ class MujocoRubbingRig:
             k: [] for k in ("t", "f_n", "f_x", "f_y", "tau", "omega", "maneuver")
         }
         phase, load, c_tilde, v_true = [], [], [], []
+        f_n_dev = []
         for plan, t_start in zip(plans, starts):
             r = self.run_maneuver(plan, built)
+            moving = plan.commanded_phase() >= 1
+            f_n_dev.append(float(np.max(np.abs(r["f_n"][moving] / plan.f_n[moving] - 1.0))))
             f_n, f_x, f_y, tau = plan.sensor(r["f_n"], r["f_x"], r["f_y"], r["tau"])
             cols["t"].append(t_start + plan.t)
             cols["f_n"].append(f_n)
@@ -333,6 +364,14 @@ class MujocoRubbingRig:
             slip_ok = (ph == 2) & np.isfinite(r["c_tilde_slip"])
             c_tilde.append(np.where(slip_ok, r["c_tilde_slip"], c_geom))
             v_true.append(r["v"])
+        bounced = [i for i, dev in enumerate(f_n_dev) if dev > _BOUNCE]
+        if bounced:
+            warnings.warn(
+                f"MujocoRubbingRig: in maneuvers {bounced[:10]} the true normal force left the "
+                f"plan by more than {100 * _BOUNCE:.0f} % (MuJoCo's soft elliptic cone makes a "
+                "fast-sliding pad bounce; keep contact speeds below about 5 mm/s)",
+                stacklevel=2,
+            )
         cat = {k: np.concatenate(v) for k, v in cols.items()}
         log = SlidingLog.from_arrays(
             cat["t"],
@@ -352,7 +391,9 @@ class MujocoRubbingRig:
             "design": design.to_dict(),
             "pad": asdict(self.pad),
             "settings": asdict(self.settings),
-            "wall_time_s": time.perf_counter() - wall,
+            "seconds": time.perf_counter() - wall,
+            "normal_force_deviation_max": max(f_n_dev),
+            "normal_force_bounce_maneuvers": bounced,
         }
         return RubbingData(
             log=log,
@@ -363,3 +404,101 @@ class MujocoRubbingRig:
             truth=self.truth(),
             meta=meta,
         )
+
+
+def _sweep_plan(rig: MujocoRubbingRig, c_tilde: float, f_n: float) -> ManeuverPlan:
+    """A rub about a CoR at c_tilde rho at 3 mm/s contact speed (1 rad/s at most), 0.4 s of
+    sliding, then 0.4 s of loaded rest; no sensor noise."""
+    rho = float(rig.radius(f_n))
+    omega = min(1.0, 3e-3 / (c_tilde * rho)) if c_tilde > 0 else 1.0
+    kt = np.array([0.0, 0.1, 0.15, 0.55, 0.6])
+    kw = np.array([0.0, 0.0, omega, omega, 0.0])
+    t = np.arange(int(1.0 / 0.002) + 1) * 0.002
+    c = c_tilde * rho
+    return ManeuverPlan(
+        index=0, t=t, knots_t=kt, knots_omega=kw, cor=np.array([c, 0.0]), c_tilde=c_tilde,
+        rho_nominal=rho, f_n_nominal=f_n, approach=0.1, motion_end=0.6, f_n_start=1.0,
+        ripple=0.0, ripple_freq=1.0, ripple_phase=0.0, reversals=0, offset=np.zeros(4),
+        noise=(0.0, 0.0), noise_seed=0,
+    )  # fmt: skip
+
+
+#: (label, changes to the rig's model after it is built) compared by :func:`settings_sweep`
+SWEEP_SETTINGS = (
+    ("rig defaults: elliptic, noslip 10, impratio 10, solref 2 ms, explicit pad damping", {}),
+    ("noslip 5", {"noslip_iterations": 5}),
+    ("noslip 0", {"noslip_iterations": 0}),
+    ("pad damping as MuJoCo joint damping (implicit)", {"implicit_damping": True}),
+    ("contact solref 4 ms", {"solref": 0.004}),
+    ("impratio 1", {"impratio": 1.0}),
+)
+
+
+def settings_sweep(c_tilde: float = 1.0, f_n: float = 4.0) -> list[dict]:
+    """Stick, creep and sliding of the rig under each MuJoCo setting of
+    :data:`SWEEP_SETTINGS`, on one rub (:func:`_sweep_plan`). Per row: slip of the stuck pad
+    while its load builds [um], creep at the loaded rest [um/s], the load left at the end of
+    the rest, and the largest departure of the sliding wrench from the elliptic cone."""
+    rows = []
+    for label, change in SWEEP_SETTINGS:
+        pad = MujocoRubbingRig().pad
+        if "solref" in change:
+            pad = dataclasses.replace(pad, solref=(change["solref"], 1.0))
+        rig = MujocoRubbingRig(pad=pad)
+        m, d, p = rig.build()
+        if "noslip_iterations" in change:
+            m.opt.noslip_iterations = change["noslip_iterations"]
+        if "impratio" in change:
+            m.opt.impratio = change["impratio"]
+        if change.get("implicit_damping"):
+            m.dof_damping[p.joint_dof] = p._damping
+            p._damping = np.zeros(3)
+        plan = _sweep_plan(rig, c_tilde, f_n)
+        r = rig.run_maneuver(plan, (m, d, p))
+        ph = plan.commanded_phase()
+        dt = float(plan.t[1] - plan.t[0])
+        rho = rig.radius(r["f_n"])
+        speed = r["v"] + np.abs(r["omega"]) * rho
+        first = int(np.argmax((ph == 1) & r["sliding"])) if np.any(r["sliding"]) else len(ph)
+        build = (ph == 1) & (np.arange(len(ph)) < first) & (r["utilisation"] < 0.9)
+        rest = (ph == 3) & (plan.t > plan.motion_end + 0.05)
+        slide = (ph == 1) & r["sliding"]
+        rows.append(
+            {
+                "setting": label,
+                "onset_slip_um": 1e6 * float(np.sum(speed[build]) * dt),
+                "rest_creep_um_s": 1e6 * float(np.mean(speed[rest])),
+                "rest_load_end": float(r["load_ratio"][-1]),
+                "rest_load_start": float(r["load_ratio"][rest][0]),
+                "sliding_off_cone": float(np.max(np.abs(r["utilisation"][slide] - 1.0)))
+                if slide.any()
+                else float("nan"),
+            }
+        )
+    return rows
+
+
+def main(argv=None) -> int:
+    """``python -m lugrip.rigs.mujoco_rig [--c-tilde C] [--f-n F]``: the settings table."""
+    import argparse
+
+    ap = argparse.ArgumentParser(description=main.__doc__)
+    ap.add_argument("--c-tilde", type=float, default=1.0)
+    ap.add_argument("--f-n", type=float, default=4.0)
+    args = ap.parse_args(argv)
+    print(
+        "| MuJoCo setting | slip while the load builds [um] | creep at loaded rest [um/s] "
+        "| load at rest start -> end | sliding wrench off the cone |"
+    )
+    print("|---|---|---|---|---|")
+    for row in settings_sweep(args.c_tilde, args.f_n):
+        print(
+            f"| {row['setting']} | {row['onset_slip_um']:.2f} | {row['rest_creep_um_s']:.3g} "
+            f"| {row['rest_load_start']:.3f} -> {row['rest_load_end']:.3f} "
+            f"| {row['sliding_off_cone']:.1e} |"
+        )
+    return 0
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())

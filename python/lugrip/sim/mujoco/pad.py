@@ -67,6 +67,11 @@ CONTACT_OPTIONS: dict[str, object] = {
 #: the contact dimensionality of every pad pair: normal, two tangential, torsional
 CONDIM = 4
 
+_NO_CONTACT = np.empty(0, dtype=int)
+_FIRST_CONTACT = np.zeros(1, dtype=int)
+_NO_CONTACT.setflags(write=False)
+_FIRST_CONTACT.setflags(write=False)
+
 
 def contact_options_xml(gravity: Sequence[float] = (0.0, 0.0, -9.81), **overrides) -> str:
     """The MJCF ``<option>`` element with :data:`CONTACT_OPTIONS` (keys may be overridden)."""
@@ -89,14 +94,16 @@ class PadSpec:
     """Geometry, compliance and friction law of one fingertip pad."""
 
     name: str = "pad"  #: prefix of the pad's MJCF names (body, joints, geom, pairs)
-    shape: str = "sphere"  #: "sphere" (hemispherical pad) or "disc" (flat round pad)
+    #: "sphere" (hemispherical pad) or "disc" (flat round pad: an oblate ellipsoid, radius by
+    #: thickness / 2, whose face touches at one point)
+    shape: str = "sphere"
     radius: float = 0.012  #: sphere radius or disc radius [m]
     thickness: float = 0.004  #: disc thickness [m] (sphere: unused)
-    mass: float = 0.005  #: pad body mass [kg]
-    k_slide: float = 2000.0  #: in-plane stiffness of each slide joint [N/m]
-    d_slide: float = 4.0  #: in-plane damping [N s/m]
-    k_twist: float = 0.1  #: twist stiffness about the pad normal [N m/rad]
-    d_twist: float = 2.5e-4  #: twist damping [N m s/rad]
+    mass: float = 0.04  #: pad body mass [kg] (with k_slide: 1 ms steps resolve its mode)
+    k_slide: float = 40000.0  #: in-plane stiffness of each slide joint [N/m]
+    d_slide: float = 40.0  #: in-plane damping [N s/m] (damping ratio 0.5)
+    k_twist: float = 0.2  #: twist stiffness about the pad normal [N m/rad]
+    d_twist: float = 6.8e-4  #: twist damping [N m s/rad] (damping ratio 0.5)
     mu: float = 0.7  #: Coulomb friction coefficient of the pad pairs [-]
     delta: float = 1.8e-3  #: contact radius law rho = delta f_n^gamma [m / N^gamma]
     gamma: float = 0.254  #: contact radius exponent [-]
@@ -163,31 +170,42 @@ class PadSpec:
         if self.shape == "sphere":
             i = 0.4 * m * r * r
             return (i, i, i)
-        h = self.thickness
-        ixy = m * (3 * r * r + h * h) / 12.0
-        return (ixy, ixy, 0.5 * m * r * r)
+        c = 0.5 * self.thickness  # ellipsoid semi-axes r, r, c
+        ixy = 0.2 * m * (r * r + c * c)
+        return (ixy, ixy, 0.4 * m * r * r)
 
 
 def _fmt(v: Iterable[float]) -> str:
     return " ".join(f"{x:.10g}" for x in v)
 
 
-def pad_body_xml(spec: PadSpec, pos: Sequence[float] = (0.0, 0.0, 0.0), quat=None) -> str:
+def pad_body_xml(
+    spec: PadSpec, pos: Sequence[float] = (0.0, 0.0, 0.0), quat=None, gravcomp: float = 0.0
+) -> str:
     """The MJCF ``<body>`` of the pad, to be placed inside its finger's body.
 
     ``pos``/``quat`` place the pad frame in the finger's frame; the pad frame's -z points out
     of the face toward the object. The geom's face (its front-most point) is at the pad
-    frame's origin, the geom extends toward +z (into the finger).
+    frame's origin, the geom extends toward +z (into the finger). ``gravcomp`` is MuJoCo's
+    gravity compensation of the pad body (1: its weight does not load its springs).
     """
     q = "" if quat is None else f' quat="{_fmt(quat)}"'
+    if gravcomp:
+        q += f' gravcomp="{float(gravcomp):.10g}"'
     jx, jy, jt = spec.joint_names
     ixx, iyy, izz = spec.inertia()
     if spec.shape == "sphere":
         centre = (0.0, 0.0, spec.radius)
         geom = f'type="sphere" size="{spec.radius:.10g}"'
     else:
+        # an oblate ellipsoid: a round, nearly flat face (curvature radius radius^2 / (thickness
+        # / 2) at its centre) that touches at one point, so the torsional law holds (a cylinder
+        # would touch at several rim points, each with its own torsional friction)
         centre = (0.0, 0.0, 0.5 * spec.thickness)
-        geom = f'type="cylinder" size="{spec.radius:.10g} {0.5 * spec.thickness:.10g}"'
+        geom = (
+            f'type="ellipsoid" size="{spec.radius:.10g} {spec.radius:.10g} '
+            f'{0.5 * spec.thickness:.10g}"'
+        )
     return (
         f'<body name="{spec.body_name}" pos="{_fmt(pos)}"{q}>'
         f'<joint name="{jx}" type="slide" axis="1 0 0" stiffness="{spec.k_slide:.10g}"/>'
@@ -256,7 +274,9 @@ class FingertipSensor:
 class Pad:
     """One pad in a compiled MuJoCo model: its torsional law and its sensor wrench.
 
-    ``Pad(model, spec)`` finds the pad's body, geom and pairs by their names. Each step::
+    ``Pad(model, spec)`` finds the pad's body, geom and pairs by their names. :meth:`update`
+    writes the pairs' torsional coefficient into ``model.pair_friction``: one model per
+    simulation (a model shared by several ``MjData`` shares that coefficient). Each step::
 
         pad.update(model, data)     # torsional coefficient, the springs' damping
         mujoco.mj_step(model, data)
@@ -316,7 +336,8 @@ class Pad:
         micrometres per second under load, even with noslip)."""
         if f_n is None:
             f_n = self._normal_force(model, data) if data is not None else self.f_n_last
-        spin = float(self.spec.spin_coefficient(f_n))
+        sp = self.spec
+        spin = sp.mu * sp.xi * sp.delta * max(float(f_n), sp.f_n_floor) ** sp.gamma
         if spin != self._spin_set:
             model.pair_friction[self.pair_ids, 2] = spin
             self._spin_set = spin
@@ -328,17 +349,21 @@ class Pad:
         """(origin, R) of the pad frame in world coordinates; columns of R are x, y, z."""
         return data.xpos[self.body_id].copy(), data.xmat[self.body_id].reshape(3, 3).copy()
 
-    def contacts(self, data) -> list[int]:
+    def contacts(self, data) -> np.ndarray:
         """Indices of the present contacts that involve the pad's geom."""
+        n = data.ncon
+        if n == 0:
+            return _NO_CONTACT
+        geom = data.contact.geom
         g = self.geom_id
-        return [
-            i for i in range(data.ncon) if data.contact[i].geom1 == g or data.contact[i].geom2 == g
-        ]
+        if n == 1:  # the common case, without numpy's per-call overhead
+            return _FIRST_CONTACT if g in (geom[0, 0], geom[0, 1]) else _NO_CONTACT
+        return np.flatnonzero((geom[:, 0] == g) | (geom[:, 1] == g))
 
     def _normal_force(self, model, data) -> float:
         total = 0.0
         for i in self.contacts(data):
-            self._mj.mj_contactForce(model, data, i, self._f6)
+            self._mj.mj_contactForce(model, data, int(i), self._f6)
             total += self._f6[0]
         return total
 
@@ -346,37 +371,36 @@ class Pad:
         """(f_n, f_x, f_y, tau): the wrench the object exerts on the pad, in the pad frame
         [N, N, N, N m], its moment taken about the centre of pressure of the pad's contacts
         (with one contact: the contact point). Zero without contact."""
-        _, R = self.frame(data)
-        force = np.zeros(3)
-        moment = np.zeros(3)
-        points = []
-        for i in self.contacts(data):
-            c = data.contact[i]
-            self._mj.mj_contactForce(model, data, i, self._f6)
-            basis = np.asarray(c.frame).reshape(3, 3)  # rows: normal (geom1 -> geom2), tangents
-            f_on_geom2 = basis.T @ self._f6[:3]
-            spin_on_geom2 = self._f6[3] * basis[0]
-            sign = -1.0 if c.geom1 == self.geom_id else 1.0  # reaction when the pad is geom1
-            f = sign * f_on_geom2
-            force += f
-            moment += sign * spin_on_geom2
-            points.append((np.asarray(c.pos, dtype=float).copy(), f))
         out = np.zeros(4)
-        if not points:
+        idx = self.contacts(data)
+        if idx.size == 0:
             self.f_n_last = 0.0
             return out
-        if len(points) > 1:
+        R = data.xmat[self.body_id].reshape(3, 3)
+        con = data.contact
+        f6 = self._f6
+        forces = np.empty((idx.size, 3))
+        moment = np.zeros(3)
+        for j, i in enumerate(idx):
+            self._mj.mj_contactForce(model, data, int(i), f6)
+            basis = con.frame[i].reshape(3, 3)  # rows: normal (geom1 -> geom2), tangents
+            # the force and spin moment on geom2; their reaction when the pad is geom1
+            sign = -1.0 if con.geom[i, 0] == self.geom_id else 1.0
+            forces[j] = sign * (f6[0] * basis[0] + f6[1] * basis[1] + f6[2] * basis[2])
+            moment += (sign * f6[3]) * basis[0]
+        if idx.size > 1:
             # moment of the contact forces about their centre of pressure
-            weights = np.array([max(float(f @ R[:, 2]), 0.0) for _, f in points])
-            ps = np.array([p for p, _ in points])
-            cop = (weights @ ps) / weights.sum() if weights.sum() > 0 else ps.mean(axis=0)
-            for p, f in points:
-                moment += np.cross(p - cop, f)
-        local_f = R.T @ force
-        out[0] = local_f[2]
-        out[1] = local_f[0]
-        out[2] = local_f[1]
-        out[3] = float(moment @ R[:, 2])
+            points = con.pos[idx]
+            weights = np.maximum(forces @ R[:, 2], 0.0)
+            total = weights.sum()
+            cop = (weights @ points) / total if total > 0 else points.mean(axis=0)
+            moment += np.cross(points - cop, forces).sum(axis=0)
+        force = forces.sum(axis=0)
+        local = force @ R  # pad-frame components (R's columns are the pad axes)
+        out[0] = local[2]
+        out[1] = local[0]
+        out[2] = local[1]
+        out[3] = moment @ R[:, 2]
         self.f_n_last = float(out[0])
         return out
 
@@ -391,12 +415,13 @@ class Pad:
         the velocity before the step).
         """
         idx = self.contacts(data)
-        if not idx:
+        if idx.size == 0:
             return np.full(3, np.nan)
-        c = data.contact[idx[0]]
-        other = c.geom2 if c.geom1 == self.geom_id else c.geom1
+        g1, g2 = data.contact.geom[idx[0]]
+        other = g2 if g1 == self.geom_id else g1
         other_body = int(model.geom_bodyid[other])
-        o, R = self.frame(data)
+        o = data.xpos[self.body_id]
+        R = data.xmat[self.body_id].reshape(3, 3)
         mj = self._mj
         if self._jac is None or self._jac[0].shape[1] != model.nv:
             self._jac = (np.zeros((3, model.nv)), np.zeros((3, model.nv)))
