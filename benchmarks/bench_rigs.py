@@ -25,10 +25,9 @@ import numpy as np
 
 HERE = Path(__file__).resolve().parent
 sys.path.insert(0, str(HERE))
-from sections import markers, write_section  # noqa: E402
-
-from lugrip.rigs import GridContactRig, RubbingDesign, plan_maneuvers  # noqa: E402
-from lugrip.rigs.model_rigs import LumpedRig, PatchRig  # noqa: E402
+from lugrip.rigs import GridContactRig, RubbingDesign, plan_maneuvers
+from lugrip.rigs.model_rigs import LumpedRig, PatchRig
+from sections import markers, write_section
 
 SECTION = "rigs"
 TARGET_S = 60.0  # [s] 160 maneuvers of the grid plant on one core
@@ -79,24 +78,23 @@ def main(argv=None) -> int:
         rows.append((rig.name, "per maneuver (Python loop over samples)", n, len(data), sec))
 
     begin, end = markers(SECTION)
-    lines = [begin, "", "## Rubbing rigs: generation speed and content", "",
-             f"`python benchmarks/bench_rigs.py --maneuvers {n}` on {platform.machine()} "
+    intro = (f"`python benchmarks/bench_rigs.py --maneuvers {n}` on {platform.machine()} "
              f"({os.cpu_count()} cores, one used), numpy {np.__version__}; default "
-             "`RubbingDesign`, seed "
-             f"{args.seed}. Target: {n if n == 160 else 160} grid maneuvers in <= "
-             f"{TARGET_S:g} s on one core (docs/rigs.md).", "",
+             f"`RubbingDesign`, seed {args.seed}. Target: 160 grid maneuvers in <= "
+             f"{TARGET_S:g} s on one core (docs/rigs.md).")
+    lines = [begin, "", "## Rubbing rigs: generation speed and content", "", intro, "",
              "| plant | integration | maneuvers | samples | time [s] | samples/s |",
              "|---|---|---|---|---|---|"]
     for name, how, m, samples, sec in rows:
         lines.append(f"| {name} | {how} | {m} | {samples} | {sec:.2f} | {samples / sec:,.0f} |")
     vec = rows[0][3] / rows[0][4]
     base = rows[2][3] / rows[2][4]
-    lines += ["", f"Vectorising over maneuvers is {vec / base:.1f}x faster per sample than the "
-              "same plant one maneuver at a time.", "",
-              "What the data hold (all samples of each set):", "",
-              "| plant | approach | presliding | sliding | rest | presliding duration "
+    gain = (f"Vectorising over maneuvers is {vec / base:.1f}x faster per sample than the "
+            "same plant one maneuver at a time.")
+    header = ("| plant | approach | presliding | sliding | rest | presliding duration "
               "median (5-95 %) [ms] | load ratio in sliding 5/50/95 % | mu_s / mu_k | "
-              "beta_A [N s/m^3] | tau_max(2 N), tau_max(8 N) [N m] |",
+              "beta_A [N s/m^3] | tau_max(2 N), tau_max(8 N) [N m] |")
+    lines += ["", gain, "", "What the data hold (all samples of each set):", "", header,
               "|---|---|---|---|---|---|---|---|---|---|"]
     for name, d in sets.items():
         share = [100.0 * np.mean(d.phase == k) for k in range(4)]
@@ -110,10 +108,11 @@ def main(argv=None) -> int:
             f"{np.percentile(pre, 95):.0f}) | {lr[0]:.2f} / {lr[1]:.2f} / {lr[2]:.2f} | "
             f"{tr.mu_static:g} / {tr.mu_kinetic:g} | {beta} | "
             f"{tr.tau_max(2.0):.3e}, {tr.tau_max(8.0):.3e} |")
-    lines += ["", "The load ratio is the friction torque about the prescribed CoR over the "
-              "plant's full-sliding torque about it at static friction; with the viscous shear "
-              "it exceeds 1 where the viscous part is large. The lumped and patch rigs use "
-              "the aluminium_can preset.", "", end, ""]
+    note = ("The load ratio is the friction torque about the prescribed CoR over the "
+            "plant's full-sliding torque about it at static friction; with the viscous shear "
+            "it exceeds 1 where the viscous part is large. The lumped and patch rigs use "
+            "the aluminium_can preset.")
+    lines += ["", note, "", end, ""]
     text = "\n".join(lines)
     write_section(args.out, text, SECTION)
     print(text)

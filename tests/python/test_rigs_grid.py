@@ -19,7 +19,6 @@ import numpy as np
 import pytest
 from hypothesis import given
 from hypothesis import strategies as st
-
 from lugrip.cli import main
 from lugrip.rigs import (
     GridContactRig,
@@ -39,7 +38,7 @@ XI_HERTZ = 3.0 * math.pi / 16.0  # int p r dA / (f_n rho) for p ~ sqrt(1 - r^2/r
 def _plan(cor, knots_t, knots_w, *, f_n=F_N, duration=None, dt=0.002) -> ManeuverPlan:
     """A noiseless, ripple-free plan with the given pad angular-velocity knots."""
     duration = knots_t[-1] if duration is None else duration
-    t = np.arange(int(round(duration / dt)) + 1) * dt
+    t = np.arange(round(duration / dt) + 1) * dt
     return ManeuverPlan(
         index=0, t=t, knots_t=np.asarray(knots_t, float), knots_omega=np.asarray(knots_w, float),
         cor=np.asarray(cor, float), c_tilde=0.0, rho_nominal=1.0, f_n_nominal=f_n,

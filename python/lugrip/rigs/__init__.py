@@ -15,14 +15,14 @@ See docs/rigs.md.
 """
 
 from ._data import PHASES, RigTruth, RubbingData
-from .motion import ManeuverPlan, RubbingDesign, plan_maneuvers, stack_times
 from .grid import GridContactRig
+from .motion import ManeuverPlan, RubbingDesign, plan_maneuvers, stack_times
 from .registry import PLANTS, make_rig
 
 __all__ = [
-    "GridContactRig",
     "PHASES",
     "PLANTS",
+    "GridContactRig",
     "ManeuverPlan",
     "RigTruth",
     "RubbingData",

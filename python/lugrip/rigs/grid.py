@@ -23,8 +23,11 @@ equations (docs/rigs.md):
 * the sensor reads the sum of the cell forces and their moment about the patch centre.
 
 The bristles are stiff, so every internal step uses the exact solution of the bristle
-equation for the velocity frozen at the step's midpoint. All maneuvers and cells are
-integrated together as (maneuvers x cells) numpy arrays.
+equation for the velocity frozen at the step's midpoint; the cell positions are held over
+each sample interval (radius at the interval's mean force). All maneuvers of a batch and all
+cells are integrated together as (maneuvers x cells) numpy arrays; the sums over cells are
+matrix-vector products, and the uniform viscous shear, linear in position, is summed over
+the cells in closed form.
 """
 
 from __future__ import annotations
@@ -38,7 +41,7 @@ import numpy as np
 
 from ._data import RigTruth, RubbingData
 from ._run import RigRun, assemble
-from .motion import ManeuverPlan, RubbingDesign, plan_maneuvers, stack_times
+from .motion import ManeuverPlan, RubbingDesign, plan_maneuvers
 
 __all__ = ["GridContactRig"]
 
@@ -186,12 +189,13 @@ class GridContactRig:
     def _run_batch(self, plans: list[ManeuverPlan], S: int) -> list[RigRun]:
         u, w, area = self.cells()
         ux, uy = u[:, 0][None, :], u[:, 1][None, :]
-        w = w[None, :]
+        wx, wy = w * u[:, 0], w * u[:, 1]  # load-weighted cell positions (unit disc)
+        w_r2 = float(np.sum(u * u))  # sum |u_i|^2 (viscous moment)
+        n_cells = u.shape[0]
         M = len(plans)
         L = max(len(p) for p in plans)
         dt = float(plans[0].t[1] - plans[0].t[0]) if L > 1 else 1.0
         h = dt / S
-        t_s = np.arange(L) * dt
         # per-sample inputs, padded past each plan's end with rest at the last force
         fn_s = np.empty((M, L))
         w_s = np.zeros((M, L))
@@ -209,64 +213,88 @@ class GridContactRig:
         cx = np.array([p.cor[0] for p in plans])[:, None]
         cy = np.array([p.cor[1] for p in plans])[:, None]
         rho_s = self.rho(fn_s)
-        zx = np.zeros((M, u.shape[0]))
+        zx = np.zeros((M, n_cells))
         zy = np.zeros_like(zx)
         dmu = self.mu_s - self.mu_k
         inv_vs2 = 1.0 / self.v_s ** 2
         res = {k: np.zeros((M, L)) for k in ("fx", "fy", "tau", "tau_cor", "cap", "slide")}
+        speed, s, x, tmp = (np.empty((M, n_cells)) for _ in range(4))
 
-        def kinematics(omega, rho):
-            rx, ry = rho[:, None] * ux, rho[:, None] * uy
-            dx, dy = rx - cx, ry - cy
-            vx, vy = -omega[:, None] * dy, omega[:, None] * dx
-            speed = np.abs(omega)[:, None] * np.hypot(dx, dy)
-            s = self.mu_k + dmu * np.exp(-(speed * speed) * inv_vs2)
-            return rx, ry, dx, dy, vx, vy, speed, s
+        def geometry(rho):
+            """Cell offsets from the CoR, their distance and the unit direction in which the
+            slider moves there for omega > 0."""
+            dx, dy = rho * ux - cx, rho * uy - cy
+            dn = np.hypot(dx, dy)
+            safe = np.where(dn > 0.0, dn, 1.0)
+            return dx, dy, dn, -dy / safe, dx / safe
 
-        def sample(k):
-            fn, rho, omega = fn_s[:, k], rho_s[:, k], w_s[:, k]
-            rx, ry, dx, dy, vx, vy, speed, s = kinematics(omega, rho)
-            a = self.sigma0 * speed / s
-            load = fn[:, None] * w
+        def stribeck(omega, dn):
+            """|v| and s(|v|) of every cell into the buffers speed and s."""
+            np.multiply(np.abs(omega), dn, out=speed)
+            np.multiply(speed, speed, out=s)
+            np.multiply(s, -inv_vs2, out=s)
+            np.exp(s, out=s)
+            np.multiply(s, dmu, out=s)
+            np.add(s, self.mu_k, out=s)
+
+        def sample(k, geo):
+            fn, omega = fn_s[:, k], w_s[:, k][:, None]
+            rho = rho_s[:, k]
+            _, _, dn, ex, ey = geo
+            stribeck(omega, dn)
+            # bristle force per unit cell load: sigma0 z + sigma1 dz/dt + sigma2 v
+            vx, vy = omega * dn * ex, omega * dn * ey
             cell_x = self.sigma0 * zx
             cell_y = self.sigma0 * zy
             if self.sigma1 > 0.0:
-                cell_x = cell_x + self.sigma1 * (vx - a * zx)
-                cell_y = cell_y + self.sigma1 * (vy - a * zy)
+                a = self.sigma0 * speed / s
+                cell_x += self.sigma1 * (vx - a * zx)
+                cell_y += self.sigma1 * (vy - a * zy)
             if self.sigma2 > 0.0:
-                cell_x = cell_x + self.sigma2 * vx
-                cell_y = cell_y + self.sigma2 * vy
-            fx = load * cell_x
-            fy = load * cell_y
+                cell_x += self.sigma2 * vx
+                cell_y += self.sigma2 * vy
+            fx = fn * (cell_x @ w)
+            fy = fn * (cell_y @ w)
+            tau = fn * rho * (cell_y @ wx - cell_x @ wy)
             if self.beta_a > 0.0:
-                visc = self.beta_a * area * (rho * rho)[:, None]
-                fx = fx + visc * vx
-                fy = fy + visc * vy
-            res["fx"][:, k] = fx.sum(axis=1)
-            res["fy"][:, k] = fy.sum(axis=1)
-            res["tau"][:, k] = (rx * fy - ry * fx).sum(axis=1)
-            res["tau_cor"][:, k] = (dx * fy - dy * fx).sum(axis=1)
-            res["cap"][:, k] = self.mu_s * fn * (w * np.hypot(dx, dy)).sum(axis=1)
+                # uniform shear beta_A A v summed over the cells (the grid is symmetric, so
+                # sum u_i = 0): force beta_A A n omega (c_y, -c_x), moment beta_A A omega
+                # rho^2 sum |u_i|^2 about the centre
+                visc = self.beta_a * area * rho * rho * w_s[:, k]
+                fx = fx + visc * n_cells * cy[:, 0]
+                fy = fy - visc * n_cells * cx[:, 0]
+                tau = tau + visc * rho * rho * w_r2
+            res["fx"][:, k] = fx
+            res["fy"][:, k] = fy
+            res["tau"][:, k] = tau
+            res["tau_cor"][:, k] = tau - (cx[:, 0] * fy - cy[:, 0] * fx)
+            res["cap"][:, k] = self.mu_s * fn * (dn @ w)
             # a cell slides when it moves and its bristle has reached its sliding deflection
-            along = (zx * vx + zy * vy) / np.maximum(speed, 1e-300)
+            along = np.sign(omega) * (zx * ex + zy * ey)
             sliding = (speed > 0.0) & (self.sigma0 * along >= _STEADY * s)
-            res["slide"][:, k] = (w * sliding).sum(axis=1)
+            res["slide"][:, k] = sliding @ w
 
-        sample(0)
+        sample(0, geometry(rho_s[:, 0][:, None]))
+        rate = self.sigma0 * h
         for k in range(L - 1):
-            fn0, fn1 = fn_s[:, k], fn_s[:, k + 1]
+            # geometry held over the sample interval (radius at the mean force)
+            geo = geometry(self.rho(0.5 * (fn_s[:, k] + fn_s[:, k + 1]))[:, None])
+            dn, ex, ey = geo[2], geo[3], geo[4]
             for j in range(S):
-                frac = (j + 0.5) / S
-                omega = w_mid[:, k * S + j]
-                rho = self.rho(fn0 + frac * (fn1 - fn0))
-                _, _, _, _, vx, vy, speed, s = kinematics(omega, rho)
-                x = (self.sigma0 * h) * speed / s
-                decay = np.exp(-x)
-                # (1 - exp(-x)) / x, = 1 at x = 0
-                gain = np.where(x > 1e-12, -np.expm1(-x) / np.maximum(x, 1e-300), 1.0)
-                zx = zx * decay + (h * gain) * vx
-                zy = zy * decay + (h * gain) * vy
-            sample(k + 1)
+                omega = w_mid[:, k * S + j][:, None]
+                stribeck(omega, dn)
+                # exact bristle relaxation over h toward its sliding deflection s/sigma0 along v
+                np.divide(speed, s, out=x)
+                x *= -rate
+                np.expm1(x, out=x)  # -(1 - decay)
+                np.multiply(s, x, out=tmp)
+                tmp *= -np.sign(omega) / self.sigma0  # (1 - decay) * sliding deflection
+                x += 1.0  # decay
+                zx *= x
+                zx += tmp * ex
+                zy *= x
+                zy += tmp * ey
+            sample(k + 1, geo)
 
         runs = []
         for m, p in enumerate(plans):

@@ -341,7 +341,7 @@ def plan_maneuvers(design: RubbingDesign, n: int, seed: int = 0, *,
         kw.append(0.0)
         motion_end = t_now
         total = motion_end + rest
-        t = np.arange(int(math.floor(total / dt)) + 1) * dt
+        t = np.arange(math.floor(total / dt) + 1) * dt
         cor = c * np.array([math.cos(phi[i]), math.sin(phi[i])])
         offset = np.array([r.normal(0.0, design.offset_force),
                            r.normal(0.0, design.offset_force),
