@@ -166,7 +166,8 @@ NB_MODULE(_core, m) {
       .def_ro("inside", &CorOutput::inside)
       .def_ro("saturated", &CorOutput::saturated)
       .def_ro("iterations", &CorOutput::iterations)
-      .def_ro("status", &CorOutput::status);
+      .def_ro("status", &CorOutput::status)
+      .def_ro("c_tilde_unclipped", &CorOutput::c_tilde_unclipped);
 
   nb::class_<CorEstimator>(m, "CorEstimator")
       .def(nb::init<const ContactParams&, const CorSettings&>(), "params"_a, "settings"_a = CorSettings())
@@ -186,6 +187,7 @@ NB_MODULE(_core, m) {
              g = new_array<double>(n), s1 = new_array<double>(n), y = new_array<double>(n);
         auto inside = new_array<bool>(n), sat = new_array<bool>(n);
         auto iters = new_array<int32_t>(n), status = new_array<int32_t>(n);
+        auto c_free = new_array<double>(n);
         const double *pf = fn.data(), *pt = ft.data(), *pq = tau.data();
         {
           nb::gil_scoped_release release;
@@ -205,9 +207,11 @@ NB_MODULE(_core, m) {
             sat.data()[i] = o.saturated;
             iters.data()[i] = o.iterations;
             status.data()[i] = static_cast<int32_t>(o.status);
+            c_free.data()[i] = o.c_tilde_unclipped;
           }
         }
         nb::dict d;
+        d["c_tilde_unclipped"] = c_free;
         d["c_tilde"] = c_tilde; d["c"] = c; d["ft_tilde"] = ft_t; d["tau_tilde"] = tau_t;
         d["sigma"] = sigma; d["rho"] = rho; d["g"] = g; d["sigma_1"] = s1; d["y"] = y;
         d["inside"] = inside; d["saturated"] = sat; d["iterations"] = iters; d["status"] = status;
@@ -781,7 +785,10 @@ NB_MODULE(_core, m) {
       .def_ro("substeps_capped", &ObserverOutput::substeps_capped)
       .def_ro("substeps", &ObserverOutput::substeps)
       .def_ro("cor_iterations", &ObserverOutput::cor_iterations)
-      .def_ro("status", &ObserverOutput::status);
+      .def_ro("status", &ObserverOutput::status)
+      .def_ro("c_tilde_unclipped", &ObserverOutput::c_tilde_unclipped)
+      .def_ro("omega_object", &ObserverOutput::omega_object)
+      .def_ro("v_slip", &ObserverOutput::v_slip);
 
   nb::class_<Observer>(m, "Observer")
       .def(nb::init<const ContactParams&, const ObserverSettings&>(), "params"_a, "settings"_a = ObserverSettings())
@@ -806,6 +813,7 @@ NB_MODULE(_core, m) {
         auto obs = new_array<bool>(n), inside = new_array<bool>(n), sat = new_array<bool>(n),
              proj = new_array<bool>(n), div = new_array<bool>(n), cap = new_array<bool>(n);
         auto sub = new_array<int32_t>(n), iters = new_array<int32_t>(n), status = new_array<int32_t>(n);
+        auto cu = new_array<double>(n), wo = new_array<double>(n), vs = new_array<double>(n);
         const double *pf = fn.data(), *pt = ft.data(), *pq = tau.data(), *pd = dt.data();
         {
           nb::gil_scoped_release release;
@@ -819,6 +827,7 @@ NB_MODULE(_core, m) {
             inside.data()[i] = r.inside; sat.data()[i] = r.saturated; proj.data()[i] = r.projected;
             div.data()[i] = r.diverged; cap.data()[i] = r.substeps_capped; sub.data()[i] = r.substeps;
             iters.data()[i] = r.cor_iterations; status.data()[i] = static_cast<int32_t>(r.status);
+            cu.data()[i] = r.c_tilde_unclipped; wo.data()[i] = r.omega_object; vs.data()[i] = r.v_slip;
           }
         }
         nb::dict d;
@@ -827,6 +836,7 @@ NB_MODULE(_core, m) {
         d["speed_observable"] = obs; d["inside"] = inside; d["saturated"] = sat; d["projected"] = proj;
         d["diverged"] = div; d["substeps_capped"] = cap; d["substeps"] = sub; d["cor_iterations"] = iters;
         d["status"] = status;
+        d["c_tilde_unclipped"] = cu; d["omega_object"] = wo; d["v_slip"] = vs;
         return d;
       }, "f_n"_a, "f_t"_a, "tau"_a, "dt"_a, "Runs step() over 1-D arrays in C++ (dt 0: nominal); returns a dict of arrays.");
   // ===== end of observer block =============================================================

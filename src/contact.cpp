@@ -170,6 +170,33 @@ double ContactModel::solve_outside(double f, double t, int* iterations, double g
   return a;
 }
 
+double ContactModel::solve_outside_beyond(double f, double t, double a_limit, int* iterations) const noexcept {
+  const double xi2 = 2.0 * ls_.xi();
+  auto h = [&](double a, double& dh) {
+    const LsPoint q = ls_.eval(a);
+    dh = -q.dF - xi2 * (t - q.T) + xi2 * a * q.dT;
+    return f - q.F - xi2 * a * (t - q.T);
+  };
+  // h(c_max) > 0 and h -> -inf (t > 0): expand the bracket by factors of 4, then Newton in it.
+  double lo = p_.c_max, hi = p_.c_max, d = 0.0;
+  int evals = 0;
+  double v_hi = 1.0;
+  while (v_hi > 0.0) {
+    if (hi >= a_limit) {
+      if (iterations) *iterations = evals;
+      return a_limit;
+    }
+    lo = hi;
+    hi = std::min(4.0 * hi, a_limit);
+    v_hi = h(hi, d);
+    ++evals;
+  }
+  int it = 0;
+  const double a = bracketed_newton(h, 0.5 * (lo + hi), lo, hi, false, 1e-10, 0.0, 1e-14, kMaxIter, &it);
+  if (iterations) *iterations = evals + it;
+  return a;
+}
+
 void ContactModel::wrench_at(double f_n, double c_tilde, double y, double& f_t, double& tau) const noexcept {
   const double a = std::fabs(c_tilde), sign = y < 0.0 ? -1.0 : 1.0;
   const double rho_n = rho(f_n), unit = p_.mu * f_n * rho_n;  // g = unit * G(a)
@@ -233,6 +260,16 @@ void CorEstimator::reset() noexcept {
 }
 
 Status CorEstimator::step(const CorInput& in, CorOutput& out) noexcept {
+  const Status st = evaluate(in, out);
+  commit(out);
+  return st;
+}
+
+void CorEstimator::commit(const CorOutput& out) noexcept {
+  if (is_valid(out.status)) last_ = out;
+}
+
+Status CorEstimator::evaluate(const CorInput& in, CorOutput& out) const noexcept {
   const bool finite = std::isfinite(in.f_n) && std::isfinite(in.f_t) && std::isfinite(in.tau);
   if (!finite || std::fabs(in.f_n) > s_.force_limit || std::fabs(in.f_t) > s_.force_limit ||
       std::fabs(in.tau) > s_.torque_limit) {
@@ -260,6 +297,7 @@ Status CorEstimator::step(const CorInput& in, CorOutput& out) noexcept {
   }
   const double f = std::fabs(ft_t), t = std::fabs(tau_t);
   const double prev = last_.c_tilde;
+  const double prev_unclipped = last_.c_tilde_unclipped;
 
   // The result is assembled in locals and written field by field to last_ and out (no
   // zero-initialised temporary, no struct copy through the stack).
@@ -268,6 +306,7 @@ Status CorEstimator::step(const CorInput& in, CorOutput& out) noexcept {
   const double sigma = t > 0.0 ? std::copysign(std::fmin(f_pow / t, std::numeric_limits<double>::max()), in.tau)
                                : (f > 0.0 ? std::numeric_limits<double>::max() : 0.0);
   double a = 0.0, sign = 1.0;
+  double a_free = 0.0;        // |c~| before the clip
   LsPoint point;              // LS point at the final a when a branch already evaluated it
   double point_a = -1.0;
   Status status = Status::Ok;
@@ -275,6 +314,7 @@ Status CorEstimator::step(const CorInput& in, CorOutput& out) noexcept {
   bool inside;
   if (f < s_.zero_force && t < s_.zero_torque) {  // no wrench: the CoR is undefined
     a = std::fabs(prev);
+    a_free = std::max(std::fabs(prev_unclipped), a);
     sign = prev < 0.0 ? -1.0 : 1.0;
     inside = true;
     status = Status::Degenerate;
@@ -289,11 +329,18 @@ Status CorEstimator::step(const CorInput& in, CorOutput& out) noexcept {
     inside = f * f + t * t < q.F * q.F + q.T * q.T;
     if (inside) {
       a = a_sigma;
+      a_free = a_sigma;
       point = q;
     } else {
       int it2 = 0;
       a = model_.solve_outside(f, t, &it2, a_sigma, &point);
       iters += it2;
+      a_free = a;
+      if (a >= p.c_max) {  // the root lies at or past the clip: find it there too
+        int it3 = 0;
+        a_free = std::max(model_.solve_outside_beyond(f, t, kCTildeUnclippedMax, &it3), p.c_max);
+        iters += it3;
+      }
     }
     point_a = a;
     if (no_torque)  // sign of a torque below the noise: hold the previous side (hysteresis)
@@ -308,6 +355,7 @@ Status CorEstimator::step(const CorInput& in, CorOutput& out) noexcept {
     if (status == Status::Ok) status = Status::Saturated;
   }
   const double c_tilde = sign * a;
+  const double c_tilde_unclipped = sign * std::max(std::min(a_free, kCTildeUnclippedMax), a);
   const double c = c_tilde * rho;
   const LsPoint q = (a == point_a) ? point : ls.eval(a);
   const double r2 = rho * rho;
@@ -323,6 +371,7 @@ Status CorEstimator::step(const CorInput& in, CorOutput& out) noexcept {
     return out.status = Status::InvalidSample;
   }
   auto fill = [&](CorOutput& o) {
+    o.c_tilde_unclipped = c_tilde_unclipped;
     o.c_tilde = c_tilde;
     o.c = c;
     o.ft_tilde = ft_t;
@@ -337,7 +386,6 @@ Status CorEstimator::step(const CorInput& in, CorOutput& out) noexcept {
     o.iterations = iters;
     o.status = status;
   };
-  fill(last_);
   fill(out);
   return status;
 }

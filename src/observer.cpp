@@ -37,36 +37,43 @@ bool validate(const ObserverSettings& s, std::string* message) {
   auto bad = [&](const char* name, const std::string& value, const char* rule) {
     msg += std::string(name) + " = " + value + ": " + rule + "\n";
   };
-  auto positive = [&](const char* name, double v, const char* unit) {
-    if (!(std::isfinite(v) && v > 0.0)) bad(name, fmt(v), unit);
+  // v finite and in [lo, hi] (lo_open: v > lo)
+  auto within = [&](const char* name, double v, double lo, bool lo_open, double hi, const char* unit) {
+    if (!(std::isfinite(v) && (lo_open ? v > lo : v >= lo) && v <= hi))
+      bad(name, fmt(v), (std::string("must be finite, ") + (lo_open ? "> " : ">= ") + fmt(lo) + " and <= " +
+                         fmt(hi) + " " + unit).c_str());
   };
-  auto non_negative = [&](const char* name, double v, const char* unit) {
-    if (!(std::isfinite(v) && v >= 0.0)) bad(name, fmt(v), unit);
-  };
-  positive("dt", s.dt, "must be finite and > 0 [s]");
+  within("dt", s.dt, 1e-9, false, 10.0, "[s]");
   if (!(s.integrator == Integrator::Implicit || s.integrator == Integrator::Rk4 ||
         s.integrator == Integrator::Rk4Adaptive || s.integrator == Integrator::Rosenbrock))
     bad("integrator", std::to_string(static_cast<int>(s.integrator)), "unknown scheme (implicit, rk4, rk4_adaptive, rosenbrock)");
   if (!(s.gain_mode == GainMode::Fixed || s.gain_mode == GainMode::Bandwidth))
     bad("gain_mode", std::to_string(static_cast<int>(s.gain_mode)), "unknown mode (fixed, bandwidth)");
-  positive("gain", s.gain, "must be finite and > 0 [1/(kg m^2)]");
-  positive("bandwidth", s.bandwidth, "must be finite and > 0 [1/s]");
-  positive("gain_min", s.gain_min, "must be finite and > 0 [1/(kg m^2)]");
-  positive("gain_max", s.gain_max, "must be finite and > 0 [1/(kg m^2)]");
-  if (std::isfinite(s.gain_min) && std::isfinite(s.gain_max) && s.gain_min > s.gain_max)
+  within("gain", s.gain, 0.0, true, 1e15, "[1/(kg m^2)]");
+  within("bandwidth", s.bandwidth, 0.0, true, 1e9, "[1/s]");
+  within("gain_min", s.gain_min, 0.0, true, 1e15, "[1/(kg m^2)]");
+  within("gain_max", s.gain_max, 0.0, true, 1e15, "[1/(kg m^2)]");
+  if (std::isfinite(s.gain_min) && std::isfinite(s.gain_max) && s.gain_min > 0.0 && s.gain_max <= 1e15 &&
+      s.gain_min > s.gain_max)
     bad("gain_max", fmt(s.gain_max), "must be >= gain_min");
-  positive("g_floor", s.g_floor, "must be finite and > 0 [N m]");
-  non_negative("torque_cutoff", s.torque_cutoff, "must be finite and >= 0 [Hz] (0: no filter)");
-  non_negative("cor_sign_sigmas", s.cor_sign_sigmas, "must be finite and >= 0 [-]");
-  if (!(s.max_invalid >= 1)) bad("max_invalid", std::to_string(s.max_invalid), "must be >= 1");
-  if (!(std::isfinite(s.max_dt_gap) && s.max_dt_gap > 0.0 && !(s.max_dt_gap < s.dt)))
-    bad("max_dt_gap", fmt(s.max_dt_gap), "must be finite and >= dt [s]");
-  non_negative("torque_noise", s.torque_noise, "must be finite and >= 0 [N m]");
-  positive("resolution_max", s.resolution_max, "must be finite and > 0 [rad/s]");
-  positive("omega_limit", s.omega_limit, "must be finite and > 0 [rad/s]");
+  within("g_floor", s.g_floor, 0.0, true, 1.0, "[N m]");
+  within("torque_cutoff", s.torque_cutoff, 0.0, false, 1e9, "[Hz] (0: no filter)");
+  within("cor_sign_sigmas", s.cor_sign_sigmas, 0.0, false, 1e3, "[-]");
+  if (!(s.max_invalid >= 1 && s.max_invalid <= 1000000))
+    bad("max_invalid", std::to_string(s.max_invalid), "must be >= 1 and <= 1000000");
+  if (!(std::isfinite(s.max_dt_gap) && s.max_dt_gap > 0.0 && !(s.max_dt_gap < s.dt) && s.max_dt_gap <= 10.0))
+    bad("max_dt_gap", fmt(s.max_dt_gap), "must be finite, >= dt and <= 10 [s]");
+  const double torque_range = std::isfinite(s.cor.torque_limit) && s.cor.torque_limit > 0.0 ? s.cor.torque_limit : 0.0;
+  if (!(std::isfinite(s.torque_noise) && s.torque_noise >= 0.0 && s.torque_noise <= torque_range))
+    bad("torque_noise", fmt(s.torque_noise), "must be finite, >= 0 and <= cor.torque_limit [N m]");
+  within("omega_limit", s.omega_limit, 0.0, true, 1e6, "[rad/s]");
+  const double omega_range = std::isfinite(s.omega_limit) && s.omega_limit > 0.0 ? std::min(s.omega_limit, 1e6) : 1e6;
+  if (!(std::isfinite(s.resolution_max) && s.resolution_max > 0.0 && s.resolution_max <= omega_range))
+    bad("resolution_max", fmt(s.resolution_max), "must be finite, > 0 and <= omega_limit [rad/s]");
   if (!(s.substeps >= 1)) bad("substeps", std::to_string(s.substeps), "must be >= 1");
-  if (!(s.max_substeps >= 1)) bad("max_substeps", std::to_string(s.max_substeps), "must be >= 1");
-  if (s.substeps >= 1 && s.max_substeps >= 1 && s.substeps > s.max_substeps)
+  if (!(s.max_substeps >= 1 && s.max_substeps <= kMaxObserverSubsteps))
+    bad("max_substeps", std::to_string(s.max_substeps), "must be >= 1 and <= 5000");
+  else if (s.substeps >= 1 && s.substeps > s.max_substeps)
     bad("max_substeps", std::to_string(s.max_substeps), "must be >= substeps");
   std::string cor_msg;
   if (!validate(s.cor, &cor_msg)) {
@@ -77,6 +84,16 @@ bool validate(const ObserverSettings& s, std::string* message) {
       if (end == std::string::npos) break;
       start = end + 1;
     }
+  } else {
+    // Narrower than the estimator alone accepts: keeps |y|, g / sigma0 and v_slip finite.
+    if (!(s.cor.f_n_min >= kMinContactForce))
+      bad("cor.f_n_min", fmt(s.cor.f_n_min), "must be >= 1e-06 [N] in an observer");
+    if (!(s.cor.force_limit <= kMaxForceLimit))
+      bad("cor.force_limit", fmt(s.cor.force_limit), "must be <= 1e+09 [N] in an observer");
+    if (!(s.cor.torque_limit <= kMaxForceLimit))
+      bad("cor.torque_limit", fmt(s.cor.torque_limit), "must be <= 1e+09 [N m] in an observer");
+    if (s.cor.f_n_min >= kMinContactForce && s.cor.force_limit <= kMaxForceLimit && !(s.cor.f_n_min < s.cor.force_limit))
+      bad("cor.f_n_min", fmt(s.cor.f_n_min), "must be < cor.force_limit");
   }
   if (message) *message = msg;
   return msg.empty();
@@ -124,6 +141,39 @@ void Observer::reset() noexcept {
   last_ = ObserverOutput();
 }
 
+Status Observer::reject(double dt, ObserverOutput& out) noexcept {
+  // State untouched; the skipped time is integrated with the next valid sample (or, beyond
+  // max_dt_gap, causes a re-initialisation).
+  pending_ = std::min(pending_ + dt, 1.0e9);
+  if (invalid_run_ < s_.max_invalid) ++invalid_run_;
+  out = last_;
+  out.substeps = 0;
+  out.cor_iterations = 0;
+  out.diverged = false;
+  out.substeps_capped = false;
+  if (invalid_run_ >= s_.max_invalid) {
+    need_init_ = true;
+    return out.status = Status::SensorFault;
+  }
+  return out.status = Status::InvalidSample;
+}
+
+namespace {
+// omega_object and v_slip from omega_hat about the clipped CoR (a = |c~|) and the unclipped
+// estimate a_u >= a (ObserverOutput, header).
+inline void unclipped_slip(double omega_hat, double a, double a_u, double rho, double& omega_object,
+                           double& v_slip) noexcept {
+  if (!(a_u > a)) {
+    omega_object = omega_hat;
+    v_slip = std::fabs(omega_hat) * a * rho;
+    return;
+  }
+  const double k = a * a + 0.5;
+  omega_object = omega_hat * (k / (a * a_u + 0.5));
+  v_slip = std::fabs(omega_hat) * rho * (k / (a + 0.5 / a_u));
+}
+}  // namespace
+
 Status Observer::step(const ObserverInput& in, ObserverOutput& out) noexcept {
   const CorSettings& cs = s_.cor;
   const double dt = in.dt == 0.0 ? s_.dt : in.dt;
@@ -131,33 +181,20 @@ Status Observer::step(const ObserverInput& in, ObserverOutput& out) noexcept {
   const bool valid = dt_ok && std::isfinite(in.f_n) && std::isfinite(in.f_t) && std::isfinite(in.tau) &&
                      std::fabs(in.f_n) <= cs.force_limit && std::fabs(in.f_t) <= cs.force_limit &&
                      std::fabs(in.tau) <= cs.torque_limit;
-  if (!valid) {
-    // State untouched; the skipped time is integrated with the next valid sample (or, beyond
-    // max_dt_gap, causes a re-initialisation).
-    pending_ = std::min(pending_ + (dt_ok ? dt : s_.dt), 1.0e9);
-    if (invalid_run_ < s_.max_invalid) ++invalid_run_;
-    out = last_;
-    out.substeps = 0;
-    out.cor_iterations = 0;
-    out.diverged = false;
-    out.substeps_capped = false;
-    if (invalid_run_ >= s_.max_invalid) {
-      need_init_ = true;
-      return out.status = Status::SensorFault;
-    }
-    return out.status = Status::InvalidSample;
-  }
-  invalid_run_ = 0;
+  if (!valid) return reject(dt_ok ? dt : s_.dt, out);
   const double h = pending_ + dt;
-  pending_ = 0.0;
 
   if (!(in.f_n >= cs.f_n_min)) {  // contact lost: forget the state, show it
+    invalid_run_ = 0;
+    pending_ = 0.0;
     need_init_ = true;
     ObserverOutput r = last_;
     r.omega_hat = 0.0;
     r.z_hat = 0.0;
     r.S = 0.0;
     r.y = 0.0;
+    r.omega_object = 0.0;
+    r.v_slip = 0.0;
     r.projected = r.diverged = r.substeps_capped = false;
     r.substeps = 0;
     r.cor_iterations = 0;
@@ -166,38 +203,41 @@ Status Observer::step(const ObserverInput& in, ObserverOutput& out) noexcept {
     out = r;
     return r.status;
   }
-  if (h > s_.max_dt_gap) need_init_ = true;
+  // Everything below is computed in locals and committed only when the sample is usable: a
+  // sample whose CoR or outputs cannot be computed (InvalidSample) leaves the state as it was.
+  const bool init = need_init_ || h > s_.max_dt_gap;
 
   // (1) CoR from the low-pass filtered torque with sign hysteresis; raw torque for y.
-  const bool init = need_init_;
   bool flipped = false;
+  double tau_f, ft_f, side = cor_sign_, z0 = z_, w0 = omega_;
   if (init) {
-    cor_.reset();
-    tau_f_ = in.tau;
-    ft_f_ = in.f_t;
-    cor_sign_ = in.tau < 0.0 ? -1.0 : 1.0;
+    tau_f = in.tau;
+    ft_f = in.f_t;
+    side = in.tau < 0.0 ? -1.0 : 1.0;
   } else {
     // at the nominal period the coefficient computed at construction (the same value)
     const double alpha = h == s_.dt ? alpha_dt_ : filter_alpha(s_, h);
-    tau_f_ += alpha * (in.tau - tau_f_);
-    ft_f_ += alpha * (in.f_t - ft_f_);
-    if (std::fabs(tau_f_) > sign_band_) {
-      const double side = tau_f_ < 0.0 ? -1.0 : 1.0;
+    tau_f = tau_f_ + alpha * (in.tau - tau_f_);
+    ft_f = ft_f_ + alpha * (in.f_t - ft_f_);
+    if (std::fabs(tau_f) > sign_band_) {
+      const double next = tau_f < 0.0 ? -1.0 : 1.0;
       // The CoR changes side: the torque about it, y = tau - c f_t, changes sign with c (for a
       // translation-dominated load almost entirely). The state is the friction about the CoR, so
       // mirror it: S stays continuous instead of dropping to 0 while z_hat crosses zero.
-      if (side != cor_sign_) {
-        z_ = -z_;
-        omega_ = -omega_;
+      if (next != side) {
+        z0 = -z0;
+        w0 = -w0;
         flipped = true;
       }
-      cor_sign_ = side;
+      side = next;
     }
   }
-  const double tau_cor = std::copysign(std::fabs(tau_f_), cor_sign_);
+  const double tau_cor = std::copysign(std::fabs(tau_f), side);
   CorOutput co;
-  const double ft_cor = s_.filter_force ? ft_f_ : in.f_t;
-  const Status cor_status = cor_.step(CorInput{in.f_n, ft_cor, tau_cor}, co);
+  const double ft_cor = s_.filter_force ? ft_f : in.f_t;
+  if (init) cor_.reset();  // a twin that never saw a rejected sample re-initialises here too
+  const Status cor_status = cor_.evaluate(CorInput{in.f_n, ft_cor, tau_cor}, co);
+  if (!is_valid(cor_status)) return reject(dt, out);
 
   // (2) g, sigma_1, y at this sample.
   const ContactParams& p = cor_.model().params();
@@ -219,29 +259,41 @@ Status Observer::step(const ObserverInput& in, ObserverOutput& out) noexcept {
   bool projected = false, diverged = false, capped = false;
   int substeps = 0;
   Status status = cor_status;
+  double z = z0, w = w0;
   if (init) {
-    z_ = clip(rc.drive / rc.sigma0, bound);
-    omega_ = 0.0;
-    need_init_ = false;
+    z = clip(rc.drive / rc.sigma0, bound);
+    w = 0.0;
     status = Status::Reinitialized;
   } else {
-    double z = z_, w = omega_;
     projected = rotor_advance(z, w, h, rc, s_.integrator, s_.substeps, s_.max_substeps, &substeps, &capped);
-    if (std::isfinite(z) && std::isfinite(w) && std::fabs(w) <= s_.omega_limit) {
-      z_ = z;
-      omega_ = w;
-    } else {
+    if (!(std::isfinite(z) && std::isfinite(w) && std::fabs(w) <= s_.omega_limit)) {
       diverged = true;
       projected = false;
-      z_ = clip(rc.drive / rc.sigma0, bound);
-      omega_ = 0.0;
+      z = clip(rc.drive / rc.sigma0, bound);
+      w = 0.0;
       status = Status::Reinitialized;
     }
   }
-  const double S = std::min(p.sigma0 * std::fabs(z_) / rc.g, 1.0);
+  const double S = std::min(p.sigma0 * std::fabs(z) / rc.g, 1.0);
   const double omega_resolution =
       co.sigma_1 > 0.0 ? std::min(s_.torque_noise / co.sigma_1, std::numeric_limits<double>::max())
                        : (s_.torque_noise > 0.0 ? std::numeric_limits<double>::max() : 0.0);
+  double omega_object = 0.0, v_slip = 0.0;
+  unclipped_slip(w, std::fabs(co.c_tilde), std::fabs(co.c_tilde_unclipped), co.rho, omega_object, v_slip);
+  if (!(std::isfinite(z) && std::isfinite(S) && std::isfinite(rc.drive) && std::isfinite(bound) &&
+        std::isfinite(rc.gain) && std::isfinite(omega_object) && std::isfinite(v_slip)))
+    return reject(dt, out);
+
+  // Commit.
+  cor_.commit(co);
+  z_ = z;
+  omega_ = w;
+  tau_f_ = tau_f;
+  ft_f_ = ft_f;
+  cor_sign_ = side;
+  pending_ = 0.0;
+  invalid_run_ = 0;
+  need_init_ = false;
   // Written field by field to last_ and out (no zero-initialised temporary, no struct copy
   // through the stack).
   auto fill = [&](ObserverOutput& r) {
@@ -267,6 +319,9 @@ Status Observer::step(const ObserverInput& in, ObserverOutput& out) noexcept {
     r.substeps = substeps;
     r.cor_iterations = co.iterations;
     r.status = status;
+    r.c_tilde_unclipped = co.c_tilde_unclipped;
+    r.omega_object = omega_object;
+    r.v_slip = v_slip;
   };
   fill(last_);
   fill(out);

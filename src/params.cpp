@@ -22,7 +22,8 @@ bool validate(const ContactParams& p, std::string* message) {
   };
   if (!(std::isfinite(p.mu) && p.mu > 0.0 && p.mu <= 10.0)) bad("mu", p.mu, "must be finite, > 0 and <= 10");
   if (!(std::isfinite(p.beta_a) && p.beta_a >= 0.0)) bad("beta_a", p.beta_a, "must be finite and >= 0 [N s/m^3]");
-  if (!(std::isfinite(p.sigma0) && p.sigma0 > 0.0)) bad("sigma0", p.sigma0, "must be finite and > 0 [N m/rad]");
+  // >= 1e-12 keeps the bristle state g/sigma0 finite for every g a sensor range allows (1e17 N m)
+  if (!(std::isfinite(p.sigma0) && p.sigma0 >= 1e-12)) bad("sigma0", p.sigma0, "must be finite and >= 1e-12 [N m/rad]");
   if (!(std::isfinite(p.sigma_z) && p.sigma_z >= 0.0)) bad("sigma_z", p.sigma_z, "must be finite and >= 0 [N m s/rad]");
   if (!(std::isfinite(p.delta) && p.delta > 0.0 && p.delta < 1.0)) bad("delta", p.delta, "must be finite, > 0 and < 1 [m/N^gamma]");
   if (!(p.gamma > 0.0 && p.gamma < 1.0 / 3.0)) bad("gamma", p.gamma, "must satisfy 0 < gamma < 1/3");

@@ -48,6 +48,11 @@ class ContactModel {
   //! `point` (optional) receives the LS point (F, T, dF, dT) at the returned a.
   double solve_outside(double ft_abs, double tau_abs, int* iterations = nullptr,
                        double guess = -1.0, LsPoint* point = nullptr) const noexcept;
+  //! The same root beyond the clip, for a wrench whose root lies past c_max (h(c_max) > 0):
+  //! searched on [c_max, a_limit] by an expanding bracket and safeguarded Newton; returns
+  //! a_limit when h(a_limit) > 0 (a torque too small for a finite CoR within the limit).
+  double solve_outside_beyond(double ft_abs, double tau_abs, double a_limit,
+                              int* iterations = nullptr) const noexcept;
 
  private:
   ContactParams p_;
@@ -59,7 +64,22 @@ class ContactModel {
   static constexpr int kInverseIntervals = 2048;
 };
 
-//! Per-sample settings of the CoR estimator (defaults in one place).
+//! Largest |c~| the estimator reports before the clip (CorOutput::c_tilde_unclipped) [-]: a
+//! translation whose torque is too small to place the CoR closer reads as this.
+constexpr double kCTildeUnclippedMax = 1.0e6;
+
+//! Per-sample settings of the CoR estimator (defaults in one place). Every field must be finite
+//! and > 0; a sample whose normalisation or CoR quantities overflow (forces near the largest
+//! double, mu or delta near 0) is InvalidSample. Inside an Observer the sensor range and the
+//! contact threshold are narrower (ObserverSettings).
+//!
+//! | field | meaning | unit | range | default |
+//! |---|---|---|---|---|
+//! | f_n_min | below this normal force: NoContact (paper's code: 0.03) | N | > 0 | 0.03 |
+//! | force_limit | |f_n| or |f_t| above: InvalidSample (sensor range) | N | > 0 | 1e4 |
+//! | torque_limit | |tau| above: InvalidSample (sensor range) | N m | > 0 | 1e3 |
+//! | zero_force | f~_t below this counts as zero (pure rotation) | - | > 0 | 1e-4 |
+//! | zero_torque | |tau~| below this counts as zero: |c~| = c_max, sign held | - | > 0 | 1e-4 |
 struct CorSettings {
   double f_n_min = 0.03;         //!< [N] below this normal force: NoContact (paper's code: 0.03)
   double force_limit = 1.0e4;    //!< [N] |f_n| or |f_t| above: InvalidSample (sensor range)
@@ -67,6 +87,12 @@ struct CorSettings {
   double zero_force = 1.0e-4;    //!< f~_t below this counts as zero (pure rotation)
   double zero_torque = 1.0e-4;   //!< |tau~| below this counts as zero: |c~| = c_max, sign held
 };
+
+//! Largest cor.force_limit [N] and cor.torque_limit [N m] an Observer accepts.
+constexpr double kMaxForceLimit = 1.0e9;
+//! Smallest cor.f_n_min [N] an Observer accepts (a micronewton: below any force sensor's
+//! resolution).
+constexpr double kMinContactForce = 1.0e-6;
 
 //! Checks the settings; one line per bad field in *message. Returns true when valid.
 bool validate(const CorSettings& s, std::string* message);
@@ -93,6 +119,9 @@ struct CorOutput {
   bool saturated = false;  //!< |c~| was clipped at c_max
   int iterations = 0;      //!< root-finding iterations spent on this sample
   Status status = Status::NoContact;
+  //! signed normalized CoR before the clip [-]: equals c_tilde when |c~| < c_max, otherwise
+  //! the root of the same equations past c_max, |c~u| <= kCTildeUnclippedMax
+  double c_tilde_unclipped = 0.0;
 };
 
 //! CoR estimator (MODEL.md 5.7): virtual CoR inside the LS, viscous-LS CoR outside, sign rule
@@ -105,7 +134,14 @@ class CorEstimator {
   explicit CorEstimator(const ContactModel& model, const CorSettings& settings = CorSettings());
 
   //! Estimate from one sample; never throws, never allocates, outputs always finite.
+  //! Same as evaluate() followed by commit().
   Status step(const CorInput& in, CorOutput& out) noexcept;
+  //! Estimate from one sample without changing the state (the previous estimate, used for the
+  //! undefined cases, stays as it was). On NoContact / InvalidSample `out` is the held estimate.
+  Status evaluate(const CorInput& in, CorOutput& out) const noexcept;
+  //! Makes `out` (a result of evaluate()) the previous estimate; ignored unless its status
+  //! carries an estimate (not NoContact / InvalidSample / SensorFault).
+  void commit(const CorOutput& out) noexcept;
   void reset() noexcept;
 
   const ContactModel& model() const noexcept { return model_; }

@@ -33,24 +33,37 @@ const char* to_string(GainMode m) noexcept;
 //!
 //! | field | meaning | unit | range | default |
 //! |---|---|---|---|---|
-//! | dt | nominal sample period, used when ObserverInput::dt == 0 | s | > 0 | 0.002 |
+//! | dt | nominal sample period, used when ObserverInput::dt == 0 | s | [1e-9, 10] | 0.002 |
 //! | integrator | discretisation (Integrator) | - | | Rosenbrock |
 //! | gain_mode | Fixed or Bandwidth | - | | Bandwidth |
-//! | gain | l in Fixed mode | 1/(kg m^2) | > 0 | 200 |
-//! | bandwidth | B = l sigma_1 in Bandwidth mode (sliding convergence rate) | 1/s | > 0 | 3000 |
-//! | gain_min, gain_max | clip of l in Bandwidth mode | 1/(kg m^2) | 0 < min <= max | 1, 1e7 |
-//! | g_floor | lower bound on g | N m | > 0 | 1e-7 |
-//! | torque_cutoff | first-order low-pass of the torque used for the CoR only (0: off); y uses the raw torque | Hz | >= 0 | 2 |
+//! | gain | l in Fixed mode | 1/(kg m^2) | (0, 1e15] | 200 |
+//! | bandwidth | B = l sigma_1 in Bandwidth mode (sliding convergence rate) | 1/s | (0, 1e9] | 3000 |
+//! | gain_min, gain_max | clip of l in Bandwidth mode | 1/(kg m^2) | 0 < min <= max <= 1e15 | 1, 1e7 |
+//! | g_floor | lower bound on g | N m | (0, 1] | 1e-7 |
+//! | torque_cutoff | first-order low-pass of the torque used for the CoR only (0: off); y uses the raw torque | Hz | [0, 1e9] | 2 |
 //! | filter_force | also low-pass f_t (same filter) for the CoR, so a proportional load ramp keeps its CoR | - | | true |
-//! | cor_sign_sigmas | CoR sign hysteresis: the side changes only when the filtered torque exceeds this many standard deviations of the filtered torque noise (torque_noise through the low-pass at dt) with the other sign | - | >= 0 | 5 |
-//! | max_invalid | consecutive invalid samples before SensorFault | - | >= 1 | 10 |
-//! | max_dt_gap | longer gaps re-initialise instead of being integrated across | s | >= dt | 0.05 |
-//! | torque_noise | torque noise std of the sensor (omega_resolution, sign hysteresis) | N m | >= 0 | 1e-5 |
-//! | resolution_max | speed_observable when omega_resolution <= this | rad/s | > 0 | 0.02 |
-//! | omega_limit | divergence guard: larger |omega_hat| re-initialises | rad/s | > 0 | 1000 |
-//! | substeps | (minimum) equal substeps per sample, every scheme | - | >= 1 | 1 |
-//! | max_substeps | cap of adaptive substeps (Rk4Adaptive, Rosenbrock) per sample | - | >= substeps | 500 |
-//! | cor | CoR estimator settings (contact threshold, sensor range, zero thresholds) | | | CorSettings() |
+//! | cor_sign_sigmas | CoR sign hysteresis: the side changes only when the filtered torque exceeds this many standard deviations of the filtered torque noise (torque_noise through the low-pass at dt) with the other sign | - | [0, 1e3] | 5 |
+//! | max_invalid | consecutive invalid samples before SensorFault | - | [1, 1e6] | 10 |
+//! | max_dt_gap | longer gaps re-initialise instead of being integrated across | s | [dt, 10] | 0.05 |
+//! | torque_noise | torque noise std of the sensor (omega_resolution, sign hysteresis) | N m | [0, cor.torque_limit] | 1e-5 |
+//! | resolution_max | speed_observable when omega_resolution <= this | rad/s | (0, omega_limit] | 0.02 |
+//! | omega_limit | divergence guard: larger |omega_hat| re-initialises | rad/s | (0, 1e6] | 1000 |
+//! | substeps | (minimum) equal substeps per sample, every scheme | - | [1, max_substeps] | 1 |
+//! | max_substeps | cap of adaptive substeps (Rk4Adaptive, Rosenbrock) per sample | - | [substeps, 5000] | 500 |
+//! | cor | CoR estimator settings (contact threshold, sensor range, zero thresholds); here cor.f_n_min >= 1e-6 N (kMinContactForce) and cor.force_limit, cor.torque_limit <= 1e9 N, N m (kMaxForceLimit) | | | CorSettings() |
+//!
+//! What the ranges guarantee, with ContactParams inside theirs (sigma0 >= 1e-12 among them):
+//! * finite outputs: rho = delta f_n^gamma < max(1, f_n^(1/3)) and |c| <= c_max rho (c_max <=
+//!   1e3), so forces <= 1e9 N give rho < 1e3 m, |y| <= |tau| + |c| f_t < 1e16 N m and g < 1e17 N m,
+//!   hence |z_hat| <= g / sigma0 < 1e29 rad; |omega_object| <= |omega_hat| <= omega_limit <= 1e6
+//!   rad/s keeps v_slip <= |omega_hat| rho (c_max + 1/(2 c_max)) below 1e12 m/s; every other
+//!   output is a ratio with a floored denominator. An update that still overflows (a gain of 1e15
+//!   times a large sigma_1 over a long step) is the divergence guard's case; a sample whose CoR
+//!   or outputs are not finite is rejected like an invalid input (InvalidSample: state untouched).
+//! * bounded work: each sample costs at most 8 x max_substeps integrator substeps (the adaptive
+//!   schemes retry up to eight times) plus a CoR solve of at most a few hundred limit-surface
+//!   evaluations. A substep takes about 0.1 us, so substeps = max_substeps = 5000 costs about
+//!   0.5 ms per sample (2 s for a 4000-sample log; 1e8 took minutes), at most 4 ms.
 struct ObserverSettings {
   double dt = 0.002;
   Integrator integrator = Integrator::Rosenbrock;
@@ -72,6 +85,9 @@ struct ObserverSettings {
   int max_substeps = 500;
   CorSettings cor;
 };
+
+//! Upper bound of ObserverSettings::max_substeps (bounds the work per sample).
+constexpr int kMaxObserverSubsteps = 5000;
 
 //! Checks every field (and the nested CorSettings); one line per bad field in *message,
 //! naming field and value. Returns true when valid.
@@ -105,8 +121,24 @@ struct ObserverInput {
 
 //! Result for one sample. Always finite. On InvalidSample / SensorFault the previous output is
 //! held (with the new status); on NoContact omega_hat = z_hat = S = y = 0 (state reset).
+//!
+//! Two angular velocities. omega_hat is the observer's state, the slip about the CoR the
+//! dynamics use, i.e. with |c~| clipped at c_max (paper; docs/model.md §5.6); it is what the grasp
+//! controller's dynamic part C_d filters (GraspController, FingerInput::omega_hat). On a
+//! translation-dominated slide the true CoR lies far beyond the clip, the object turns slowly
+//! and omega_hat (about the clipped CoR) is several times the object's angular velocity.
+//! omega_object and v_slip re-express the same slip about the unclipped CoR estimate
+//! c~u = c_tilde_unclipped: with the viscous stress uniform over the patch (docs/model.md §5.1) the
+//! viscous torque about a point at a rho on the CoR line of a slip omega about a_u rho is
+//! pi beta_A rho^4 omega (1/2 + a a_u), so the torque omega_hat explains about the clip
+//! (sigma_1 = pi beta_A rho^4 (a^2 + 1/2)) is that of
+//!   omega_object = omega_hat (a^2 + 1/2) / (a a_u + 1/2)   (a = |c~|, a_u = |c~u| >= a),
+//! and the patch centre, at distance a_u rho from that CoR, slides at
+//!   v_slip = |omega_object| a_u rho = |omega_hat| rho (a^2 + 1/2) / (a + 1/(2 a_u)).
+//! Without the clip (a_u = a) these are omega_hat and |omega_hat c|; a pure translation
+//! (a_u -> inf) gives omega_object -> 0 and a finite v_slip.
 struct ObserverOutput {
-  double omega_hat = 0.0;   //!< estimated slip velocity about the CoR [rad/s] (object vs fingertip)
+  double omega_hat = 0.0;   //!< estimated slip velocity about the clipped CoR c [rad/s] (object vs fingertip); drives C_d
   double z_hat = 0.0;       //!< estimated bristle state [rad], |sigma0 z_hat| <= g
   double S = 0.0;           //!< slippage indicator sigma0 |z_hat| / g in [0, 1] (eq. 37)
   double c_tilde = 0.0;     //!< normalized CoR [-] (sensor frame), |c~| <= c_max
@@ -130,6 +162,9 @@ struct ObserverOutput {
   int substeps = 0;         //!< integrator (sub)steps on this sample (0 when not integrated)
   int cor_iterations = 0;   //!< root-finding iterations of the CoR estimate
   Status status = Status::NoContact;
+  double c_tilde_unclipped = 0.0;  //!< normalized CoR before the clip [-], signed like c_tilde, |c~u| >= |c~|
+  double omega_object = 0.0;  //!< slip velocity about the unclipped CoR [rad/s] (= omega_hat unless saturated)
+  double v_slip = 0.0;        //!< slip speed of the patch centre [m/s], >= 0
 };
 
 //! Nonlinear sliding-velocity observer of the paper (eqs. 21-23, MODEL.md 7), per fingertip:
@@ -170,6 +205,10 @@ class Observer {
   const ObserverSettings& settings() const noexcept { return s_; }
 
  private:
+  // Holds the state and the previous output for a sample that cannot be used (input invalid
+  // or its CoR/outputs not computable); counts toward SensorFault.
+  Status reject(double dt, ObserverOutput& out) noexcept;
+
   CorEstimator cor_;
   ObserverSettings s_;
   double z_ = 0.0, omega_ = 0.0;

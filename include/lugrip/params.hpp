@@ -10,7 +10,7 @@ namespace lugrip {
 struct ContactParams {
   double mu = 0.0;       //!< Coulomb friction coefficient [-], (0, 10]
   double beta_a = -1.0;  //!< viscous friction per unit area and speed [N s/m^3], >= 0 (paper prints "Ns/m")
-  double sigma0 = 0.0;   //!< micro-asperity (bristle) stiffness [N m/rad], > 0
+  double sigma0 = 0.0;   //!< micro-asperity (bristle) stiffness [N m/rad], >= 1e-12
   double sigma_z = -1.0; //!< micro-asperity damping [N m s/rad], >= 0
   double delta = 0.0;    //!< contact-radius law rho = delta f_n^gamma [m/N^gamma], > 0
   double gamma = 0.0;    //!< contact-radius exponent [-], 0 < gamma < 1/3

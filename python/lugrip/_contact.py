@@ -197,7 +197,9 @@ class CorEstimate:
             coefficient [N m s/rad]; y: tau - c f_t [N m]; ft_tilde, tau_tilde: normalized wrench;
         saturated: |c~| clipped at c_max; iterations: root-finding iterations;
         status: Status codes (int array); samples without contact or invalid hold the previous
-            estimate.
+            estimate;
+        c_tilde_unclipped: the same estimate before the clip at c_max [-] (equal to c_tilde
+            below it; a pure translation reads as the largest value reported, 1e6).
     """
 
     c_tilde: np.ndarray
@@ -212,6 +214,7 @@ class CorEstimate:
     saturated: np.ndarray
     iterations: np.ndarray
     status: np.ndarray
+    c_tilde_unclipped: np.ndarray
 
     def __iter__(self):
         return iter((self.c_tilde, self.inside))

@@ -92,7 +92,16 @@ class ObserverSample:
     filtered wrench used for the CoR), gain [1/(kg m^2)] (l used), omega_resolution [rad/s]
     (torque_noise / sigma_1), speed_observable, inside, saturated (|c~| clipped), projected
     (z_hat clipped), diverged (re-initialised by the guard), substeps_capped, substeps,
-    cor_iterations, status (Status).
+    cor_iterations, status (Status), c_tilde_unclipped [-] (the CoR before the clip at c_max),
+    omega_object [rad/s] (the slip re-expressed about the unclipped CoR) and v_slip [m/s] (slip
+    speed of the patch centre).
+
+    ``omega_hat`` is the slip about the clipped CoR, the quantity the grasp controller's C_d
+    filters; on translation-dominated slides (|c~| clipped) it exceeds the object's angular
+    velocity, which ``omega_object`` estimates: with a viscous stress uniform over the patch,
+    omega_object = omega_hat (a^2 + 1/2) / (a a_u + 1/2) and v_slip = |omega_object| a_u rho,
+    a = |c_tilde|, a_u = |c_tilde_unclipped| (both equal omega_hat and |omega_hat c| below the
+    clip).
     """
 
     omega_hat: float
@@ -116,6 +125,9 @@ class ObserverSample:
     substeps: int
     cor_iterations: int
     status: Status
+    c_tilde_unclipped: float
+    omega_object: float
+    v_slip: float
 
     @classmethod
     def _from_core(cls, o) -> ObserverSample:
@@ -152,6 +164,9 @@ class ObserverRun:
     substeps: np.ndarray
     cor_iterations: np.ndarray
     status: np.ndarray
+    c_tilde_unclipped: np.ndarray
+    omega_object: np.ndarray
+    v_slip: np.ndarray
     t: np.ndarray | None = None
 
     def __len__(self) -> int:
@@ -236,7 +251,10 @@ class Observer:
         torque_noise [N m], resolution_max [rad/s], omega_limit [rad/s], substeps,
         max_substeps) and of CorSettings (f_n_min [N], force_limit [N], torque_limit [N m],
         zero_force, zero_torque). None means "not given": the file's observer block, else
-        the C++ default.
+        the C++ default. The accepted ranges (the table of include/lugrip/observer.hpp) keep
+        every output finite and bound the work per sample, e.g. dt in [1e-9, 10] s,
+        max_substeps <= 5000, omega_limit <= 1e6 rad/s, f_n_min >= 1e-6 N, force_limit and
+        torque_limit <= 1e9.
 
     Raises:
         ValueError: naming every invalid setting (for a file's observer block: the file, the

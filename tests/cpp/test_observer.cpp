@@ -8,6 +8,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
+#include <cstdlib>
 #include <limits>
 #include <random>
 #include <stdexcept>
@@ -291,6 +293,86 @@ TEST(Observer, SignOfOmegaHatFollowsGroundTruth) {
   }
 }
 
+TEST(Observer, BeyondTheClipOmegaObjectOnAnIndependentPatchPlant) {
+  // Independent plant: steady slip omega about a CoR at c~ rho (c~ from 0.5 to 20), wrench by
+  // quadrature of the dry and viscous stress over the patch (patch_wrench), sensor noise 2e-5 N m
+  // and 0.01 N; beta_A = 2e7 (speed observable at these forces). The truth is the prescribed
+  // kinematics: omega, and the patch centre sliding at |omega| c~ rho.
+  // Below the clip omega_object is omega_hat exactly; beyond it (c~ > 3) the error of
+  // omega_object must not exceed that of predicting zero, where omega_hat's does.
+  ContactParams p = table1_params();
+  p.mu = 0.5;
+  p.beta_a = 2e7;
+  const ContactModel m(p);
+  std::mt19937_64 rng(17);
+  std::normal_distribution<double> normal(0.0, 1.0);
+  double e_obj = 0.0, e_hat = 0.0, e_zero = 0.0, v_rel = 0.0, v_rel_clip = 0.0;
+  int n_far = 0, n_near = 0;
+  for (double f_n : {2.0, 6.0}) {
+    const double rho = m.rho(f_n);
+    for (double ct : {0.5, 1.0, 1.4, 3.0, 5.0, 10.0, 20.0}) {
+      for (double omega : {0.1, -0.5, 1.0}) {
+        const Wrench w = patch_wrench(p, f_n, ct * rho, 0.3, omega);
+        Observer obs(m);
+        ObserverOutput out;
+        double w_obj = 0.0, w_hat = 0.0, v = 0.0;
+        const int n = 600, tail = 200;
+        for (int i = 0; i < n; ++i) {
+          obs.step(ObserverInput::from_force_vector(f_n + 0.01 * normal(rng), w.fx + 0.01 * normal(rng),
+                                                    w.fy + 0.01 * normal(rng), w.tau + 2e-5 * normal(rng), kDt),
+                   out);
+          ASSERT_GE(std::fabs(out.c_tilde_unclipped), std::fabs(out.c_tilde));
+          ASSERT_LE(std::fabs(out.omega_object), std::fabs(out.omega_hat));
+          if (!out.saturated) {  // nothing changes below the clip
+            ASSERT_EQ(out.omega_object, out.omega_hat);
+            ASSERT_EQ(out.c_tilde_unclipped, out.c_tilde);
+            ASSERT_DOUBLE_EQ(out.v_slip, std::fabs(out.omega_hat * out.c));
+          }
+          if (i >= n - tail) {
+            w_obj += out.omega_object / tail;
+            w_hat += out.omega_hat / tail;
+            v += out.v_slip / tail;
+          }
+        }
+        SCOPED_TRACE("f_n=" + std::to_string(f_n) + " c~=" + std::to_string(ct) + " omega=" + std::to_string(omega));
+        EXPECT_GT(w_obj * omega, 0.0);
+        const double v_true = std::fabs(omega) * ct * rho;
+        if (std::getenv("LUGRIP_VERBOSE"))
+          std::printf("f_n %.0f c~ %5.1f (est %7.2f, S %.3f) omega %5.2f: omega_hat %8.4f omega_object %8.4f v/v_true %.3f\n", f_n, ct,
+                      std::fabs(out.c_tilde_unclipped), out.S, omega, w_hat, w_obj, v / v_true);
+        if (ct > 3.0 - 1e-9) {
+          e_obj += (w_obj - omega) * (w_obj - omega);
+          e_hat += (w_hat - omega) * (w_hat - omega);
+          e_zero += omega * omega;
+          ++n_far;
+          EXPECT_NEAR(std::fabs(out.c_tilde_unclipped), ct, 0.25 * ct);
+          v_rel += (v - v_true) * (v - v_true) / (v_true * v_true);
+          const double v_clip = std::fabs(w_hat) * p.c_max * rho;  // |omega_hat c| at the clip
+          v_rel_clip += (v_clip - v_true) * (v_clip - v_true) / (v_true * v_true);
+          EXPECT_GT(v, 0.4 * v_true);
+          EXPECT_LT(v, 1.1 * v_true);
+        } else if (ct < p.c_max) {  // (below the clip the lumped LS and the quadrature differ by
+          ++n_near;                  // up to 40 % of omega at 2 N; omega_hat's own accuracy)
+          EXPECT_LT(std::fabs(w_obj - omega), std::fabs(omega));
+        }
+      }
+    }
+  }
+  ASSERT_GT(n_far, 0);
+  ASSERT_GT(n_near, 0);
+  e_obj = std::sqrt(e_obj / n_far);
+  e_hat = std::sqrt(e_hat / n_far);
+  e_zero = std::sqrt(e_zero / n_far);
+  v_rel = std::sqrt(v_rel / n_far);
+  v_rel_clip = std::sqrt(v_rel_clip / n_far);
+  std::printf("  [beyond clip] |c~| >= 3 RMSE: omega_object %.4f, omega_hat %.4f, zero %.4f rad/s; "
+              "relative RMSE of v_slip %.3f (|omega_hat c| at the clip: %.3f)\n", e_obj, e_hat, e_zero, v_rel, v_rel_clip);
+  EXPECT_LE(e_obj, 0.5 * e_zero);
+  EXPECT_GT(e_hat, e_zero);  // the clipped CoR's omega_hat is not the object's angular velocity
+  EXPECT_LT(v_rel, 0.2);
+  EXPECT_LT(v_rel, v_rel_clip);
+}
+
 // ---------------------------------------------------------------------------------------------
 // Discretisation
 // ---------------------------------------------------------------------------------------------
@@ -359,7 +441,7 @@ TEST(Observer, StableSchemesAgreeOnPlantData) {
   ObserverSettings ref_s;
   ref_s.integrator = Integrator::Rk4Adaptive;
   ref_s.substeps = 200;
-  ref_s.max_substeps = 200000;
+  ref_s.max_substeps = kMaxObserverSubsteps;
   Observer ref(p, ref_s);
   const auto r = observe(ref, s);
   for (Integrator scheme : {Integrator::Rosenbrock, Integrator::Implicit, Integrator::Rk4Adaptive}) {
@@ -501,7 +583,8 @@ TEST(Observer, BoundedUnderAMillionRandomInputs) {
       ASSERT_TRUE(std::isfinite(out.omega_hat) && std::isfinite(out.z_hat) && std::isfinite(out.S) &&
                   std::isfinite(out.c_tilde) && std::isfinite(out.c) && std::isfinite(out.g) &&
                   std::isfinite(out.sigma_1) && std::isfinite(out.y) && std::isfinite(out.gain) &&
-                  std::isfinite(out.omega_resolution) && std::isfinite(out.tau_cor) && std::isfinite(out.ft_cor))
+                  std::isfinite(out.omega_resolution) && std::isfinite(out.tau_cor) && std::isfinite(out.ft_cor) &&
+                  std::isfinite(out.c_tilde_unclipped) && std::isfinite(out.omega_object) && std::isfinite(out.v_slip))
           << "run " << run << " sample " << i;
       ASSERT_GE(out.S, 0.0);
       ASSERT_LE(out.S, 1.0);
@@ -677,4 +760,138 @@ TEST(Observer, SettingsValidationNamesEachBadField) {
   s.cor.zero_torque = 0.0;
   EXPECT_FALSE(validate(s, &msg));
   EXPECT_EQ(std::count(msg.begin(), msg.end(), '\n'), 3) << msg;
+}
+
+TEST(Observer, SettingsRangesAtTheirEdges) {
+  // Each bounded field: the edge value is accepted, one step past it is refused with one line
+  // naming the field. The edges are those of the settings table in observer.hpp.
+  struct Edge {
+    const char* field;
+    void (*set)(ObserverSettings&, double);
+    double ok, bad;
+    int lines = 1;  // lines of the refusal (a dt above 10 s also puts max_dt_gap below dt)
+  };
+  const Edge edges[] = {
+      {"dt", [](ObserverSettings& s, double v) { s.dt = v; s.max_dt_gap = std::max(s.max_dt_gap, std::min(v, 10.0)); }, 1e-9, 9e-10},
+      {"dt", [](ObserverSettings& s, double v) { s.dt = v; s.max_dt_gap = 10.0; }, 10.0, 10.5, 2},
+      {"gain", [](ObserverSettings& s, double v) { s.gain = v; }, 1e15, 2e15},
+      {"bandwidth", [](ObserverSettings& s, double v) { s.bandwidth = v; }, 1e9, 2e9},
+      {"gain_max", [](ObserverSettings& s, double v) { s.gain_max = v; }, 1e15, 2e15},
+      {"g_floor", [](ObserverSettings& s, double v) { s.g_floor = v; }, 1.0, 1.5},
+      {"torque_cutoff", [](ObserverSettings& s, double v) { s.torque_cutoff = v; }, 1e9, 2e9},
+      {"cor_sign_sigmas", [](ObserverSettings& s, double v) { s.cor_sign_sigmas = v; }, 1e3, 2e3},
+      {"max_invalid", [](ObserverSettings& s, double v) { s.max_invalid = static_cast<int>(v); }, 1e6, 1e6 + 1},
+      {"max_dt_gap", [](ObserverSettings& s, double v) { s.max_dt_gap = v; }, 10.0, 10.5},
+      {"torque_noise", [](ObserverSettings& s, double v) { s.torque_noise = v; }, 1e3, 2e3},  // cor.torque_limit
+      {"omega_limit", [](ObserverSettings& s, double v) { s.omega_limit = v; }, 1e6, 2e6},
+      {"resolution_max", [](ObserverSettings& s, double v) { s.resolution_max = v; }, 1e3, 2e3},  // omega_limit
+      {"max_substeps", [](ObserverSettings& s, double v) { s.max_substeps = static_cast<int>(v); }, kMaxObserverSubsteps, 1e8},
+      {"max_substeps", [](ObserverSettings& s, double v) { s.substeps = s.max_substeps = static_cast<int>(v); }, kMaxObserverSubsteps, 1e8},
+      {"cor.f_n_min", [](ObserverSettings& s, double v) { s.cor.f_n_min = v; }, kMinContactForce, 1e-300},
+      {"cor.force_limit", [](ObserverSettings& s, double v) { s.cor.force_limit = v; }, kMaxForceLimit, 1e300},
+      {"cor.torque_limit", [](ObserverSettings& s, double v) { s.cor.torque_limit = v; }, kMaxForceLimit, 1e300},
+  };
+  for (const Edge& e : edges) {
+    ObserverSettings ok, bad;
+    e.set(ok, e.ok);
+    e.set(bad, e.bad);
+    std::string msg;
+    EXPECT_TRUE(validate(ok, &msg)) << e.field << " = " << e.ok << ": " << msg;
+    EXPECT_FALSE(validate(bad, &msg)) << e.field << " = " << e.bad;
+    EXPECT_EQ(msg.rfind(std::string(e.field) + " = ", 0), 0u) << msg;
+    EXPECT_EQ(std::count(msg.begin(), msg.end(), '\n'), e.lines) << msg;
+  }
+  // ContactParams: a bristle stiffness that makes g / sigma0 overflow is refused.
+  ContactParams p = table1_params();
+  p.sigma0 = std::numeric_limits<double>::denorm_min();
+  EXPECT_FALSE(validate(p, nullptr));
+  p.sigma0 = 1e-12;
+  EXPECT_TRUE(validate(p, nullptr));
+}
+
+TEST(Observer, EdgeSettingsKeepOutputsFiniteAndTheWorkBounded) {
+  // The cases found with settings that passed validate() before the ranges existed, now at the
+  // edges of the ranges: the smallest sigma0 at the largest sensor range (z_hat was +-inf with a
+  // denormal sigma0), the largest substep counts (minutes per log with 1e8), the shortest and
+  // longest periods.
+  const double f_max = kMaxForceLimit;
+  ContactParams p = table1_params();
+  p.sigma0 = 1e-12;
+  ObserverSettings s;
+  s.cor.force_limit = s.cor.torque_limit = f_max;
+  s.substeps = s.max_substeps = kMaxObserverSubsteps;
+  for (Integrator scheme : {Integrator::Rosenbrock, Integrator::Implicit, Integrator::Rk4, Integrator::Rk4Adaptive}) {
+    s.integrator = scheme;
+    Observer obs(p, s);
+    ObserverOutput out;
+    for (double f_n : {0.5, 1e3, f_max}) {
+      for (int i = 0; i < 20; ++i) {
+        const double load = 0.05 * i;
+        obs.step(ObserverInput{f_n, std::min(f_max, load * obs.model().ft_max(f_n)),
+                               std::min(f_max, load * obs.model().tau_max(f_n)), 0.0}, out);
+        ASSERT_TRUE(std::isfinite(out.z_hat) && std::isfinite(out.omega_hat) && std::isfinite(out.S) &&
+                    std::isfinite(out.y) && std::isfinite(out.v_slip) && std::isfinite(out.omega_object))
+            << to_string(scheme) << " f_n " << f_n;
+        ASSERT_LE(out.substeps, kMaxObserverSubsteps);
+        ASSERT_LE(p.sigma0 * std::fabs(out.z_hat), out.g * (1.0 + 1e-12));
+      }
+    }
+  }
+  for (double dt : {1e-9, 10.0}) {
+    ObserverSettings st;
+    st.dt = dt;
+    st.max_dt_gap = 10.0;
+    Observer obs(table1_params(), st);
+    ObserverOutput out;
+    for (int i = 0; i < 200; ++i) {
+      obs.step(ObserverInput{5.0, 0.01 * i, -1e-4 * i, 0.0}, out);
+      ASSERT_TRUE(std::isfinite(out.omega_hat) && std::isfinite(out.z_hat) && std::isfinite(out.v_slip)) << dt;
+      ASSERT_TRUE(is_valid(out.status)) << dt;
+    }
+  }
+}
+
+TEST(Observer, RejectedSamplesLeaveTheStateAsItWas) {
+  // A sample that passes the input checks but whose CoR cannot be computed (here mu = 1e-300:
+  // f_t / (mu f_n) overflows at large forces) is InvalidSample and must not advance the state:
+  // a twin that never saw it, fed the skipped time with the next sample, agrees exactly.
+  ContactParams p = table1_params();
+  p.mu = 1e-300;
+  p.beta_a = 1e20;
+  ObserverSettings s;
+  s.cor.force_limit = s.cor.torque_limit = kMaxForceLimit;
+  s.filter_force = false;  // the CoR sees the raw f_t
+  Observer a(p, s), twin(p, s);
+  ObserverOutput oa, ob;
+  std::mt19937_64 rng(5);
+  std::uniform_real_distribution<double> u(0.0, 1.0);
+  int rejected = 0, compared = 0;
+  double pending = 0.0;
+  for (int i = 0; i < 3000; ++i) {
+    ObserverInput in{1.0, 1e-301 * u(rng), -1e-304 * u(rng), 0.0};  // tiny loads of a tiny mu
+    if (i % 7 == 3) in.f_t = 1e9;                                     // overflow: rejected
+    const double omega_before = a.omega_hat(), z_before = a.z_hat();
+    const Status st = a.step(in, oa);
+    if (st == Status::InvalidSample) {
+      ++rejected;
+      EXPECT_EQ(a.omega_hat(), omega_before);
+      EXPECT_EQ(a.z_hat(), z_before);
+      pending += s.dt;
+      continue;
+    }
+    twin.step(ObserverInput{in.f_n, in.f_t, in.tau, pending + s.dt}, ob);
+    pending = 0.0;
+    ++compared;
+    ASSERT_EQ(oa.status, ob.status) << i;
+    ASSERT_EQ(oa.omega_hat, ob.omega_hat) << i;
+    ASSERT_EQ(oa.z_hat, ob.z_hat) << i;
+    ASSERT_EQ(oa.c_tilde, ob.c_tilde) << i;
+    ASSERT_EQ(oa.omega_object, ob.omega_object) << i;
+  }
+  EXPECT_GT(rejected, 300);
+  EXPECT_GT(compared, 2000);
+  // f_n_min at 1e-300 is refused outright in an observer (it was accepted, and such samples
+  // returned InvalidSample while still advancing omega_hat).
+  s.cor.f_n_min = 1e-300;
+  EXPECT_THROW(Observer(p, s), std::invalid_argument);
 }
