@@ -47,7 +47,7 @@ def _gauss_newton(
         HF = H[np.ix_(F, F)]
         D = np.maximum(np.diag(HF), 1e-12 * max(np.max(np.diag(HF)), 1e-300))
         accepted = False
-        for _ in range(30):
+        for _ in range(8):
             try:
                 step_f = np.linalg.solve(HF + lam * np.diag(D), -g[F])
             except np.linalg.LinAlgError:

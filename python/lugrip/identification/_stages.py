@@ -130,15 +130,21 @@ def sliding_points(mans: list[_Maneuver], phases: list[np.ndarray], bins: int = 
     )
 
 
+_COARSE = np.unique(np.concatenate([[0], np.round(np.geomspace(1, _A.size - 1, 160)).astype(int)]))
+
+
 def _nearest(ft, tt, lam, F, T, xi):
-    """Per point the CoR a on the (shifted) curve nearest to the point, and the residuals."""
-    df = ft[:, None] - F[None, :] - 2.0 * xi * _A[None, :] * lam[:, None]
-    dtt = tt[:, None] - T[None, :] - lam[:, None]
+    """Per point the CoR a on the (shifted) curve nearest to the point, and the residuals:
+    a search on a coarse subset of the table, then a parabola through the three nodes around
+    the best one, the curve evaluated on the full table at the result."""
+    A, Fc, Tc = _A[_COARSE], F[_COARSE], T[_COARSE]
+    df = ft[:, None] - Fc[None, :] - 2.0 * xi * A[None, :] * lam[:, None]
+    dtt = tt[:, None] - Tc[None, :] - lam[:, None]
     d2 = df * df + dtt * dtt
     j = np.argmin(d2, axis=1)
-    jj = np.clip(j, 1, _A.size - 2)
+    jj = np.clip(j, 1, A.size - 2)
     r = np.arange(ft.size)
-    x0, x1, x2 = _A[jj - 1], _A[jj], _A[jj + 1]
+    x0, x1, x2 = A[jj - 1], A[jj], A[jj + 1]
     y0, y1, y2 = d2[r, jj - 1], d2[r, jj], d2[r, jj + 1]
     den = (x0 - x1) * (x0 - x2) * (x1 - x2)
     A2 = x2 * (y1 - y0) + x1 * (y0 - y2) + x0 * (y2 - y1)
