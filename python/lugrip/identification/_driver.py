@@ -274,7 +274,10 @@ def identify(
     estimates, bound_notes = estimates_of(p_hat, p0, free_t, mn, bnds, stderr_log, guess_notes,
                                           fixed_notes, stage)
     ident += bound_notes
-    at_bound = [e for e in estimates if e.at_bound]
+    at_bound = [(e.name, e.at_bound) for e in estimates if e.at_bound]
+    if stage is not None:
+        at_bound += [(n, "limit-surface stage") for n in stage.ls.at_bound
+                     if n not in {name for name, _ in at_bound}]
     if not refine:
         status, message = "stages", "stage values (no eq. 32 refinement)"
     elif res.success:
@@ -285,8 +288,10 @@ def identify(
         status, message = "failed", str(res.message)
     if at_bound:
         status = "failed"
-        message = "parameter(s) at a bound: " + ", ".join(
-            f"{e.name} ({e.at_bound})" for e in at_bound)
+        message = "parameter(s) at a bound: " + ", ".join(f"{n} ({where})" for n, where in at_bound)
+        if any(n == "k" for n, _ in at_bound):
+            message += (" (k at 0.5: the sliding wrench is more elliptic than any pressure "
+                        "profile of the limit-surface family; hold k with k=... to accept it)")
         warnings.warn(message, IdentificationWarning, stacklevel=2)
     elif status not in ("converged", "stages"):
         warnings.warn(f"the optimiser stopped without convergence: {res.message}",

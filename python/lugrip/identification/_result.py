@@ -389,7 +389,8 @@ def estimates_of(p_hat, p0, free_t, mn, bnds, stderr_log, guess_notes, fixed_not
                                          False, at, se, fixed_notes.get(n, "fixed (params0)")))
     if stage is not None:
         for name in stage.ls.at_bound:
-            notes.append(f"limit-surface stage: {name} at the bound of its range (a failure)")
+            what = {"k": "k at 0.5"}.get(name, name)
+            notes.append(f"limit-surface stage: {what}, the bound of its range (a failure)")
             out = [dataclasses.replace(e, at_bound="stage") if e.name == name else e for e in out]
     return out, notes
 
