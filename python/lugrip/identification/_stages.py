@@ -130,7 +130,7 @@ def sliding_points(mans: list[_Maneuver], phases: list[np.ndarray], bins: int = 
     )
 
 
-_COARSE = np.unique(np.concatenate([[0], np.round(np.geomspace(1, _A.size - 1, 160)).astype(int)]))
+_COARSE = np.unique(np.concatenate([[0], np.round(np.geomspace(1, _A.size - 1, 320)).astype(int)]))
 
 
 def _nearest(ft, tt, lam, F, T, xi):
