@@ -50,7 +50,7 @@ def stribeck():
 
 @pytest.fixture(scope="module")
 def viscous():
-    data = make_rig("grid-viscous").simulate(n=28, seed=3)
+    data = make_rig("grid-viscous").simulate(n=40, seed=3)
     train, test = _split(data)
     return data.truth, _fit(train.log), test
 

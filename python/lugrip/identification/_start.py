@@ -125,7 +125,7 @@ def staged_estimate(
             "surface needs several CoRs and normal forces; record more maneuvers"
         )
     pts = sliding_points(mans, phases)
-    ls = fit_limit_surface(pts, gamma=fix_gamma, k=k, viscous=True)
+    ls = _fit_ls(pts, fix_gamma, k, lines)
     lines.append(_ls_line(ls, pts, fix_gamma))
     # (c) viscous shear: significance and observability
     tn = noise.torque if math.isfinite(noise.torque) else 1.0e-5
@@ -168,7 +168,7 @@ def staged_estimate(
             )
     if pre is not None and second:
         pts = sliding_points(mans, phases)
-        ls = fit_limit_surface(pts, gamma=fix_gamma, k=k, viscous=True)
+        ls = _fit_ls(pts, fix_gamma, k, lines)
         lines.append(_ls_line(ls, pts, fix_gamma))
         _, resolution, observable, beta, line = _viscous(ls, pts, tn, c_max, resolution_max)
         lines.append(line)
@@ -221,6 +221,27 @@ def staged_estimate(
         phases=phases,
         report=tuple(lines),
     )
+
+
+K_DEFAULT = 4.0  # pressure exponent held when the data do not determine k (the paper's)
+K_GAIN = 0.95  # a free k must lower the RMS distance to the surface below this fraction
+
+
+def _fit_ls(pts, fix_gamma, k, lines: list) -> LimitSurfaceFit:
+    """Stage (a)+(c) with k free, kept only when it lowers the RMS distance to the surface by
+    more than 5 % against k = 4 (else k is not determined by the data and held at 4)."""
+    if k is not None:
+        return fit_limit_surface(pts, gamma=fix_gamma, k=k, viscous=True)
+    free = fit_limit_surface(pts, gamma=fix_gamma, k=None, viscous=True)
+    held = fit_limit_surface(pts, gamma=fix_gamma, k=K_DEFAULT, viscous=True)
+    if free.residual_rms < K_GAIN * held.residual_rms:
+        return free
+    lines.append(
+        f"k not determined by these data (free k = {free.k:.3g} lowers the distance to the "
+        f"surface only to {free.residual_rms / held.residual_rms:.2f} of k = {K_DEFAULT:g}): "
+        f"held at {K_DEFAULT:g}"
+    )
+    return held
 
 
 def _ls_line(ls: LimitSurfaceFit, pts, fix_gamma) -> str:
