@@ -125,7 +125,8 @@ def staged_estimate(
             "surface needs several CoRs and normal forces; record more maneuvers"
         )
     pts = sliding_points(mans, phases)
-    ls = _fit_ls(pts, fix_gamma, k, lines)
+    # first pass at k = 4 (or the given k): it only has to find sigma0 for the second pass
+    ls = fit_limit_surface(pts, gamma=fix_gamma, k=K_DEFAULT if k is None else k, viscous=True)
     lines.append(_ls_line(ls, pts, fix_gamma))
     # (c) viscous shear: significance and observability
     tn = noise.torque if math.isfinite(noise.torque) else 1.0e-5
@@ -166,6 +167,14 @@ def staged_estimate(
                 f"phases, second pass (slip >= 4.6 g/sigma0 with sigma0 {pre.sigma0:.3g}) "
                 f"would leave gross sliding in {m2} maneuver(s): the first pass is kept"
             )
+    if k is None and not second:  # no second pass: decide about k on the first one's points
+        ls = _fit_ls(pts, fix_gamma, k, lines)
+        lines.append(_ls_line(ls, pts, fix_gamma))
+        _, resolution, observable, beta, line = _viscous(ls, pts, tn, c_max, resolution_max)
+        lines.append(line)
+        probe = probe.replace(mu=ls.mu, delta=ls.delta, gamma=ls.gamma, k=ls.k)
+        p_ls = probe.replace(beta_a=beta)
+        pre = fit_presliding(mans, phases, p_ls)
     if pre is not None and second:
         pts = sliding_points(mans, phases)
         ls = _fit_ls(pts, fix_gamma, k, lines)
