@@ -17,10 +17,11 @@ from __future__ import annotations
 import math
 import warnings
 
+import lugrip
 import numpy as np
 import pytest
-
-import lugrip
+from hypothesis import given
+from hypothesis import strategies as st
 from lugrip.identification import IdentifiabilityWarning, IdentificationError
 from lugrip.rigs import RubbingData, make_rig
 
@@ -195,3 +196,21 @@ def test_parameter_at_a_bound_is_a_failure(lumped, tmp_path):
     doc = yaml.safe_load(path.read_text())
     assert doc["identification"]["status"] == "failed"
     assert math.isclose(doc["contact"]["mu"]["value"], r.params.mu)
+
+
+
+@given(factor=st.floats(min_value=30.0, max_value=1.0e3), shift=st.integers(0, 9))
+def test_any_implausibly_fast_omega_is_refused(lumped, factor, shift):
+    """Consistency plant, property: omega scaled by any factor of 30 or more (deg/s is 57.3)
+    on any subset of maneuvers that includes one of the fastest is refused before any fit,
+    naming deg/s; never a silent 'converged'."""
+    log = lumped.log
+    ids = np.unique(log.maneuver)
+    fast = int(ids[np.argmax([np.abs(log.omega[log.maneuver == i]).max() for i in ids])])
+    pick = {fast} | {int(i) for i in ids if (int(i) + shift) % 3 == 0}
+    om = np.where(np.isin(log.maneuver, list(pick)), log.omega * factor, log.omega)
+    bad = _with(lumped, omega=om)
+    if np.percentile(np.abs(om), 99) <= 20.0:
+        return  # too few scaled samples to tell from a fast rub: not this property
+    with pytest.raises(IdentificationError, match="deg/s"):
+        lugrip.identify(bad)
