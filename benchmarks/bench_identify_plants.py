@@ -148,8 +148,8 @@ def markdown(rows: list[dict], argv: list[str]) -> str:
         "",
         "| plant | mu (truth) | tau_max 2 N / 8 N | at bound | S >= 0.9 sliding | S >= 0.9 stick < 0.7 "
         "| speed_observable on sliding (truth) | abs-omega RMSE c~ <= 1.5 / zero | all samples / zero "
-        "| fit [s] (observer pass) |",
-        "|---|---|---|---|---|---|---|---|---|---|",
+        "| status | fit wall / CPU [s] (observer pass [s], load average) |",
+        "|---|---|---|---|---|---|---|---|---|---|---|",
     ]
     for r in rows:
         h, t = r["held_out"], r["training"]
