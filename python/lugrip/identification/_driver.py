@@ -291,7 +291,7 @@ def identify(
         message = "parameter(s) at a bound: " + ", ".join(f"{n} ({where})" for n, where in at_bound)
         if any(n == "k" for n, _ in at_bound):
             message += (" (k at 0.5: the sliding wrench is more elliptic than any pressure "
-                        "profile of the limit-surface family; hold k with k=... to accept it)")
+                        "profile of the limit-surface family; hold it with k=0.5, --k 0.5, to accept it)")
         warnings.warn(message, IdentificationWarning, stacklevel=2)
     elif status not in ("converged", "stages"):
         warnings.warn(f"the optimiser stopped without convergence: {res.message}",
