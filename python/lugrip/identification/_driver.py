@@ -111,8 +111,9 @@ def identify(
     t_start = time.perf_counter()
     free = _parse_free(free)
     bnds = _bounds(bounds)
-    tolerance = check_options(loss=loss, weighting=weighting, method=method,
-                              tolerance=tolerance, uncertainty=uncertainty)
+    tolerance = check_options(
+        loss=loss, weighting=weighting, method=method, tolerance=tolerance, uncertainty=uncertainty
+    )
     p_given, observer = read_params0(params0, observer)
     if p_given is None and len(free) < len(PARAMETERS):
         fixed = [n for n in PARAMETERS if n not in free]
@@ -135,7 +136,7 @@ def identify(
     short = force_range_too_small(mans)
     fix_gamma = None
     if short and "gamma" in free_list and "delta" in free_list:
-        g_fix = (p_given.gamma if p_given is not None else 0.25)
+        g_fix = p_given.gamma if p_given is not None else 0.25
         if fix_unidentifiable:
             free_list.remove("gamma")
             fix_gamma = g_fix
@@ -164,12 +165,20 @@ def identify(
         lo, hi = bnds[n]
         if not (lo < v < hi):
             p0 = p0.replace(**{n: _clip(n, v, bnds)})
-            notes.append(f"{n}: start {v:.4g} outside the bounds [{lo:.3g}, {hi:.3g}], moved inside")
-    if ("delta" in free_list and ("mu" in free_list or "beta_a" in free_list) and not staged
-            and rotation_only(mans, p0, slip_threshold)):
-        msg = ("the data hold only rotations (estimated |c~| < 0.15 on 95 % of the sliding "
-               "samples): mu and delta enter only as mu delta (tau_max) and beta_A only as "
-               "beta_A delta^4, so delta is not separately identifiable")
+            notes.append(
+                f"{n}: start {v:.4g} outside the bounds [{lo:.3g}, {hi:.3g}], moved inside"
+            )
+    if (
+        "delta" in free_list
+        and ("mu" in free_list or "beta_a" in free_list)
+        and not staged
+        and rotation_only(mans, p0, slip_threshold)
+    ):
+        msg = (
+            "the data hold only rotations (estimated |c~| < 0.15 on 95 % of the sliding "
+            "samples): mu and delta enter only as mu delta (tau_max) and beta_A only as "
+            "beta_A delta^4, so delta is not separately identifiable"
+        )
         if fix_unidentifiable:
             free_list.remove("delta")
             fixed_notes["delta"] = f"fixed at {p0.delta:.4g}: rotation-only data"
@@ -189,7 +198,11 @@ def identify(
             steps = np.concatenate([m.dt[m.dt > 0] for m in mans] or [np.zeros(0)])
             if steps.size:
                 observer["dt"] = float(np.median(steps))
-        if stage is not None and "torque_noise" not in observer and math.isfinite(stage.noise.torque):
+        if (
+            stage is not None
+            and "torque_noise" not in observer
+            and math.isfinite(stage.noise.torque)
+        ):
             observer["torque_noise"] = float(stage.noise.torque)
     osettings, odict = _observer_settings(observer, p0)
     settings = _core.IdentificationSettings()
@@ -225,10 +238,18 @@ def identify(
         val_m = [ms[i] for i in sorted(val_idx)]
         train = _Problem(train_m, settings, weighting)
         val = _Problem(val_m, settings, weighting) if val_m else None
-        mn = minimise(train, p0, free_t, bnds, method=method,
-                      max_iterations=max_iterations if refine else 0, tolerance=tolerance,
-                      prior=prior, prior_weight=1.0 / max(n_train, 1) if prior else 0.0,
-                      progress=progress)
+        mn = minimise(
+            train,
+            p0,
+            free_t,
+            bnds,
+            method=method,
+            max_iterations=max_iterations if refine else 0,
+            tolerance=tolerance,
+            prior=prior,
+            prior_weight=1.0 / max(n_train, 1) if prior else 0.0,
+            progress=progress,
+        )
         return train, val, train_m, val_m, mn, n_clip
 
     if not free_t:
@@ -244,8 +265,10 @@ def identify(
         fits += 1
         fit_time += mn.fit_time
     if fits > 1:
-        notes.append(f"{fits} fits: the clipped-CoR samples were located again at each "
-                     "fit's result until the set settled")
+        notes.append(
+            f"{fits} fits: the clipped-CoR samples were located again at each "
+            "fit's result until the set settled"
+        )
     p_hat = mn.params
     res = mn.result
     ev, split = evaluate_split(train, val, train_m, val_m, p_hat)
@@ -253,31 +276,49 @@ def identify(
         free_t = ()
 
     def refit(ms):
-        return _refit(_Problem(ms, settings, weighting), p_hat, free_t, bnds, max_iterations,
-                      tolerance)
+        return _refit(
+            _Problem(ms, settings, weighting), p_hat, free_t, bnds, max_iterations, tolerance
+        )
 
     if free_t:
         stderr_log, corr, weak, unc_notes = covariance(
-            train, ev, mn, free_t, loss=loss, uncertainty=uncertainty, sse=split["sse"],
-            refit=refit, n_bootstrap=n_bootstrap, seed=seed)
+            train,
+            ev,
+            mn,
+            free_t,
+            loss=loss,
+            uncertainty=uncertainty,
+            sse=split["sse"],
+            refit=refit,
+            n_bootstrap=n_bootstrap,
+            seed=seed,
+        )
     else:
         stderr_log, corr, weak, unc_notes = np.zeros(0), np.zeros((0, 0)), (), []
     ident = notes + unc_notes
     if n_clip:
         n_all = sum(m.n for m in mans)
-        ident.append(f"{n_clip} samples ({100 * n_clip / max(n_all, 1):.1f} %) not scored: "
-                     "sliding with the CoR clipped at c_max (translation beyond the clip), "
-                     "where omega_hat is the slip about the clipped CoR, not the object's rotation")
+        ident.append(
+            f"{n_clip} samples ({100 * n_clip / max(n_all, 1):.1f} %) not scored: "
+            "sliding with the CoR clipped at c_max (translation beyond the clip), "
+            "where omega_hat is the slip about the clipped CoR, not the object's rotation"
+        )
     if int(ev["truncated"]):
-        ident.append(f"gradient truncated on {int(ev['truncated'])} samples where the observer "
-                     "chatters (its discrete map is locally chaotic there)")
-    estimates, bound_notes = estimates_of(p_hat, p0, free_t, mn, bnds, stderr_log, guess_notes,
-                                          fixed_notes, stage)
+        ident.append(
+            f"gradient truncated on {int(ev['truncated'])} samples where the observer "
+            "chatters (its discrete map is locally chaotic there)"
+        )
+    estimates, bound_notes = estimates_of(
+        p_hat, p0, free_t, mn, bnds, stderr_log, guess_notes, fixed_notes, stage
+    )
     ident += bound_notes
     at_bound = [(e.name, e.at_bound) for e in estimates if e.at_bound]
     if stage is not None:
-        at_bound += [(n, "limit-surface stage") for n in stage.ls.at_bound
-                     if n not in {name for name, _ in at_bound}]
+        at_bound += [
+            (n, "limit-surface stage")
+            for n in stage.ls.at_bound
+            if n not in {name for name, _ in at_bound}
+        ]
     if not refine:
         status, message = "stages", "stage values (no eq. 32 refinement)"
     elif res.success:
@@ -290,33 +331,61 @@ def identify(
         status = "failed"
         message = "parameter(s) at a bound: " + ", ".join(f"{n} ({where})" for n, where in at_bound)
         if any(n == "k" for n, _ in at_bound):
-            message += (" (k at 0.5: the sliding wrench is more elliptic than any pressure "
-                        "profile of the limit-surface family; hold it with k=0.5, --k 0.5, to accept it)")
+            message += (
+                " (k at 0.5: the sliding wrench is more elliptic than any pressure "
+                "profile of the limit-surface family; hold it with k=0.5, --k 0.5, to accept it)"
+            )
         warnings.warn(message, IdentificationWarning, stacklevel=2)
     elif status not in ("converged", "stages"):
-        warnings.warn(f"the optimiser stopped without convergence: {res.message}",
-                      IdentificationWarning, stacklevel=2)
+        warnings.warn(
+            f"the optimiser stopped without convergence: {res.message}",
+            IdentificationWarning,
+            stacklevel=2,
+        )
     data_warnings = _data_warnings(split, stage)
     for w in data_warnings:
         warnings.warn(w, IdentificationWarning, stacklevel=2)
     return IdentificationResult(
-        status=status, message=message, params=p_hat, params0=p0, estimates=tuple(estimates),
-        free=free_t, cost_trace=tuple(mn.trace), rmse_train=split["rmse_train"],
-        rmse_validation=split["rmse_val"], rms_omega_train=split["rms_train"],
-        rms_omega_validation=split["rms_val"], maneuver_rmse=split["maneuver_rmse"],
-        validation_keys=tuple(m.key for m in val_m), correlation=corr,
-        identifiability=tuple(ident), weak_directions=tuple(weak), uncertainty=uncertainty,
-        wall_time=time.perf_counter() - t_start, fit_time=fit_time, iterations=mn.iterations,
-        evaluations=train.evaluations, samples_train=split["n_train"],
-        samples_validation=split["n_val"], truncated=int(ev["truncated"]),
+        status=status,
+        message=message,
+        params=p_hat,
+        params0=p0,
+        estimates=tuple(estimates),
+        free=free_t,
+        cost_trace=tuple(mn.trace),
+        rmse_train=split["rmse_train"],
+        rmse_validation=split["rmse_val"],
+        rms_omega_train=split["rms_train"],
+        rms_omega_validation=split["rms_val"],
+        maneuver_rmse=split["maneuver_rmse"],
+        validation_keys=tuple(m.key for m in val_m),
+        correlation=corr,
+        identifiability=tuple(ident),
+        weak_directions=tuple(weak),
+        uncertainty=uncertainty,
+        wall_time=time.perf_counter() - t_start,
+        fit_time=fit_time,
+        iterations=mn.iterations,
+        evaluations=train.evaluations,
+        samples_train=split["n_train"],
+        samples_validation=split["n_val"],
+        truncated=int(ev["truncated"]),
         samples_saturated=n_clip,
         settings={
-            "loss": loss, "huber_scale": float(huber_scale), "weighting": weighting,
-            "method": method, "start": start, "refine": bool(refine),
-            "validation": len(val_m), "seed": int(seed),
-            "slip_threshold": float(slip_threshold), "score_saturated": bool(score_saturated),
-            "observer": dict(odict), "bounds": {n: list(bnds[n]) for n in free_t},
-            "threads": int(threads), "maneuvers": len(mans),
+            "loss": loss,
+            "huber_scale": float(huber_scale),
+            "weighting": weighting,
+            "method": method,
+            "start": start,
+            "refine": bool(refine),
+            "validation": len(val_m),
+            "seed": int(seed),
+            "slip_threshold": float(slip_threshold),
+            "score_saturated": bool(score_saturated),
+            "observer": dict(odict),
+            "bounds": {n: list(bnds[n]) for n in free_t},
+            "threads": int(threads),
+            "maneuvers": len(mans),
         },
         validation_trace=split["trace"],
         stages=stage,
@@ -335,9 +404,12 @@ def _data_warnings(split: dict, stage) -> list[str]:
         out.append(
             f"omega_hat is no better than predicting zero on the {which} maneuvers (RMSE "
             f"{rmse:.3g} rad/s against {rms:.3g} for omega_hat = 0)"
-            + ("" if stage is None or stage.speed_observable else
-               ": expected, the sliding speed is not observable on these data (S and the "
-               "slip decision still are)")
+            + (
+                ""
+                if stage is None or stage.speed_observable
+                else ": expected, the sliding speed is not observable on these data (S and the "
+                "slip decision still are)"
+            )
         )
     return out
 
