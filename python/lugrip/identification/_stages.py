@@ -347,9 +347,11 @@ def fit_presliding(
     *,
     tail: int = 20,
     max_len: int = 400,
+    max_runs: int = 60,
 ) -> PreslidingFit | None:
-    """Fit sigma0 and sigma_z on every run's loading samples (plus ``tail`` sliding samples);
-    None when no run has a loading phase of >= 3 samples."""
+    """Fit sigma0 and sigma_z on the runs' loading samples (plus ``tail`` sliding samples; at
+    most ``max_runs`` runs, evenly spread); None when no run has a loading phase of >= 3
+    samples."""
     wins = []
     for i, (m, ph) in enumerate(zip(mans, phases)):
         for a, b in runs(m):
@@ -377,6 +379,8 @@ def fit_presliding(
             )
     if not wins:
         return None
+    if len(wins) > max_runs:  # evenly spread subset: two parameters need no more
+        wins = [wins[i] for i in np.linspace(0, len(wins) - 1, max_runs).round().astype(int)]
     L = max(len(wv[1]) for wv in wins)
     R = len(wins)
     W = np.zeros((R, L))
@@ -419,14 +423,14 @@ def fit_presliding(
     s0_0 = float(np.median(2.3 * Gm[np.arange(R), n_load][ok] / th[ok])) if ok.any() else 1.0
     best = None
     for f0 in (1.0,):
-        for sz0 in (0.0, 0.01 * s0_0 * f0):
+        for sz0 in (0.01 * s0_0 * f0,):
             r = least_squares(
                 resid,
                 [math.log(s0_0 * f0), sz0],
                 bounds=([math.log(1e-3), 0.0], [math.log(1e4), np.inf]),
                 x_scale="jac",
                 diff_step=1e-4,
-                max_nfev=60,
+                max_nfev=40,
             )
             if best is None or r.cost < best.cost:
                 best = r
