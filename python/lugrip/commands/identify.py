@@ -1,5 +1,5 @@
 """``lugrip identify``: contact parameters from sliding logs with ground-truth velocity (paper
-Section 4, MODEL.md 8), or an object's mu and beta_A from a rubbing log (paper Section 6)."""
+Section 4, docs/model.md §8), or an object's mu and beta_A from a rubbing log (paper Section 6)."""
 
 from __future__ import annotations
 
