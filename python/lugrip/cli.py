@@ -1,8 +1,10 @@
 """The ``lugrip`` command line: ``lugrip <command> [options]``.
 
 Subcommands live in :mod:`lugrip.commands` (one module each, listed in
-``lugrip.commands.COMMANDS``). User errors exit with code 2 and one line on stderr; set
-``LUGRIP_DEBUG=1`` to get the traceback instead.
+``lugrip.commands.COMMANDS``). User errors (a bad argument, an unreadable, oversized or
+invalid file or field, malformed YAML, a number out of range, exhausted memory) exit with code
+2 and one line on stderr; any other exception exits with code 1 and one line naming it as an
+internal error. Set ``LUGRIP_DEBUG=1`` to get the traceback instead.
 """
 
 from __future__ import annotations
@@ -59,11 +61,33 @@ def build_parser() -> argparse.ArgumentParser:
     return parser
 
 
+_MAX_MESSAGE = 600  # [characters] longest error line printed (a message may embed a value)
+
+
 def _one_line(err: BaseException) -> str:
     text = str(err) or type(err).__name__
     if isinstance(err, OSError) and err.filename is not None and err.strerror:
         text = f"{err.filename}: {err.strerror}"
-    return "; ".join(part.strip() for part in text.splitlines() if part.strip())
+    line = "; ".join(part.strip() for part in text[: 4 * _MAX_MESSAGE].splitlines() if part.strip())
+    return line if len(line) <= _MAX_MESSAGE else line[: _MAX_MESSAGE - 5] + " [...]"
+
+
+def _input_error(err: BaseException) -> str | None:
+    """One line for the errors a hostile input provokes in the readers (malformed YAML from a
+    reader without limits, nesting beyond the recursion limit, numbers beyond the float range,
+    memory exhausted); None for other exceptions."""
+    if type(err).__module__.split(".")[0] == "yaml":  # yaml.YAMLError and subclasses
+        mark = getattr(err, "problem_mark", None)
+        where = f"line {mark.line + 1}: " if mark is not None else ""
+        problem = getattr(err, "problem", None) or type(err).__name__
+        return f"not valid YAML: {where}{problem}"
+    if isinstance(err, RecursionError):
+        return "input nested too deeply"
+    if isinstance(err, OverflowError):
+        return f"number out of range: {_one_line(err)}"
+    if isinstance(err, MemoryError):
+        return "out of memory: the input or the requested output is too large"
+    return None
 
 
 def main(argv: list[str] | None = None) -> int:
@@ -94,6 +118,17 @@ def main(argv: list[str] | None = None) -> int:
     except KeyboardInterrupt:
         print(f"{prog}: interrupted", file=sys.stderr)
         return 130
+    except Exception as err:  # noqa: BLE001 (one line instead of a traceback)
+        if os.environ.get("LUGRIP_DEBUG"):
+            raise
+        message = _input_error(err)
+        if message is not None:
+            print(f"{prog}: error: {message}", file=sys.stderr)
+            return 2
+        # not a recognised user error: a defect of lugrip or an input it does not check yet
+        print(f"{prog}: internal error: {type(err).__name__}: {_one_line(err)} "
+              "(set LUGRIP_DEBUG=1 for the traceback)", file=sys.stderr)
+        return 1
 
 
 if __name__ == "__main__":
