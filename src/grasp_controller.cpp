@@ -50,7 +50,7 @@ const GraspControllerSettings& checked(const GraspControllerSettings& s) {
 
 bool validate(const GraspControllerSettings& s, std::string* message) {
   // Bounds that keep every internal value finite for any input step() accepts (|S| <= 1e3,
-  // |omega_hat| <= 1e6); derivation in docs/model.md §9.9 (validity of the settings).
+  // |omega_hat| <= 1e6); derivation in docs/reliability.md §1.
   constexpr double kRateMin = 1.0e-3, kRateMax = 1.0e9;  // [Hz] sensor_rate
   constexpr int kRatioMax = 1000000;                     // command_ratio
   constexpr double kGainMax = 1.0e9;                     // k_cd [N s/rad], k_p, k_f [N], k_i [N/s]
