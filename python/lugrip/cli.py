@@ -72,10 +72,35 @@ def _one_line(err: BaseException) -> str:
     return line if len(line) <= _MAX_MESSAGE else line[: _MAX_MESSAGE - 5] + " [...]"
 
 
-def _input_error(err: BaseException) -> str | None:
-    """One line for the errors a hostile input provokes in the readers (malformed YAML from a
-    reader without limits, nesting beyond the recursion limit, numbers beyond the float range,
-    memory exhausted); None for other exceptions."""
+def _input_files(args: argparse.Namespace) -> str:
+    """'FILE: ' for the one existing input file among the arguments (outputs excluded), or
+    'one of A, B: ' for several; '' when none is known."""
+    from pathlib import Path
+
+    files = []
+    for name, value in vars(args).items():
+        if name in ("out", "output", "run") or not isinstance(value, (str, os.PathLike)):
+            continue
+        try:
+            if Path(value).is_file():
+                files.append(str(value))
+        except (OSError, ValueError):
+            continue
+    if not files:
+        return ""
+    return f"{files[0]}: " if len(files) == 1 else f"one of {', '.join(files)}: "
+
+
+def _input_error(err: BaseException, args: argparse.Namespace) -> str | None:
+    """One line for the errors a hostile input provokes in the readers (malformed YAML or CSV
+    from a reader without limits, text that is not UTF-8, nesting beyond the recursion limit,
+    numbers beyond the float range, memory exhausted); None for other exceptions."""
+    import csv
+
+    if isinstance(err, UnicodeDecodeError):
+        return f"{_input_files(args)}not UTF-8 text (byte {err.start})"
+    if isinstance(err, csv.Error):
+        return f"{_input_files(args)}malformed CSV: {_one_line(err)}"
     if type(err).__module__.split(".")[0] == "yaml":  # yaml.YAMLError and subclasses
         mark = getattr(err, "problem_mark", None)
         where = f"line {mark.line + 1}: " if mark is not None else ""
@@ -113,7 +138,8 @@ def main(argv: list[str] | None = None) -> int:
     except (CliError, ValueError, OSError) as err:
         if os.environ.get("LUGRIP_DEBUG"):
             raise
-        print(f"{prog}: error: {_one_line(err)}", file=sys.stderr)
+        message = _input_error(err, args) if isinstance(err, UnicodeDecodeError) else None
+        print(f"{prog}: error: {message or _one_line(err)}", file=sys.stderr)
         return 2
     except KeyboardInterrupt:
         print(f"{prog}: interrupted", file=sys.stderr)
@@ -121,7 +147,7 @@ def main(argv: list[str] | None = None) -> int:
     except Exception as err:  # noqa: BLE001 (one line instead of a traceback)
         if os.environ.get("LUGRIP_DEBUG"):
             raise
-        message = _input_error(err)
+        message = _input_error(err, args)
         if message is not None:
             print(f"{prog}: error: {message}", file=sys.stderr)
             return 2

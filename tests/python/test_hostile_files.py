@@ -221,3 +221,56 @@ def test_mutated_bytes(cut, junk, at, tmp_path, capsys):
     assert code in (0, 2)
     if code == 2:
         _one_error_line(captured.err, path)
+
+
+# --- logs and the catch-all of the entry point ----------------------------------------------------
+
+def test_hostile_logs_give_one_line_naming_the_file(tmp_path, capsys, log_file):
+    rows = log_file.read_text().splitlines()
+    cases = {
+        "utf16.csv": ("\n".join(rows).encode("utf-16"), "UTF-8"),
+        "binary.csv": (bytes(range(256)) * 64, "UTF-8"),
+        "bigcell.csv": (("\n".join(rows[:3]) + "\n" + "1" * 200_000 + "," + "\n".join(rows[3:9]) + "\n")
+                        .encode(), "CSV"),
+    }
+    for name, (data, word) in cases.items():
+        path = tmp_path / name
+        path.write_bytes(data)
+        code = main(["observe", str(path), "--preset", "table1", "--out", str(tmp_path / "o.csv")])
+        err = capsys.readouterr().err
+        assert code == 2, (name, err)
+        assert word in _one_error_line(err, path), name
+
+
+def test_unexpected_exception_is_one_line_exit_1(monkeypatch, tmp_path, capsys):
+    """A defect (an exception that is not a user error) is named in one line, exit code 1;
+    LUGRIP_DEBUG=1 re-raises it."""
+    import lugrip.commands.params as params_cmd
+
+    def broken(args):
+        raise TypeError("x" * 10_000)
+
+    monkeypatch.setattr(params_cmd, "run", broken)
+    assert main(["params", "--list"]) == 1
+    err = capsys.readouterr().err
+    lines = err.strip().splitlines()
+    assert len(lines) == 1 and "internal error: TypeError" in lines[0] and len(lines[0]) < 700
+    assert "LUGRIP_DEBUG=1" in lines[0]
+    monkeypatch.setenv("LUGRIP_DEBUG", "1")
+    with pytest.raises(TypeError):
+        main(["params", "--list"])
+
+
+@pytest.mark.parametrize("exc, word", [(RecursionError("deep"), "nested"),
+                                       (OverflowError("int too large"), "out of range"),
+                                       (MemoryError(), "out of memory")])
+def test_input_errors_are_exit_2(exc, word, monkeypatch, capsys):
+    import lugrip.commands.params as params_cmd
+
+    def raising(args):
+        raise exc
+
+    monkeypatch.setattr(params_cmd, "run", raising)
+    assert main(["params", "--list"]) == 2
+    lines = capsys.readouterr().err.strip().splitlines()
+    assert len(lines) == 1 and word in lines[0]
