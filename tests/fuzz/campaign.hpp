@@ -113,6 +113,10 @@ inline double from_key(int64_t k) {
   return v;
 }
 
+// lo <= hi: hi - lo without overflow, and the floor of their mean.
+inline uint64_t gap(int64_t lo, int64_t hi) { return static_cast<uint64_t>(hi) - static_cast<uint64_t>(lo); }
+inline int64_t midpoint(int64_t lo, int64_t hi) { return lo + static_cast<int64_t>(gap(lo, hi) / 2); }
+
 // Edges of the accepted set along one field (others fixed): the extreme accepted values and the
 // first rejected values just outside (when the edge is not +-inf).
 struct Edges {
@@ -136,8 +140,8 @@ Edges find_edges(const S& base, double* (*ref)(S&), Valid valid) {
     e.inside.push_back(kInf);
   } else {
     int64_t a = k0, b = k_hi;  // ok(a), !ok(b)
-    while (b - a > 1) {
-      const int64_t m = a + (b - a) / 2;
+    while (gap(a, b) > 1) {
+      const int64_t m = midpoint(a, b);
       (ok(m) ? a : b) = m;
     }
     e.inside.push_back(from_key(a));
@@ -147,8 +151,8 @@ Edges find_edges(const S& base, double* (*ref)(S&), Valid valid) {
     e.inside.push_back(-kInf);
   } else {
     int64_t a = k0, b = k_lo;  // ok(a), !ok(b), b < a
-    while (a - b > 1) {
-      const int64_t m = b + (a - b) / 2;
+    while (gap(b, a) > 1) {
+      const int64_t m = midpoint(b, a);
       (ok(m) ? a : b) = m;
     }
     e.inside.push_back(from_key(a));
