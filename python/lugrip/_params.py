@@ -206,6 +206,10 @@ def _check_observer_block(block: Any, where: str) -> dict[str, Any]:
             if isinstance(v, str) and v.lower().replace("-", "_") in enums[k]:
                 plain[k] = v
                 continue
+            names = [name for name, value in enums[k].items() if value is v]  # a C++ enum value
+            if names:
+                plain[k] = names[0]
+                continue
             raise ValueError(f"{field}: expected one of {', '.join(enums[k])}")
         kind = _OBS_KINDS.get(k, "float")
         if kind == "bool":

@@ -173,4 +173,9 @@ def to_number(value: Any, where: str) -> float:
             return float(t)
         except ValueError:
             raise ValueError(f"{where}: text that is not a number") from None
+    if hasattr(value, "__float__") and not isinstance(value, (list, dict, complex)):
+        try:  # Decimal, Fraction, other real-number types
+            return float(value)
+        except (TypeError, ValueError, OverflowError):
+            raise ValueError(f"{where}: not convertible to a floating-point number") from None
     raise ValueError(f"{where}: must be a number, not {describe_kind(value)}")
