@@ -8,7 +8,7 @@ OUT    ?= out
 
 SOURCES := $(shell find src include bindings python -type f \( -name '*.cpp' -o -name '*.hpp' -o -name '*.py' \)) pyproject.toml CMakeLists.txt
 
-.PHONY: all install demo test test-cpp test-python test-install deps-cpp validate bench sanitize clean
+.PHONY: all install demo test test-cpp test-python test-install deps-cpp validate bench sanitize sanitize-campaign clean
 
 all: install
 
@@ -61,6 +61,13 @@ sanitize:
 	cmake -S . -B build/asan -DCMAKE_BUILD_TYPE=Debug -DLUGRIP_BUILD_TESTS=ON -DLUGRIP_SANITIZE=ON > /dev/null
 	cmake --build build/asan -j $(JOBS)
 	cd build/asan && ctest --output-on-failure -j $(JOBS)
+
+# The adversarial campaign (tests/fuzz, docs/reliability.md) alone under ASan/UBSan, any UB
+# fatal: what CI runs of the sanitizers (the full `make sanitize` takes ~10 min on 2 cores).
+sanitize-campaign:
+	cmake -S . -B build/asan-campaign -DCMAKE_BUILD_TYPE=Debug -DLUGRIP_BUILD_TESTS=ON -DLUGRIP_SANITIZE=ON > /dev/null
+	cmake --build build/asan-campaign -j $(JOBS) --target lugrip_fuzz_campaign
+	UBSAN_OPTIONS=halt_on_error=1:print_stacktrace=1 build/asan-campaign/tests/fuzz/lugrip_fuzz_campaign --samples 200000 --seed 3
 
 bench: install
 	cmake -S . -B $(CPP_BUILD) -DCMAKE_BUILD_TYPE=Release -DLUGRIP_BUILD_TESTS=ON -DLUGRIP_BUILD_BENCHMARKS=ON > /dev/null

@@ -49,8 +49,16 @@ const GraspControllerSettings& checked(const GraspControllerSettings& s) {
 // --- settings --------------------------------------------------------------------------------
 
 bool validate(const GraspControllerSettings& s, std::string* message) {
+  // Bounds that keep every internal value finite for any input step() accepts (|S| <= 1e3,
+  // |omega_hat| <= 1e6); derivation in docs/reliability.md §1.
+  constexpr double kRateMin = 1.0e-3, kRateMax = 1.0e9;  // [Hz] sensor_rate
+  constexpr int kRatioMax = 1000000;                     // command_ratio
+  constexpr double kGainMax = 1.0e9;                     // k_cd [N s/rad], k_p, k_f [N], k_i [N/s]
+  constexpr double kPoleMin = 1.0e-9, kCornerMax = 1.0e12;  // [rad/s] p_cd, z_cd
+  constexpr double kForceMin = 1.0e-6, kForceMax = 1.0e6;   // [N] f_min, f_max, gain_schedule_force
+  constexpr double kPivotMax = 1.0e3;                    // s_pivot (slippage inputs are <= 1e3)
   std::string msg;
-  auto bad = [&](const char* name, double v, const char* rule) {
+  auto bad = [&](const char* name, double v, const std::string& rule) {
     msg += std::string(name) + " = " + fmt(v) + ": " + rule + "\n";
   };
   auto positive = [&](const char* name, double v) {
@@ -59,27 +67,36 @@ bool validate(const GraspControllerSettings& s, std::string* message) {
   auto positive_or_inf = [&](const char* name, double v) {
     if (!(v > 0.0)) bad(name, v, "must be > 0 (inf: off)");
   };
-  positive("sensor_rate", s.sensor_rate);
-  if (!(std::isfinite(s.gain_schedule_force) && s.gain_schedule_force >= 0.0))
-    bad("gain_schedule_force", s.gain_schedule_force, "must be finite and >= 0 (0: off)");
-  if (!(s.command_ratio >= 1)) bad("command_ratio", s.command_ratio, "must be >= 1");
-  positive("k_cd", s.k_cd);
-  positive("p_cd", s.p_cd);
-  if (!(std::isfinite(s.z_cd) && s.z_cd > s.p_cd)) bad("z_cd", s.z_cd, "must be finite and > p_cd (lag network)");
+  // (lo, hi] or [lo, hi]
+  auto within = [&](const char* name, double v, double lo, bool lo_open, double hi, const char* unit) {
+    if (!(std::isfinite(v) && (lo_open ? v > lo : v >= lo) && v <= hi))
+      bad(name, v, std::string("must be finite, ") + (lo_open ? "> " : ">= ") + fmt(lo) + " and <= " + fmt(hi) + unit);
+  };
+  within("sensor_rate", s.sensor_rate, kRateMin, false, kRateMax, " [Hz]");
+  if (!(s.gain_schedule_force == 0.0 ||
+        (std::isfinite(s.gain_schedule_force) && s.gain_schedule_force >= kForceMin && s.gain_schedule_force <= kForceMax)))
+    bad("gain_schedule_force", s.gain_schedule_force, "must be 0 (off) or in [1e-06, 1e+06] [N]");
+  if (!(s.command_ratio >= 1 && s.command_ratio <= kRatioMax)) bad("command_ratio", s.command_ratio, "must be >= 1 and <= 1000000");
+  within("k_cd", s.k_cd, 0.0, true, kGainMax, " [N s/rad]");
+  within("p_cd", s.p_cd, kPoleMin, false, kCornerMax, " [rad/s]");
+  if (!(std::isfinite(s.z_cd) && s.z_cd > s.p_cd && s.z_cd <= kCornerMax))
+    bad("z_cd", s.z_cd, "must be finite, > p_cd (lag network) and <= 1e+12 [rad/s]");
   if (!(s.s_ref > 0.0 && s.s_ref < 1.0)) bad("s_ref", s.s_ref, "must satisfy 0 < s_ref < 1");
-  positive("k_p", s.k_p);
-  positive("k_i", s.k_i);
-  positive("f_min", s.f_min);
-  if (!(std::isfinite(s.f_max) && s.f_max > s.f_min)) bad("f_max", s.f_max, "must be finite and > f_min");
+  within("k_p", s.k_p, 0.0, true, kGainMax, " [N]");
+  within("k_i", s.k_i, 0.0, true, kGainMax, " [N/s]");
+  within("f_min", s.f_min, kForceMin, false, kForceMax, " [N]");
+  if (!(std::isfinite(s.f_max) && s.f_max > s.f_min && s.f_max <= kForceMax))
+    bad("f_max", s.f_max, "must be finite, > f_min and <= 1e+06 [N]");
   positive_or_inf("max_rate_up", s.max_rate_up);
   positive_or_inf("max_rate_down", s.max_rate_down);
   if (!(std::isfinite(s.omega_deadband) && s.omega_deadband >= 0.0))
     bad("omega_deadband", s.omega_deadband, "must be finite and >= 0");
   if (!(std::isfinite(s.invalid_raise_step) && s.invalid_raise_step >= 0.0))
     bad("invalid_raise_step", s.invalid_raise_step, "must be finite and >= 0");
-  if (!(std::isfinite(s.s_pivot) && s.s_pivot > 1.0)) bad("s_pivot", s.s_pivot, "must be finite and > 1");
+  if (!(std::isfinite(s.s_pivot) && s.s_pivot > 1.0 && s.s_pivot <= kPivotMax))
+    bad("s_pivot", s.s_pivot, "must be finite, > 1 and <= 1000");
   positive("tau_pivot", s.tau_pivot);
-  positive("k_f", s.k_f);
+  within("k_f", s.k_f, 0.0, true, kGainMax, " [N]");
   if (!(std::isfinite(s.pivot_floor_factor) && s.pivot_floor_factor >= 1.0))
     bad("pivot_floor_factor", s.pivot_floor_factor, "must be finite and >= 1");
   positive("pivot_end_c_tilde", s.pivot_end_c_tilde);
@@ -497,8 +514,16 @@ StaticForceResult StaticForceSolver::solve(double f_t, double tau, double s_ref)
 double static_grasp_force(const ContactParams& params, double f_t, double tau, double s_ref) {
   if (!(s_ref > 0.0 && s_ref <= 1.0))
     throw std::invalid_argument("static_grasp_force: s_ref = " + fmt(s_ref) + ": must satisfy 0 < s_ref <= 1");
+  if (!(std::isfinite(f_t) && std::isfinite(tau)))
+    throw std::invalid_argument("static_grasp_force: f_t = " + fmt(f_t) + ", tau = " + fmt(tau) + ": must be finite");
   StaticForceSolver solver(params);
-  return solver.solve(f_t, tau, s_ref).force;
+  const StaticForceResult r = solver.solve(f_t, tau, s_ref);
+  // The solver evaluates the static map between 1e-12 N and 1e12 N (its CoR settings); a load
+  // whose force lies outside gives no finite answer.
+  if (!std::isfinite(r.force))
+    throw std::invalid_argument("static_grasp_force: load f_t = " + fmt(f_t) + " N, tau = " + fmt(tau) +
+                                " N m: the static force is outside the range the solver covers (1e-12 to 1e12 N)");
+  return r.force;
 }
 
 }  // namespace lugrip

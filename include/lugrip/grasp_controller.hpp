@@ -283,7 +283,8 @@ class StaticForceSolver {
 };
 
 //! Convenience: per-finger static grasp force [N] (builds a ContactModel; prefer
-//! StaticForceSolver for many loads). Throws std::invalid_argument for invalid params or s_ref.
+//! StaticForceSolver for many loads). Throws std::invalid_argument for invalid params or s_ref,
+//! a non-finite load, or a load whose force is outside the solver's range (1e-12 to 1e12 N).
 double static_grasp_force(const ContactParams& params, double f_t, double tau, double s_ref = 0.8);
 
 }  // namespace lugrip

@@ -13,6 +13,7 @@ import numpy as np
 
 from . import _core
 from ._params import ContactParams
+from ._yaml import to_number
 
 __all__ = [
     "Status",
@@ -45,12 +46,27 @@ class Status(enum.IntEnum):
 
 def shape_factor(k: float) -> float:
     """Torsional shape factor xi(k): tau_max = mu * xi * rho * f_n (xi(4) = 0.6354)."""
-    return _core.shape_factor(float(k))
+    return _core.shape_factor(to_number(k, "k"))
 
 
-def _flat(*arrays):
-    """Broadcast inputs to one shape; return contiguous float64 1-D views and the shape."""
-    b = np.broadcast_arrays(*[np.asarray(a, dtype=np.float64) for a in arrays])
+def _as_float_array(a, name: str) -> np.ndarray:
+    try:
+        return np.asarray(a, dtype=np.float64)
+    except (TypeError, ValueError, OverflowError):
+        raise ValueError(f"{name}: must be a number or an array of numbers") from None
+
+
+def _flat(*arrays, names=None):
+    """Broadcast inputs to one shape; return contiguous float64 1-D views and the shape.
+    ``names`` (one per input) name the argument in the ValueError for a non-numeric input or
+    shapes that do not broadcast."""
+    names = names or [f"argument {i + 1}" for i in range(len(arrays))]
+    converted = [_as_float_array(a, n) for a, n in zip(arrays, names)]
+    try:
+        b = np.broadcast_arrays(*converted)
+    except ValueError:
+        shapes = ", ".join(f"{n} {x.shape}" for n, x in zip(names, converted))
+        raise ValueError(f"shapes do not broadcast: {shapes}") from None
     shape = b[0].shape
     return [np.ascontiguousarray(x).reshape(-1) for x in b], shape
 
@@ -71,8 +87,9 @@ class LimitSurface:
     """
 
     def __init__(self, k: float = 4.0):
+        k = to_number(k, "k")
         try:
-            self._ls = _core.LimitSurface(float(k))
+            self._ls = _core.LimitSurface(k)
         except ValueError as err:
             raise ValueError(str(err)) from None
 
@@ -85,7 +102,7 @@ class LimitSurface:
         return self._ls.xi
 
     def _map(self, fn, c):
-        (x,), shape = _flat(c)
+        (x,), shape = _flat(c, names=["c_tilde"])
         return _shaped(fn(x), shape)
 
     def ft_star(self, c_tilde):
@@ -108,12 +125,12 @@ class LimitSurface:
 
     def sigma_ls(self, c_tilde, gamma: float):
         """sigma_LS(|c~|) = F^(gamma+1)/T, the map inverted by the CoR estimator."""
-        (x,), shape = _flat(c_tilde)
-        return _shaped(self._ls.sigma_ls(x, float(gamma)), shape)
+        (x,), shape = _flat(c_tilde, names=["c_tilde"])
+        return _shaped(self._ls.sigma_ls(x, to_number(gamma, "gamma")), shape)
 
     def integrate(self, c_tilde: float):
         """Direct quadrature (slow, no table) at one point: (F, T, dF/da, dT/da)."""
-        return self._ls.integrate(float(c_tilde))
+        return self._ls.integrate(to_number(c_tilde, "c_tilde"))
 
     def __repr__(self) -> str:
         return f"LimitSurface(k={self.k!r})"
@@ -160,28 +177,28 @@ def _as_params(params) -> ContactParams:
 def contact_radius(params, f_n):
     """rho = delta * f_n**gamma [m]."""
     p = _as_params(params)
-    (fn,), shape = _flat(f_n)
+    (fn,), shape = _flat(f_n, names=["f_n"])
     return _shaped(_model(p).rho(fn), shape)
 
 
 def g(params, f_n, c_tilde):
     """Maximum dry friction torque about the CoR, g(f_n, c) = mu f_n rho G(|c~|) [N m] (eq. 18)."""
     p = _as_params(params)
-    (fn, c), shape = _flat(f_n, c_tilde)
+    (fn, c), shape = _flat(f_n, c_tilde, names=["f_n", "c_tilde"])
     return _shaped(_model(p).g(fn, c), shape)
 
 
 def sigma_1(params, f_n, c_tilde):
     """Viscous coefficient about the CoR, pi beta_A rho^4 (c~^2 + 1/2) [N m s/rad] (eq. 17)."""
     p = _as_params(params)
-    (fn, c), shape = _flat(f_n, c_tilde)
+    (fn, c), shape = _flat(f_n, c_tilde, names=["f_n", "c_tilde"])
     return _shaped(_model(p).sigma_1(fn, c), shape)
 
 
 def normalized_wrench(params, f_n, f_t, tau):
     """(f_t / (mu f_n), tau / tau_max(f_n)): the normalized measured friction (eqs. 11-12)."""
     p = _as_params(params)
-    (fn, ft, tq), shape = _flat(f_n, f_t, tau)
+    (fn, ft, tq), shape = _flat(f_n, f_t, tau, names=["f_n", "f_t", "tau"])
     m = _model(p)
     return _shaped(ft / m.ft_max(fn), shape), _shaped(tq / m.tau_max(fn), shape)
 
@@ -252,11 +269,11 @@ def estimate_cor(params, f_n, f_t, tau, *, f_n_min: float | None = None,
              "force_limit": force_limit, "torque_limit": torque_limit}
     for name, value in given.items():
         if value is not None:
-            setattr(settings, name, float(value))
+            setattr(settings, name, to_number(value, name))
     message = _core.validate_cor_settings(settings)
     if message:
         raise ValueError("invalid CoR settings:\n" + message.rstrip())
-    (fn, ft, tq), shape = _flat(f_n, f_t, tau)
+    (fn, ft, tq), shape = _flat(f_n, f_t, tau, names=["f_n", "f_t", "tau"])
     est = _core.CorEstimator(_model(p), settings)
     r = est.run(fn, ft, tq)
     return CorEstimate(**{k: _shaped(v, shape) for k, v in r.items() if k != "rho"})

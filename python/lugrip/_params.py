@@ -8,6 +8,7 @@ from pathlib import Path
 from typing import Any
 
 from . import _core
+from ._yaml import describe_kind, field_path, load_yaml, to_number
 
 __all__ = ["ContactParams", "PRESETS", "read_observer_settings"]
 
@@ -54,11 +55,8 @@ class ContactParams:
 
     def __post_init__(self) -> None:
         for name in _FIELDS:
-            value = getattr(self, name)
-            try:
-                object.__setattr__(self, name, float(value))
-            except (TypeError, ValueError):
-                raise ValueError(f"ContactParams.{name} = {value!r}: must be a number") from None
+            # ValueError naming the field for booleans, text, collections, huge integers
+            object.__setattr__(self, name, to_number(getattr(self, name), f"ContactParams.{name}"))
         message = _core.validate_params(self.to_core())
         if message:
             raise ValueError("invalid ContactParams:\n" + message.rstrip())
@@ -108,36 +106,53 @@ class ContactParams:
     # --- YAML --------------------------------------------------------------------------
     @classmethod
     def from_dict(cls, data: dict[str, Any]) -> "ContactParams":
-        """From a mapping; accepts either flat fields or the YAML layout of to_yaml()."""
+        """From a mapping; accepts either flat fields or the YAML layout of to_yaml().
+
+        Raises:
+            ValueError: naming the path of the bad field (``contact.mu: ...``); values are not
+                echoed.
+        """
+        if not isinstance(data, dict):
+            raise ValueError(f"expected a mapping of parameters, not {describe_kind(data)}")
         if "contact" in data:
-            data = data["contact"]
+            data, prefix = data["contact"], "contact."
+            if not isinstance(data, dict):
+                raise ValueError(f"contact: must be a mapping of parameters, not {describe_kind(data)}")
         else:  # flat layout: the observer block of an identification result is not a field
-            data = {k: v for k, v in data.items() if k != "observer"}
+            data, prefix = {k: v for k, v in data.items() if k != "observer"}, ""
         values = {}
         for name, value in data.items():
-            if name not in _FIELDS:
-                raise ValueError(f"unknown parameter {name!r}; expected {', '.join(_FIELDS)}")
+            if not isinstance(name, str) or name not in _FIELDS:
+                key = field_path(name) if isinstance(name, str) else f"a {type(name).__name__} key"
+                raise ValueError(f"unknown parameter '{prefix}{key}'; expected {', '.join(_FIELDS)}")
+            where = prefix + name
             if isinstance(value, dict):
-                value = value.get("value")
-            if isinstance(value, str) and value.strip().lower() in ("inf", ".inf", "infinity"):
-                value = math.inf
-            values[name] = value
+                if "value" not in value:
+                    raise ValueError(f"{where}: a mapping needs a 'value' entry")
+                value, where = value["value"], where + ".value"
+            values[name] = to_number(value, where)
         missing = [n for n in _FIELDS[:6] if n not in values]
         if missing:
-            raise ValueError(f"missing parameter(s): {', '.join(missing)}")
-        return cls(**values)
+            raise ValueError(f"missing parameter(s): {', '.join(prefix + m for m in missing)}")
+        try:
+            return cls(**values)
+        except ValueError as err:  # C++ validation: one line per field, without the prefix
+            lines = [ln.strip() for ln in str(err).splitlines()[1:] if ln.strip()]
+            raise ValueError("; ".join(prefix + ln for ln in lines) or str(err)) from None
 
     @classmethod
     def from_yaml(cls, path: str | Path) -> "ContactParams":
-        import yaml
+        """From a parameter YAML file (read with the limits of :func:`lugrip._yaml.load_yaml`).
 
+        Raises:
+            ValueError: ``<file>: <field path>: <problem>`` for an unreadable, oversized,
+                invalid or hostile file or field.
+        """
         path = Path(path)
-        try:
-            data = yaml.safe_load(path.read_text())
-        except yaml.YAMLError as err:
-            raise ValueError(f"{path}: not valid YAML: {err}") from None
+        data = load_yaml(path)
         if not isinstance(data, dict):
-            raise ValueError(f"{path}: expected a mapping of parameters")
+            what = "an empty file" if data is None else describe_kind(data)
+            raise ValueError(f"{path}: expected a mapping of parameters, found {what}")
         try:
             return cls.from_dict(data)
         except ValueError as err:
@@ -172,20 +187,49 @@ class ContactParams:
 
 def _check_observer_block(block: Any, where: str) -> dict[str, Any]:
     """Validates an observer block (keywords of lugrip.Observer) by building the settings;
-    returns it with plain Python values."""
-    from ._observer import Observer
+    returns it with plain Python values. Errors name ``where`` and the key, never the value."""
+    from ._observer import _COR_FIELDS, _OBS_KINDS, GAIN_MODES, INTEGRATORS, Observer
 
     if not isinstance(block, dict):
-        raise ValueError(f"{where}: expected a mapping of observer settings")
-    plain = {}
+        raise ValueError(f"{where}: expected a mapping of observer settings, not {describe_kind(block)}")
+    enums = {"integrator": INTEGRATORS, "gain_mode": GAIN_MODES}
+    known = set(_OBS_KINDS) | set(_COR_FIELDS) | set(enums) | {"gain", "bandwidth", "dt"}
+    plain: dict[str, Any] = {}
     for k, v in block.items():
-        if hasattr(v, "item"):  # numpy scalars
-            v = v.item()
-        plain[str(k)] = v
+        if not isinstance(k, str) or k not in known:
+            key = field_path(k) if isinstance(k, str) else f"a {type(k).__name__} key"
+            raise ValueError(f"{where}.{key}: unknown observer setting")
+        field = f"{where}.{k}"
+        if hasattr(v, "item") and not isinstance(v, (list, dict, str)):
+            v = v.item()  # numpy scalars
+        if k in enums:
+            if isinstance(v, str) and v.lower().replace("-", "_") in enums[k]:
+                plain[k] = v
+                continue
+            names = [name for name, value in enums[k].items() if value is v]  # a C++ enum value
+            if names:
+                plain[k] = names[0]
+                continue
+            raise ValueError(f"{field}: expected one of {', '.join(enums[k])}")
+        kind = _OBS_KINDS.get(k, "float")
+        if kind == "bool":
+            if not isinstance(v, bool):
+                raise ValueError(f"{field}: must be true or false")
+            plain[k] = v
+        elif kind == "int":
+            x = to_number(v, field)
+            if not (math.isfinite(x) and x == int(x) and abs(x) < 2**31):
+                raise ValueError(f"{field}: must be an integer")
+            plain[k] = int(x)
+        else:
+            plain[k] = to_number(v, field)
     try:
         Observer(ContactParams.table1(), **plain)
-    except (TypeError, ValueError) as err:
-        raise ValueError(f"{where}: {str(err).replace(chr(10), '; ')}") from None
+    except (TypeError, ValueError, OverflowError) as err:
+        lines = [ln.strip() for ln in str(err).splitlines() if ln.strip()]
+        if lines and lines[0].startswith("invalid observer settings"):
+            lines = lines[1:]
+        raise ValueError("; ".join(f"{where}.{ln}" for ln in lines) or where) from None
     return plain
 
 
@@ -200,15 +244,12 @@ def read_observer_settings(path: str | Path) -> dict[str, Any] | None:
     YAML ``params0``.
 
     Raises:
-        ValueError: the block is not a mapping or holds an unknown or invalid setting.
+        ValueError: the file cannot be read within the limits of :func:`lugrip._yaml.load_yaml`,
+            or the block is not a mapping or holds an unknown or invalid setting (message
+            ``<file>: observer.<key>: ...``).
     """
-    import yaml
-
     path = Path(path)
-    try:
-        data = yaml.safe_load(path.read_text())
-    except yaml.YAMLError as err:
-        raise ValueError(f"{path}: not valid YAML: {err}") from None
+    data = load_yaml(path)
     if not isinstance(data, dict) or data.get("observer") is None:
         return None
     return _check_observer_block(data["observer"], f"{path}: observer")

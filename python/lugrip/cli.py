@@ -1,8 +1,10 @@
 """The ``lugrip`` command line: ``lugrip <command> [options]``.
 
 Subcommands live in :mod:`lugrip.commands` (one module each, listed in
-``lugrip.commands.COMMANDS``). User errors exit with code 2 and one line on stderr; set
-``LUGRIP_DEBUG=1`` to get the traceback instead.
+``lugrip.commands.COMMANDS``). User errors (a bad argument, an unreadable, oversized or
+invalid file or field, malformed YAML, a number out of range, exhausted memory) exit with code
+2 and one line on stderr; any other exception exits with code 1 and one line naming it as an
+internal error. Set ``LUGRIP_DEBUG=1`` to get the traceback instead.
 """
 
 from __future__ import annotations
@@ -59,12 +61,59 @@ def build_parser() -> argparse.ArgumentParser:
     return parser
 
 
+_MAX_MESSAGE = 600  # [characters] longest error line printed (a message may embed a value)
+
+
 def _one_line(err: BaseException) -> str:
     # errors that carry a command-line wording of their hints (lugrip.io.LogError) use it
     text = getattr(err, "cli_message", None) or str(err) or type(err).__name__
     if isinstance(err, OSError) and err.filename is not None and err.strerror:
         text = f"{err.filename}: {err.strerror}"
-    return "; ".join(part.strip() for part in text.splitlines() if part.strip())
+    line = "; ".join(part.strip() for part in text[: 4 * _MAX_MESSAGE].splitlines() if part.strip())
+    return line if len(line) <= _MAX_MESSAGE else line[: _MAX_MESSAGE - 5] + " [...]"
+
+
+def _input_files(args: argparse.Namespace) -> str:
+    """'FILE: ' for the one existing input file among the arguments (outputs excluded), or
+    'one of A, B: ' for several; '' when none is known."""
+    from pathlib import Path
+
+    files = []
+    for name, value in vars(args).items():
+        if name in ("out", "output", "run") or not isinstance(value, (str, os.PathLike)):
+            continue
+        try:
+            if Path(value).is_file():
+                files.append(str(value))
+        except (OSError, ValueError):
+            continue
+    if not files:
+        return ""
+    return f"{files[0]}: " if len(files) == 1 else f"one of {', '.join(files)}: "
+
+
+def _input_error(err: BaseException, args: argparse.Namespace) -> str | None:
+    """One line for the errors a hostile input provokes in the readers (malformed YAML or CSV
+    from a reader without limits, text that is not UTF-8, nesting beyond the recursion limit,
+    numbers beyond the float range, memory exhausted); None for other exceptions."""
+    import csv
+
+    if isinstance(err, UnicodeDecodeError):
+        return f"{_input_files(args)}not UTF-8 text (byte {err.start})"
+    if isinstance(err, csv.Error):
+        return f"{_input_files(args)}malformed CSV: {_one_line(err)}"
+    if type(err).__module__.split(".")[0] == "yaml":  # yaml.YAMLError and subclasses
+        mark = getattr(err, "problem_mark", None)
+        where = f"line {mark.line + 1}: " if mark is not None else ""
+        problem = getattr(err, "problem", None) or type(err).__name__
+        return f"not valid YAML: {where}{problem}"
+    if isinstance(err, RecursionError):
+        return "input nested too deeply"
+    if isinstance(err, OverflowError):
+        return f"number out of range: {_one_line(err)}"
+    if isinstance(err, MemoryError):
+        return "out of memory: the input or the requested output is too large"
+    return None
 
 
 def main(argv: list[str] | None = None) -> int:
@@ -90,7 +139,8 @@ def main(argv: list[str] | None = None) -> int:
     except (CliError, ValueError, OSError) as err:
         if os.environ.get("LUGRIP_DEBUG"):
             raise
-        print(f"{prog}: error: {_one_line(err)}", file=sys.stderr)
+        message = _input_error(err, args) if isinstance(err, UnicodeDecodeError) else None
+        print(f"{prog}: error: {message or _one_line(err)}", file=sys.stderr)
         return 2
     except ImportError as err:
         if getattr(err, "extra", None) is None or os.environ.get("LUGRIP_DEBUG"):
@@ -100,6 +150,17 @@ def main(argv: list[str] | None = None) -> int:
     except KeyboardInterrupt:
         print(f"{prog}: interrupted", file=sys.stderr)
         return 130
+    except Exception as err:  # noqa: BLE001 (one line instead of a traceback)
+        if os.environ.get("LUGRIP_DEBUG"):
+            raise
+        message = _input_error(err, args)
+        if message is not None:
+            print(f"{prog}: error: {message}", file=sys.stderr)
+            return 2
+        # not a recognised user error: a defect of lugrip or an input it does not check yet
+        print(f"{prog}: internal error: {type(err).__name__}: {_one_line(err)} "
+              "(set LUGRIP_DEBUG=1 for the traceback)", file=sys.stderr)
+        return 1
 
 
 if __name__ == "__main__":

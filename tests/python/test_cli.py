@@ -138,7 +138,7 @@ def test_ls_out_must_be_a_directory(tmp_path, capsys):
     ("contact:\n  mu: {value: 0.5}\n", ["missing", "beta_a"]),
     ("mu: 0.5\nbeta_a: 1e7\nsigma0: 16\nsigma_z: 2\ndelta: 0.0018\ngamma: 0.25\nfriction: 1\n",
      ["friction"]),
-    ("mu: abc\nbeta_a: 1e7\nsigma0: 16\nsigma_z: 2\ndelta: 0.0018\ngamma: 0.25\n", ["mu", "abc"]),
+    ("mu: abc\nbeta_a: 1e7\nsigma0: 16\nsigma_z: 2\ndelta: 0.0018\ngamma: 0.25\n", ["mu", "not a number"]),
     ("mu: 0.5\nbeta_a: -1\nsigma0: 16\nsigma_z: 2\ndelta: 0.0018\ngamma: 0.25\n", ["beta_a"]),
     ("[1, 2, 3]\n", ["mapping"]),
     ("mu: [unclosed\n", ["YAML"]),

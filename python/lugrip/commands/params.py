@@ -60,7 +60,8 @@ def register(subparsers) -> None:
                    help="print a preset as YAML: " + ", ".join(PRESET_SOURCES))
     g.add_argument("--list", action="store_true", help="list the presets")
     g.add_argument("--check", type=Path, metavar="FILE",
-                   help="validate a parameter YAML file and print the parsed parameters")
+                   help="validate a parameter YAML file (contact parameters and the observer block, "
+                   "as `lugrip observe --params` reads it) and print the parsed values")
     p.set_defaults(run=run)
 
 
@@ -136,6 +137,14 @@ def run(args: argparse.Namespace) -> int:
         raise CliError(f"argument --check: {path}: no such file")
     if path.is_dir():
         raise CliError(f"argument --check: {path} is a directory")
+    from .._params import read_observer_settings
+
     params = ContactParams.from_yaml(path)  # ValueError names the file and the field
+    # the observer block is checked as `lugrip observe --params` builds it
+    block = read_observer_settings(path)
     sys.stdout.write(describe(params, str(path)))
+    if block:
+        sys.stdout.write("observer settings (valid):\n")
+        for key, value in block.items():
+            sys.stdout.write(f"  {key:<16} = {value}\n")
     return 0
