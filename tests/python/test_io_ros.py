@@ -383,3 +383,34 @@ def test_maneuvers_found_on_an_independent_plant():
     assert len(found) == len(true) == 9
     lag = found - true
     assert np.all((lag >= 0) & (lag <= 0.1 * 500)), lag
+
+
+def test_identify_cli_reads_bags_with_the_observe_options(tmp_path, capsys, data):
+    """`lugrip identify` takes observe's log options (--wrench-topic, --omega-topic,
+    --maneuver-topic): the bag gives the CSV's fitted mu and beta_A (8 iterations; the
+    comparison needs equal inputs, not a converged fit)."""
+    import yaml
+
+    log = data.log.select(data.log.maneuver < 4)
+    csv_log = write_log(log, tmp_path / "run.csv")
+    bag = write_two_finger_bag(tmp_path / "run.bag", log, ros1=True)
+    start = tmp_path / "table1.yaml"
+    ContactParams.table1().to_yaml(start)
+    common = ["--params0", start, "--free", "mu,beta_a", "--max-iterations", "8", "--threads",
+              "1", "--quiet"]
+    fitted = []
+    for name, src, extra in (("csv", csv_log, []),
+                             ("bag", bag, ["--wrench-topic", "/finger0/wrench", "--omega-topic",
+                                           "/truth/twist", "--maneuver-topic", "/maneuver"])):
+        out = tmp_path / f"fit_{name}.yaml"
+        rc = main(["identify", *map(str, [src, *common, *extra, "--out", out])])
+        err = capsys.readouterr().err
+        assert rc in (0, 3), err
+        fitted.append(yaml.safe_load(out.read_text())["contact"])
+    for key in ("mu", "beta_a"):
+        a, b = fitted[0][key]["value"], fitted[1][key]["value"]
+        assert b == pytest.approx(a, rel=1e-8), key
+    # without the topic option the bag's two wrench topics are ambiguous: exit 2, one line
+    rc = main(["identify", str(bag), *map(str, common), "--out", str(tmp_path / "x.yaml")])
+    err = capsys.readouterr().err
+    assert rc == 2 and len(err.strip().splitlines()) == 1, err

@@ -10,6 +10,7 @@ import time
 from pathlib import Path
 
 from . import CliError, observer_options, positive_float
+from ._log_options import add_log_options, read_log_from_args
 
 __all__ = ["ProgressBar", "register", "run", "write_report"]
 
@@ -195,6 +196,7 @@ def register(subparsers) -> None:
         "(needs --params0 for delta and gamma)",
     )
     p.add_argument("--quiet", action="store_true", help="no progress bar")
+    add_log_options(p)
     p.set_defaults(run=run)
 
 
@@ -397,7 +399,6 @@ def run(args) -> int:
     import warnings
 
     from ..identification import IdentificationError, estimate_rubbing, identify
-    from ..io import read_log
 
     for path in args.logs:
         if not path.exists():
@@ -416,7 +417,7 @@ def run(args) -> int:
             raise CliError(f"argument --params0: {err}") from None
         results = []
         for path in args.logs:
-            est = estimate_rubbing(read_log(path, allow_gaps=True), base, mode="rotation")
+            est = estimate_rubbing(read_log_from_args(path, args, allow_gaps=True), base, mode="rotation")
             results.append(est)
             print(f"{path}: {est}")
         est = results[0] if len(results) == 1 else None
@@ -454,7 +455,7 @@ def run(args) -> int:
     if args.free is not None and args.params0 is None:
         raise CliError("--free needs --params0 for the values of the fixed parameters")
     bar = None if args.quiet else ProgressBar(args.max_iterations)
-    logs = [read_log(p, allow_gaps=True) for p in args.logs]
+    logs = [read_log_from_args(p, args, allow_gaps=True) for p in args.logs]
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always")
         try:
