@@ -47,6 +47,17 @@ def _exponent(text: str) -> float:
     return k
 
 
+def _bootstrap_count(text: str) -> int:
+    """argparse type for --bootstrap: a whole number of refits in [2, 10000]."""
+    try:
+        value = int(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"invalid value {text!r}: expected a whole number") from None
+    if not 2 <= value <= 10000:
+        raise argparse.ArgumentTypeError(f"invalid value {text!r}: must be in [2, 10000]")
+    return value
+
+
 def register(subparsers) -> None:
     p = subparsers.add_parser(
         "identify",
@@ -154,7 +165,8 @@ def register(subparsers) -> None:
         help="hold the pressure exponent at K (0.5 .. inf; 2 Hertzian); default: identified",
     )
     p.add_argument(
-        "--bootstrap", type=int, default=20, metavar="N", help="refits for --uncertainty bootstrap"
+        "--bootstrap", type=_bootstrap_count, default=20, metavar="N",
+        help="refits for --uncertainty bootstrap (2 .. 10000)"
     )
     o = p.add_argument_group(
         "observer inside the cost (default: the observer block of --params0 when it has one, "

@@ -40,11 +40,11 @@ from pathlib import Path
 from typing import Any
 
 import numpy as np
-import yaml
 
 from .. import __version__
 from .._controller import static_grasp_force
 from .._params import ContactParams
+from .._yaml import load_yaml, to_number
 from ._closed_loop import ClosedLoopRun, run_closed_loop
 from ._plant import PlantConfig
 
@@ -241,11 +241,19 @@ class Scenario:
             raise ValueError(
                 f"{where}: criteria_by_plant: keys must be among {', '.join(PLANT_MODELS)}"
             )
+        plant = data["plant"]
+        if not isinstance(plant, Mapping):
+            raise ValueError(f"{where}: plant: expected a mapping (model: patch | lumped | mujoco, ...)")  # noqa: TRY004 (file content)
+        model = plant.get("model", "patch")
+        if not isinstance(model, str) or model not in PLANT_MODELS:
+            raise ValueError(f"{where}: plant.model: must be one of {', '.join(PLANT_MODELS)}")
         sw = data.get("steady_window")
+        if sw is not None and (not isinstance(sw, Sequence) or isinstance(sw, str) or len(sw) != 2):
+            raise ValueError(f"{where}: steady_window: expected [start, end] in seconds")
         s = cls(
             name=str(data["name"]),
             title=str(data["title"]),
-            duration=float(data["duration"]),
+            duration=to_number(data["duration"], f"{where}: duration"),
             plant=dict(data["plant"]),
             figure=data.get("figure"),
             group=data.get("group"),
@@ -255,8 +263,10 @@ class Scenario:
             observer=dict(data.get("observer") or {}),
             estimator=_estimator_block(data.get("estimator"), where),
             schedule=list(data.get("schedule") or []),
-            hold_start=None if data.get("hold_start") is None else float(data["hold_start"]),
-            steady_window=None if sw is None else (float(sw[0]), float(sw[1])),
+            hold_start=(None if data.get("hold_start") is None
+                        else to_number(data["hold_start"], f"{where}: hold_start")),
+            steady_window=None if sw is None else (to_number(sw[0], f"{where}: steady_window[0]"),
+                                                    to_number(sw[1], f"{where}: steady_window[1]")),
             criteria=dict(data.get("criteria") or {}),
             baselines=dict(data.get("baselines") or {}),
             short=dict(data.get("short") or {}),
@@ -267,11 +277,6 @@ class Scenario:
         )
         if s.suite not in SUITES:
             raise ValueError(f"{where}: suite {s.suite!r}: expected one of {', '.join(SUITES)}")
-        model = s.plant.get("model", "patch")
-        if model not in PLANT_MODELS:
-            raise ValueError(
-                f"{where}: plant.model {model!r}: expected one of {', '.join(PLANT_MODELS)}"
-            )
         s.plant_config()  # validates the plant block now, naming bad fields
         if s.mujoco:
             s.scene_spec()  # and the MuJoCo scene
@@ -407,9 +412,7 @@ def expand_disturbances(items: Sequence[Mapping[str, Any]]) -> list[dict]:
 def load_scenario(name: str | Path) -> Scenario:
     """Load a scenario from a YAML file or by name (``exp1_big_resin_block``)."""
     path = find_scenario(name)
-    with open(path) as f:
-        data = yaml.safe_load(f)
-    return Scenario.from_dict(data, source=path)
+    return Scenario.from_dict(load_yaml(path), source=path)
 
 
 # --- metrics ---------------------------------------------------------------------------------
