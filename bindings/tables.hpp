@@ -112,7 +112,17 @@ struct Table<GraspControllerSettings> {
       field("pivot_floor_factor", &S::pivot_floor_factor, "pivoting floor factor on f_t / mu [-]"),
       field("pivot_end_c_tilde", &S::pivot_end_c_tilde, "pivoting ends above this mean |c~| [-]"),
       field("pivot_end_samples", &S::pivot_end_samples, "consecutive samples above the threshold"),
-      field("pivot_timeout", &S::pivot_timeout, "pivoting timeout (inf: off) [s]"));
+      field("pivot_timeout", &S::pivot_timeout, "pivoting timeout (inf: off) [s]"),
+      field("slope_gain", &S::slope_gain, "PI gains from the plant's slope dS/df_n"),
+      field("loop_gain_p", &S::loop_gain_p, "proportional loop gain k_p |dS/df_n| [-]"),
+      field("loop_gain_i", &S::loop_gain_i, "integral loop gain k_i |dS/df_n| [1/s]"),
+      field("feedforward", &S::feedforward, "static part floored at the measured load's static force"),
+      field("feedforward_slippage", &S::feedforward_slippage, "S of the feed-forward force [-]"),
+      field("slip_reflex", &S::slip_reflex, "raise the force when S reaches reflex_slippage"),
+      field("reflex_slippage", &S::reflex_slippage, "threshold on the peak of S [-]"),
+      field("reflex_samples", &S::reflex_samples, "consecutive samples at or above the threshold"),
+      field("reflex_factor", &S::reflex_factor, "static-part raise per period of detected slip [-]"),
+      field("average_slippage", &S::average_slippage, "PI on the mean S of the command period"));
 };
 
 template <>
@@ -216,6 +226,11 @@ struct Table<GraspControllerOutput> {
       field("slippage", &S::slippage, "combined S = max_i S_i at the last command [-]"),
       field("error", &S::error, "S - S_ref at the last command [-]"),
       field("integrator", &S::integrator, "PI integrator [N]"),
+      field("gain_p", &S::gain_p, "k_p used at the last command [N]"),
+      field("gain_i", &S::gain_i, "k_i used at the last command [N/s]"),
+      field("feedforward_force", &S::feedforward_force, "feed-forward force at the last command [N]"),
+      field("peak_slippage", &S::peak_slippage, "peak of max_i S_i over the period before the last command [-]"),
+      field("reflex", &S::reflex, "the slip reflex raised the last command"),
       field("dynamic_sample", &S::dynamic_sample, "signed C_d omega_hat per finger at this sample [N]"),
       field("dynamic_peak", &S::dynamic_peak, "peak of max_i |C_d omega_hat_i| since the last command [N]"),
       field("mean_c_tilde", &S::mean_c_tilde, "mean |c~_i| of the valid fingers [-]"),

@@ -17,6 +17,7 @@ from ._contact import Status, _as_params, _flat, _model, _shaped
 from ._params import ContactParams
 
 __all__ = [
+    "PAPER_SETTINGS",
     "REQUEST_NONE",
     "REQUEST_PIVOTING",
     "REQUEST_SLIPPING_AVOIDANCE",
@@ -37,6 +38,19 @@ REQUEST_NONE, REQUEST_PIVOTING, REQUEST_SLIPPING_AVOIDANCE = 0, 1, 2
 _SETTINGS_FIELDS = tuple(name for name, _kind, _doc in _core.GraspControllerSettings.fields)
 _INT_FIELDS = tuple(name for name, kind, _doc in _core.GraspControllerSettings.fields if kind == "int")
 _BOOL_FIELDS = tuple(name for name, kind, _doc in _core.GraspControllerSettings.fields if kind == "bool")
+
+
+#: The settings that turn off every addition to the paper's law (eqs. 34-37): constant PI gains,
+#: no feed-forward, no slip reflex, the PI on S itself, no dead band on C_d. Pass them to compare
+#: with lugrip's defaults: ``GraspController(params, **PAPER_SETTINGS)``.
+PAPER_SETTINGS: dict[str, Any] = {
+    "slope_gain": False,
+    "feedforward": False,
+    "slip_reflex": False,
+    "average_slippage": False,
+    "static_equivalent_slippage": False,
+    "omega_deadband": 0.0,
+}
 
 
 class ControllerMode(enum.IntEnum):
@@ -99,7 +113,10 @@ class ControllerOutput:
         static_force, dynamic_force: f_ns and f_nd of the last command [N].
         floor: lower bound applied at the last command [N].
         slippage: combined S = max_i S_i at the last command; error: S - S_ref (or S - S_p).
-        integrator: PI integrator [N]; dynamic_sample: signed C_d omega_hat per finger at this
+        integrator: PI integrator [N]; gain_p, gain_i: k_p [N] and k_i [N/s] used at the last
+            command; feedforward_force: static grasp force of the measured load at the last
+            command [N] (0: none); peak_slippage: peak of S over the period before it;
+            reflex: the slip reflex raised it; dynamic_sample: signed C_d omega_hat per finger at this
             sample [N]; dynamic_peak: running peak of max_i |C_d omega_hat_i| [N].
         mean_c_tilde: mean |c~_i| of the valid fingers; pivot_time: time in pivoting [s].
         mode, pivot_end, pivot_finished: mode after this call and the end-of-pivot event.
@@ -115,6 +132,11 @@ class ControllerOutput:
     slippage: float
     error: float
     integrator: float
+    gain_p: float
+    gain_i: float
+    feedforward_force: float
+    peak_slippage: float
+    reflex: bool
     dynamic_sample: tuple
     dynamic_peak: float
     mean_c_tilde: float
@@ -133,6 +155,8 @@ class ControllerOutput:
         return cls(
             force=o.force, static_force=o.static_force, dynamic_force=o.dynamic_force,
             floor=o.floor, slippage=o.slippage, error=o.error, integrator=o.integrator,
+            gain_p=o.gain_p, gain_i=o.gain_i, feedforward_force=o.feedforward_force,
+            peak_slippage=o.peak_slippage, reflex=o.reflex,
             dynamic_sample=tuple(o.dynamic_sample), dynamic_peak=o.dynamic_peak,
             mean_c_tilde=o.mean_c_tilde, pivot_time=o.pivot_time,
             mode=ControllerMode(_code(o.mode)), pivot_end=PivotEnd(_code(o.pivot_end)),
@@ -155,6 +179,11 @@ class ControllerRun:
     slippage: np.ndarray
     error: np.ndarray
     integrator: np.ndarray
+    gain_p: np.ndarray
+    gain_i: np.ndarray
+    feedforward_force: np.ndarray
+    peak_slippage: np.ndarray
+    reflex: np.ndarray
     dynamic_sample: np.ndarray
     dynamic_peak: np.ndarray
     mean_c_tilde: np.ndarray
@@ -196,12 +225,18 @@ class GraspController:
       finger): the command is held (plus ``invalid_raise_step``), never lowered.
 
     Args:
-        params: ContactParams, a preset name or a dict (mu is used for the pivoting floor).
+        params: ContactParams, a preset name or a dict (mu for the pivoting floor; the whole
+            contact model for the feed-forward and the slope).
         **settings: any GraspControllerSettings field (see :func:`controller_settings` for the
             names and defaults): rates (sensor_rate [Hz], command_ratio), C_d (k_cd [N s/rad],
             p_cd, z_cd [rad/s], dynamic_enabled), PI (s_ref, k_p [N], k_i [N/s], anti_windup,
             gain_schedule_force [N], 0 = off; static_equivalent_slippage: regulate the S of the
             static part alone; omega_deadband: dead band of C_d in omega resolutions, 0 = off),
+            slope_gain, loop_gain_p [-], loop_gain_i [1/s]: PI gains from the plant's slope
+            dS/df_n; feedforward, feedforward_slippage: static part floored at the static grasp
+            force of the measured load; slip_reflex, reflex_slippage, reflex_factor: raise the
+            command when the peak of S reaches the threshold (see
+            :data:`PAPER_SETTINGS` for the paper's law),
             range (f_min, f_max [N]), rate
             limits (max_rate_up, max_rate_down [N/s], inf = off), invalid_raise_step [N], pivoting
             (s_pivot, tau_pivot [s], k_f [N], pivot_floor_factor, pivot_end_c_tilde,
@@ -222,7 +257,7 @@ class GraspController:
         self._params = _as_params(params)
         core = _core_settings(settings)
         try:
-            self._ctrl = _core.GraspController(self._params.to_core(), core)
+            self._ctrl = _core.GraspController(_model(self._params), core)
         except ValueError as err:
             raise ValueError(str(err)) from None
 
@@ -286,7 +321,7 @@ class GraspController:
 
     # --- stepping --------------------------------------------------------------------------
     def step(self, omega_hat, S, c_tilde=0.0, f_t=0.0, status=Status.OK,
-             present=None, omega_resolution=0.0) -> ControllerOutput:
+             present=None, omega_resolution=0.0, tau=0.0) -> ControllerOutput:
         """One sensor sample. Scalars describe finger 0 alone (finger 1 absent unless `present`
         says otherwise, then it gets the same values); length-2 sequences describe both fingers.
 
@@ -296,9 +331,11 @@ class GraspController:
             present: per-finger bools (default: the fingers given).
             omega_resolution: the observer's speed resolution [rad/s] (``omega_resolution`` of
                 its output), used by the dead band of the dynamic part (``omega_deadband``).
+            tau: measured torsional moment [N m] (signed), with f_t the load of the
+                feed-forward and of the slope (``feedforward``, ``slope_gain``).
         """
         vals = [np.atleast_1d(np.asarray(v, dtype=np.float64))
-                for v in (omega_hat, S, c_tilde, f_t, omega_resolution)]
+                for v in (omega_hat, S, c_tilde, f_t, omega_resolution, tau)]
         st = np.atleast_1d(np.asarray(status, dtype=np.int64))
         n_fingers = max(len(v) for v in vals + [st])
         if n_fingers > 2 or any(len(v) not in (1, n_fingers) for v in vals + [st]):
@@ -310,13 +347,13 @@ class GraspController:
         else:
             p = np.broadcast_to(np.asarray(present, dtype=bool), (2,))
             pres = (bool(p[0]), bool(p[1]))
-        w, s, c, f, r = (tuple(float(x) for x in v) for v in vals)
+        w, s, c, f, r, tq = (tuple(float(x) for x in v) for v in vals)
         o = self._ctrl.step(w[0], s[0], c[0], f[0], int(st[0]), pres[0],
-                            w[1], s[1], c[1], f[1], int(st[1]), pres[1], r[0], r[1])
+                            w[1], s[1], c[1], f[1], int(st[1]), pres[1], r[0], r[1], tq[0], tq[1])
         return ControllerOutput._from_core(o)
 
     def run(self, omega_hat, S, c_tilde=0.0, f_t=0.0, status=None, present=None,
-            requests=None, omega_resolution=0.0) -> ControllerRun:
+            requests=None, omega_resolution=0.0, tau=0.0) -> ControllerRun:
         """Step over N sensor samples in one C++ loop (state carried over between calls).
 
         Args:
@@ -330,11 +367,12 @@ class GraspController:
                 "slipping_avoidance"}.
             omega_resolution: the observers' speed resolution [rad/s], like omega_hat (used by
                 the dead band ``omega_deadband``; default 0: no dead band).
+            tau: measured torsional moment [N m], like f_t (feed-forward and slope load).
 
         Returns:
             ControllerRun with (N,) arrays.
         """
-        arrays = [np.asarray(v) for v in (omega_hat, S, c_tilde, f_t, omega_resolution)]
+        arrays = [np.asarray(v) for v in (omega_hat, S, c_tilde, f_t, omega_resolution, tau)]
         extra = [np.asarray(v) for v in (status,) if v is not None]
         shaped = [a for a in arrays + extra if a.ndim >= 1]
         if not shaped:
@@ -346,9 +384,11 @@ class GraspController:
             raise ValueError("all per-sample inputs must have the same number of samples")
         n = lengths.pop()
         two = any(a.ndim == 2 and a.shape[1] == 2 for a in shaped)
-        w, s, c, f, res = (
+        w, s, c, f, res, tq = (
             _per_finger(a, n, name, np.float64)
-            for a, name in zip(arrays, ("omega_hat", "S", "c_tilde", "f_t", "omega_resolution"))
+            for a, name in zip(
+                arrays, ("omega_hat", "S", "c_tilde", "f_t", "omega_resolution", "tau")
+            )
         )
         st = _per_finger(Status.OK if status is None else status, n, "status", np.int32)
         if present is None:
@@ -365,7 +405,7 @@ class GraspController:
                 req[int(index)] = codes[what]
         elif requests is not None:
             req[:] = np.asarray(requests, dtype=np.int32)
-        r = self._ctrl.run(w, s, c, f, st, pres, req, res)
+        r = self._ctrl.run(w, s, c, f, st, pres, req, res, tq)
         dyn = np.stack([r.pop("dynamic_sample_0"), r.pop("dynamic_sample_1")], axis=1)
         return ControllerRun(dynamic_sample=dyn, **r)
 
