@@ -43,6 +43,10 @@ void bind_slip_control(nb::module_& m) {
   def_fields_ro(out);
   out.def_prop_ro("fingers", [](const SlipControlOutput& o) { return nb::make_tuple(o.fingers[0], o.fingers[1]); },
                   "each finger's ObserverOutput (finger 1 unused with one finger)");
+  out.def_prop_ro("pivot_finished", [](const SlipControlOutput& o) { return o.controller.pivot_finished; },
+                  "pivoting ended in this cycle (controller.pivot_end says why)");
+  out.def_prop_ro("mode", [](const SlipControlOutput& o) { return o.controller.mode; },
+                  "ControllerMode after this cycle");
 
   nb::class_<SC>(m, "SlipControl")
       .def(nb::init<const ContactParams&, const SlipControlSettings&>(), "params"_a,

@@ -84,7 +84,10 @@ class SlipControl {
 
   void request_pivoting() noexcept { ctrl_.request_pivoting(); }                      //!< at the next step()
   void request_slipping_avoidance() noexcept { ctrl_.request_slipping_avoidance(); }  //!< at the next step()
-  void set_dynamic_enabled(bool enabled) noexcept { ctrl_.set_dynamic_enabled(enabled); }
+  void set_dynamic_enabled(bool enabled) noexcept {
+    ctrl_.set_dynamic_enabled(enabled);
+    s_.controller.dynamic_enabled = enabled;
+  }
 
   //! Replaces the friction coefficient of the observers and the controller (the per-object
   //! refit, docs/model.md §8.1). Rebuilds the contact tables (allocates, a few ms): call it
@@ -94,7 +97,10 @@ class SlipControl {
   void set_mu(double mu);
 
   //! Replaces the controller settings marked (*) in GraspControllerSettings (validated).
-  void set_controller_settings(const GraspControllerSettings& settings) { ctrl_.set_settings(settings); }
+  void set_controller_settings(const GraspControllerSettings& settings) {
+    ctrl_.set_settings(settings);
+    s_.controller = ctrl_.settings();
+  }
 
   double command() const noexcept { return ctrl_.command(); }  //!< last command [N]
   ControllerMode mode() const noexcept { return ctrl_.mode(); }

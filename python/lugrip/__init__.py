@@ -45,6 +45,7 @@ from ._controller import (
     static_grasp_force,
     static_slippage,
 )
+from ._slip_control import SlipControl, SlipControlRun
 from .io import LogError, LogWarning, SlidingLog, read_log, write_log
 from .sliding import simulate_sliding
 
@@ -78,6 +79,8 @@ __all__ = [
     "PAPER_SETTINGS",
     "static_grasp_force",
     "static_slippage",
+    "SlipControl",
+    "SlipControlRun",
     "SlidingLog",
     "LogError",
     "LogWarning",

@@ -55,6 +55,8 @@ STEPS: list[DemoStep] = [
     DemoStep("observer", "Observer replay (paper Figure 5)", "lugrip.commands.observe:demo_section"),
     DemoStep("experiments", "Closed-loop experiments (paper Figures 11, 13, 15, 17) and baselines",
              "lugrip.sim.report:demo_section"),
+    DemoStep("mujoco", "Closed loop on MuJoCo: the paper's experiments and unseen objects",
+             "lugrip.sim.report:mujoco_demo_section"),
 ]
 """Steps of ``lugrip demo`` in report order."""
 

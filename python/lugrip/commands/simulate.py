@@ -1,5 +1,6 @@
-"""``lugrip simulate``: run the paper's experiments (scenario YAML files) in closed loop with the
-baselines, write Figures 11/13/15/17, a Markdown report and metrics.json, print a summary.
+"""``lugrip simulate``: run the paper's experiments and the unseen objects (scenario YAML files)
+in closed loop with the baselines on the patch, lumped or MuJoCo plant; write the figures, a
+Markdown report and the metrics JSON, print a summary.
 
 Exit code 0 when every scenario passes its criteria, 1 when one fails, 2 on a user error.
 """
@@ -15,12 +16,18 @@ from . import CliError
 __all__ = ["register", "run"]
 
 _EPILOG = """\
-scenarios: names in ./scenarios (or $LUGRIP_SCENARIOS) or YAML paths; 'all' runs every file.
+scenarios: names in ./scenarios (or $LUGRIP_SCENARIOS) or its unseen/ folder, or YAML paths;
+'all' runs the paper's experiments, 'unseen' the objects the controller was not tuned on.
 examples:
   lugrip simulate all --out out/                        # the four experiments + baselines
   lugrip simulate exp2_small_resin_block --json m.json  # one scenario
   lugrip simulate all --short --plant lumped --no-baselines
+  lugrip simulate box_heavy --plant mujoco --video out/box.mp4
+  lugrip simulate all unseen --plant mujoco --seeds 8 --compare patch
   lugrip simulate --list
+MuJoCo plant: writes DIR/mujoco.md, DIR/mujoco_<scenario>.png (frames of the lift and the pivot
+when offscreen rendering works: MUJOCO_GL=egl or osmesa) and the metrics JSON (default
+DIR/mujoco_metrics.json). Without OpenGL the frames and the video are skipped with a message.
 """
 
 
@@ -64,9 +71,33 @@ def register(subparsers) -> None:
     )
     p.add_argument(
         "--plant",
-        choices=("patch", "lumped"),
+        choices=("patch", "lumped", "mujoco"),
         default=None,
         help="plant model (default: the scenario's, patch)",
+    )
+    p.add_argument(
+        "--video",
+        type=Path,
+        default=None,
+        metavar="FILE.mp4",
+        help="MuJoCo plant: MP4 of lugrip's run (several scenarios: FILE_<name>.mp4)",
+    )
+    p.add_argument(
+        "--seeds",
+        type=int,
+        default=1,
+        metavar="N",
+        help="MuJoCo plant: also run lugrip on N - 1 further noise seeds (default 1)",
+    )
+    p.add_argument(
+        "--compare",
+        action="append",
+        choices=("patch", "lumped"),
+        default=None,
+        help="MuJoCo plant: run this plant too and put it beside MuJoCo (repeatable)",
+    )
+    p.add_argument(
+        "--no-frames", action="store_true", help="MuJoCo plant: no rendered frames in the figures"
     )
     p.add_argument("--no-baselines", action="store_true", help="only lugrip's controller")
     p.add_argument("--no-plots", action="store_true", help="skip the figures")
@@ -76,6 +107,9 @@ def register(subparsers) -> None:
 
 def run(args: argparse.Namespace) -> int:
     from ..sim import report
+
+    if args.plant == "mujoco" and (args.video or not args.no_frames):
+        report.choose_gl_backend()  # before anything imports MuJoCo
     from ..sim.scenarios import find_scenario, list_scenarios, load_scenario
 
     if args.list:
@@ -84,19 +118,30 @@ def run(args: argparse.Namespace) -> int:
             raise CliError(
                 "no scenarios found (run from the repository root or set LUGRIP_SCENARIOS)"
             )
-        for name in names:
+        for name in names + list_scenarios(suite="unseen"):
             s = load_scenario(name)
-            print(f"{name:32s} {s.title}")
+            print(f"{name:32s} {s.suite:7s} {s.title}")
         return 0
-    names = list(args.scenarios)
+    names = []
+    for n in args.scenarios:
+        names += list_scenarios() if n == "all" else list_scenarios(suite="unseen") if n == "unseen" else [n]
     if not names:
-        raise CliError("no scenario given (names, YAML files or 'all'; see --list)")
-    if "all" in names:
-        names = list_scenarios()
+        raise CliError("no scenario given (names, YAML files, 'all' or 'unseen'; see --list)")
     try:
         paths = [str(find_scenario(n)) for n in names]
+        if args.plant == "mujoco":
+            for p in paths:
+                load_scenario(p).scene_spec()
     except ValueError as err:
         raise CliError(str(err)) from None
+    if args.plant != "mujoco" and (args.video or args.compare or args.seeds != 1 or args.no_frames):
+        raise CliError("--video, --seeds, --compare and --no-frames need --plant mujoco")
+    if args.seeds < 1:
+        raise CliError(f"--seeds {args.seeds}: must be >= 1")
+    if args.video is not None and args.video.suffix.lower() != ".mp4":
+        raise CliError(f"--video {args.video}: expected a .mp4 file")
+    if args.plant == "mujoco":
+        return _run_mujoco(args, paths)
 
     results = report.run_all(
         paths,
@@ -124,3 +169,53 @@ def run(args: argparse.Namespace) -> int:
     for name, path in written.items():
         print(f"wrote {path}", file=sys.stderr)
     return 0 if all(r.passed for r in results) else 1
+
+
+def _run_mujoco(args: argparse.Namespace, paths: list[str]) -> int:
+    from ..sim import report
+    from ..sim.mujoco.render import RenderUnavailable, video_writer_available
+
+    video = args.video
+    if video is not None and not video_writer_available():
+        print(
+            "lugrip simulate: no video: writing MP4 needs imageio-ffmpeg "
+            '(pip install "lugrip[video]")',
+            file=sys.stderr,
+        )
+        video = None
+    try:
+        data = report.run_mujoco_set(
+            paths,
+            args.out,
+            seeds=args.seeds,
+            compare=tuple(args.compare or ()),
+            short=args.short,
+            frames=not args.no_frames,
+            video=video,
+            baselines=not args.no_baselines,
+            log=lambda s: print(s, file=sys.stderr, flush=True),
+        )
+    except RenderUnavailable as err:  # raised only for the video writer; frames degrade
+        raise CliError(str(err)) from None
+    if data["render"]:
+        print(f"lugrip simulate: no frames or video: {data['render']}", file=sys.stderr)
+    written = report.write_mujoco_outputs(data, args.out, json_path=args.json)
+    for name, r in data["results"].items():
+        m = r.metrics["lugrip"]
+        seeds = data["seeds"][name]
+        print(
+            f"{name:32s} mujoco {'pass' if r.passed else 'FAIL'}  scene {m.get('scene_status')}"
+            f"  mean force {m.get('mean_force', float('nan')):6.3f} N"
+            f"  hold slip {m['hold_slip_mm']:.3f} mm  hold rot {m['hold_rotation_deg']:.3f} deg"
+            f"  dropped {'yes' if m['dropped'] else 'no'}  seeds {sum(x['pass'] for x in seeds)}/{len(seeds)}",
+            flush=True,
+        )
+        for cname, c in r.criteria.items():
+            if c["pass"] is False:
+                print(f"    failed: {cname} (value {c['value']}, limit {c['limit']})")
+    for path in [*written.values(), *data["videos"].values()]:
+        print(f"wrote {path}", file=sys.stderr)
+    ok = all(r.passed for r in data["results"].values()) and all(
+        x["pass"] for rows in data["seeds"].values() for x in rows
+    )
+    return 0 if ok else 1

@@ -31,3 +31,12 @@ __all__ = [
     "plan_maneuvers",
     "stack_times",
 ]
+
+
+def __getattr__(name: str):
+    # the MuJoCo rig imports MuJoCo only when asked for
+    if name == "MujocoRubbingRig":
+        from .mujoco_rig import MujocoRubbingRig
+
+        return MujocoRubbingRig
+    raise AttributeError(f"module 'lugrip.rigs' has no attribute {name!r}")

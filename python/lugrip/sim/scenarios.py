@@ -61,6 +61,9 @@ __all__ = [
     "metrics_document",
     "run_scenario",
     "scenario_dir",
+    "simulate",
+    "expand_disturbances",
+    "PLANT_MODELS",
 ]
 
 #: Criteria a scenario may list, with their meaning (value compared with the YAML limit).
@@ -84,6 +87,18 @@ CRITERIA = {
     "force_ratio": "steady force / steady force of `reference` >= min",
     "constant_force_exceeds_steady": "the constant-force baseline needs more than lugrip's steady force",
     "friction_cone_fails": "the friction-cone baseline fails (drop or hold slip) where lugrip holds",
+    "scene_ok": (
+        "the scene itself worked: both pads reached the object and kept contact (MuJoCo plant; "
+        "the status names the fault: object_not_reached, closed_on_nothing, lost_contact)"
+    ),
+    "max_steady_command_ptp": (
+        "peak-to-peak of the command in the steady window / its mean <= limit (no sustained "
+        "oscillation)"
+    ),
+    "mean_force_below_constant": (
+        "mean grip force from the lift start on < the smallest constant force that survives "
+        "the scenario (bisection)"
+    ),
 }
 
 
@@ -99,25 +114,36 @@ def scenario_dir() -> Path | None:
     return None
 
 
-def list_scenarios(directory: str | Path | None = None) -> list[str]:
-    """Names of the scenario files in `directory` (default: :func:`scenario_dir`), sorted."""
+def list_scenarios(directory: str | Path | None = None, suite: str = "paper") -> list[str]:
+    """Names of the scenario files in `directory` (default: :func:`scenario_dir`), sorted:
+    suite "paper" the files in it, "unseen" those in its unseen/ folder, "all" both."""
     d = Path(directory) if directory is not None else scenario_dir()
     if d is None:
         return []
-    return sorted(p.stem for p in d.glob("*.yaml"))
+    if suite not in (*SUITES, "all"):
+        raise ValueError(f"suite {suite!r}: expected paper, unseen or all")
+    names = []
+    if suite in ("paper", "all"):
+        names += sorted(p.stem for p in d.glob("*.yaml"))
+    if suite in ("unseen", "all"):
+        names += sorted(p.stem for p in (d / "unseen").glob("*.yaml"))
+    return names
 
 
 def find_scenario(name: str | Path) -> Path:
-    """Path of a scenario given as a file path or a name in :func:`scenario_dir`."""
+    """Path of a scenario given as a file path or a name in :func:`scenario_dir` (or its
+    unseen/ folder)."""
     p = Path(name)
     if p.suffix in (".yaml", ".yml") or p.exists():
         if not p.is_file():
             raise ValueError(f"scenario file {p} does not exist")
         return p
     d = scenario_dir()
-    if d is not None and (d / f"{name}.yaml").is_file():
-        return d / f"{name}.yaml"
-    known = ", ".join(list_scenarios()) or "none found (set LUGRIP_SCENARIOS)"
+    if d is not None:
+        for cand in (d / f"{name}.yaml", d / "unseen" / f"{name}.yaml"):
+            if cand.is_file():
+                return cand
+    known = ", ".join(list_scenarios(suite="all")) or "none found (set LUGRIP_SCENARIOS)"
     raise ValueError(f"unknown scenario {str(name)!r}; known: {known}")
 
 
@@ -151,7 +177,16 @@ _KEYS = {
     "criteria",
     "baselines",
     "short",
+    "suite",
+    "mujoco",
+    "criteria_by_plant",
 }
+
+#: Plant models a scenario runs on: the two of lugrip's own simulator and MuJoCo's gripper.
+PLANT_MODELS = ("patch", "lumped", "mujoco")
+#: Scenario sets: the paper's experiments (scenarios/*.yaml) and objects the controller was not
+#: tuned on (scenarios/unseen/*.yaml).
+SUITES = ("paper", "unseen")
 
 
 @dataclasses.dataclass
@@ -175,6 +210,9 @@ class Scenario:
     criteria: dict = dataclasses.field(default_factory=dict)
     baselines: dict = dataclasses.field(default_factory=dict)
     short: dict = dataclasses.field(default_factory=dict)
+    suite: str = "paper"
+    mujoco: dict = dataclasses.field(default_factory=dict)
+    criteria_by_plant: dict = dataclasses.field(default_factory=dict)
     source: Path | None = None
 
     @classmethod
@@ -188,9 +226,15 @@ class Scenario:
         for key in ("name", "title", "duration", "plant"):
             if key not in data:
                 raise ValueError(f"{where}: missing key {key!r}")
-        unknown = sorted(set(data.get("criteria") or {}) - set(CRITERIA))
-        if unknown:
-            raise ValueError(f"{where}: unknown criteria {', '.join(unknown)}")
+        by_plant = dict(data.get("criteria_by_plant") or {})
+        for crit in [data.get("criteria") or {}, *by_plant.values()]:
+            unknown = sorted(set(crit) - set(CRITERIA))
+            if unknown:
+                raise ValueError(f"{where}: unknown criteria {', '.join(unknown)}")
+        if not set(by_plant) <= set(PLANT_MODELS):
+            raise ValueError(
+                f"{where}: criteria_by_plant: keys must be among {', '.join(PLANT_MODELS)}"
+            )
         sw = data.get("steady_window")
         s = cls(
             name=str(data["name"]),
@@ -210,9 +254,21 @@ class Scenario:
             criteria=dict(data.get("criteria") or {}),
             baselines=dict(data.get("baselines") or {}),
             short=dict(data.get("short") or {}),
+            suite=str(data.get("suite") or "paper"),
+            mujoco=dict(data.get("mujoco") or {}),
+            criteria_by_plant={str(k): dict(v) for k, v in by_plant.items()},
             source=source,
         )
-        PlantConfig.from_dict(s.plant)  # validates the plant block now, naming bad fields
+        if s.suite not in SUITES:
+            raise ValueError(f"{where}: suite {s.suite!r}: expected one of {', '.join(SUITES)}")
+        model = s.plant.get("model", "patch")
+        if model not in PLANT_MODELS:
+            raise ValueError(
+                f"{where}: plant.model {model!r}: expected one of {', '.join(PLANT_MODELS)}"
+            )
+        s.plant_config()  # validates the plant block now, naming bad fields
+        if s.mujoco:
+            s.scene_spec()  # and the MuJoCo scene
         return s
 
     def to_dict(self) -> dict:
@@ -228,13 +284,44 @@ class Scenario:
             return self
         return Scenario.from_dict(_merge(self.to_dict() | {"short": {}}, self.short), self.source)
 
+    def for_plant(self, model: str) -> Scenario:
+        """The scenario with the criteria of plant `model` (``criteria_by_plant``, replacing
+        ``criteria`` when given)."""
+        if model not in self.criteria_by_plant:
+            return self
+        return dataclasses.replace(self, criteria=dict(self.criteria_by_plant[model]))
+
+    def plant_model(self, model: str | None = None) -> str:
+        """The plant model a run uses: `model`, else the file's ``plant.model`` (patch)."""
+        m = str(model if model is not None else self.plant.get("model", "patch"))
+        if m not in PLANT_MODELS:
+            raise ValueError(f"plant model {m!r}: expected one of {', '.join(PLANT_MODELS)}")
+        return m
+
     def plant_config(self, model: str | None = None, seed: int | None = None) -> PlantConfig:
+        """The plant block as a PlantConfig. For the MuJoCo plant the same block (object,
+        contact, actuator, sensors, moves, disturbances, drop limits) with model "patch": the
+        MuJoCo scene reads what it needs from it and :meth:`scene_spec` adds the rest."""
         d = copy.deepcopy(self.plant)
         if model is not None:
             d["model"] = model
+        if d.get("model") == "mujoco":
+            d["model"] = "patch"
         if seed is not None:
             d["seed"] = int(seed)
+        d["disturbances"] = expand_disturbances(d.get("disturbances") or [])
         return PlantConfig.from_dict(d)
+
+    def scene_spec(self):
+        """The MuJoCo scene of the ``mujoco:`` block (:class:`lugrip.sim.mujoco.SceneSpec`)."""
+        if not self.mujoco:
+            raise ValueError(
+                f"scenario {self.name}: no 'mujoco' block (object shape and size), so it cannot "
+                "run on the MuJoCo plant"
+            )
+        from .mujoco.gripper import SceneSpec
+
+        return SceneSpec.from_dict(self.mujoco)
 
     @property
     def lift_end(self) -> float:
@@ -271,11 +358,40 @@ def _estimator_block(value: Any, where: str) -> dict:
     parameters the estimator side uses with that plant."""
     if value is None:
         return {}
-    if not isinstance(value, Mapping) or not set(value) <= {"patch", "lumped"}:
+    if not isinstance(value, Mapping) or not set(value) <= set(PLANT_MODELS):
         raise ValueError(
-            f"{where}: estimator: expected a mapping with keys 'patch' and/or 'lumped'"
+            f"{where}: estimator: expected a mapping with keys among {', '.join(PLANT_MODELS)}"
         )
     return {str(k): copy.deepcopy(v) for k, v in value.items()}
+
+
+def expand_disturbances(items: Sequence[Mapping[str, Any]]) -> list[dict]:
+    """The plant's pulse list with every ``shape: trapezoid`` pulse (rise and fall over
+    ``edge`` [s], flat in between) written as the plant's own shapes: a ramp up over the rising
+    edge, a rectangle from its end to the pulse end, and a negative ramp over the falling edge
+    (they add up to the trapezoid exactly)."""
+    out = []
+    for k, q in enumerate(items):
+        q = dict(q)
+        if str(q.get("shape", "")).lower() != "trapezoid":
+            if "edge" in q:
+                raise ValueError(f"disturbances[{k}]: 'edge' is only for shape trapezoid")
+            out.append(q)
+            continue
+        edge = float(q.pop("edge", 0.02))
+        t0, dur = float(q.get("t_start", 0.0)), float(q.get("duration", 0.1))
+        if not (edge > 0.0 and 2.0 * edge <= dur):
+            raise ValueError(f"disturbances[{k}]: trapezoid edge {edge} must be in (0, duration/2]")
+        force = [float(v) for v in q.get("force", (0.0, 0.0))]
+        torque = float(q.get("torque", 0.0))
+        base = {key: v for key, v in q.items() if key not in ("shape", "t_start", "duration")}
+        neg = dict(base, force=[-force[0], -force[1]], torque=-torque)
+        out += [
+            dict(base, shape="ramp", t_start=t0, duration=edge),
+            dict(base, shape="rectangular", t_start=t0 + edge, duration=dur - edge),
+            dict(neg, shape="ramp", t_start=t0 + dur - edge, duration=edge),
+        ]
+    return out
 
 
 def load_scenario(name: str | Path) -> Scenario:
@@ -407,6 +523,43 @@ def compute_metrics(
             steady_over_static=steady / static if static > 0 else None,
             steady_over_min=steady / minimum if minimum > 0 else None,
         )
+        if sw.stop > sw.start:
+            ptp = float(np.ptp(cmd[sw]))
+            m.update(
+                steady_command_ptp=ptp,
+                steady_command_ptp_ratio=ptp / steady if steady > 0 else None,
+            )
+    hw = run.window(scenario.lift_start, end)
+    if hw.stop > hw.start:
+        m["mean_force"] = float(np.mean(run["f_n"][hw]))
+        err = [run[f"omega_hat_{k}"][hw] - run[f"omega_true_{k}"][hw] for k in (0, 1)]
+        m["omega_rmse"] = float(np.sqrt(np.mean(np.square(err))))
+        m["omega_hat_peak"] = float(
+            max(np.max(np.abs(run[f"omega_hat_{k}"][hw])) for k in (0, 1))
+        )
+        m["omega_true_peak"] = float(
+            max(np.max(np.abs(run[f"omega_true_{k}"][hw])) for k in (0, 1))
+        )
+    scene = getattr(run, "scene", None)
+    if scene and scenario.steady_window is not None:
+        # the plant's own slip force for the steady loads of each finger: MuJoCo's elliptic cone
+        from .mujoco.loop import cone_slip_force
+
+        sw = run.window(*scenario.steady_window)
+        if sw.stop > sw.start:
+            m["min_force_plant"] = max(
+                cone_slip_force(
+                    cfg.contact,
+                    float(np.mean(run[f"f_t_true_{k}"][sw])),
+                    float(np.mean(np.abs(run[f"tau_true_{k}"][sw]))),
+                )
+                for k in (0, 1)
+            )
+    elif "min_force" in m:
+        m["min_force_plant"] = m["min_force"]  # the patch follows lugrip's limit surface
+    m["scene_status"] = scene["status"] if scene else "ok"
+    if scene:
+        m["scene"] = dict(scene)
     return m
 
 
@@ -435,6 +588,46 @@ def _survives(
     return ok
 
 
+def simulate(
+    scenario: Scenario,
+    cfg: PlantConfig,
+    model: str,
+    schedule,
+    *,
+    kind: str = "lugrip",
+    frame_callback=None,
+    **options,
+) -> ClosedLoopRun:
+    """One closed-loop run of `scenario` on plant `model` (patch, lumped: lugrip's C++ loop;
+    mujoco: :func:`lugrip.sim.mujoco.loop.run_mujoco_loop`) with controller `kind`."""
+    est = scenario.estimator_for(model)
+    if model == "mujoco":
+        from .mujoco.loop import run_mujoco_loop
+
+        return run_mujoco_loop(
+            cfg,
+            scenario.scene_spec(),
+            scenario.controller,
+            scenario.observer,
+            schedule,
+            scenario.duration,
+            kind=kind,
+            estimator=est,
+            frame_callback=frame_callback,
+            **options,
+        )
+    return run_closed_loop(
+        cfg,
+        scenario.controller,
+        scenario.observer,
+        schedule,
+        scenario.duration,
+        kind=kind,
+        estimator=est,
+        **options,
+    )
+
+
 def constant_force_search(
     scenario: Scenario,
     cfg: PlantConfig,
@@ -444,6 +637,7 @@ def constant_force_search(
     tolerance: float = 0.01,
     f_max: float | None = None,
     max_runs: int = 24,
+    model: str | None = None,
 ) -> dict[str, Any]:
     """Minimum constant grasp force [N] with which the scenario (without pivoting) is survived
     (:func:`_survives`, compared with the `reference` metrics), by bisection on log(force) to a
@@ -458,15 +652,8 @@ def constant_force_search(
 
     def attempt(f: float):
         if f not in cache:
-            run = run_closed_loop(
-                cfg,
-                scenario.controller,
-                scenario.observer,
-                None,
-                scenario.duration,
-                kind="constant_force",
-                constant_force=f,
-                estimator=scenario.estimator_for(cfg.model),
+            run = simulate(
+                scenario, cfg, model or cfg.model, None, kind="constant_force", constant_force=f
             )
             m = compute_metrics(scenario, run, cfg=cfg, pivot=False)
             ok = _survives(scenario, m, reference)
@@ -594,6 +781,19 @@ def _evaluate(scenario: Scenario, metrics: dict[str, dict[str, Any]], search) ->
                 "group constant > steady" if limit == "group" else "constant > steady",
                 ok,
             )
+        elif name == "scene_ok":
+            st = m.get("scene_status", "ok")
+            out[name] = _criterion(st, "ok", st == "ok")
+        elif name == "max_steady_command_ptp":
+            v = m.get("steady_command_ptp_ratio")
+            out[name] = _criterion(v, limit, v is not None and v <= float(limit))
+        elif name == "mean_force_below_constant":
+            f = None if search is None else search["force"]
+            mean = metrics.get("lugrip_no_pivot", m).get("mean_force")
+            ok = None if search is None else (f is None or (mean is not None and mean < f))
+            out[name] = _criterion(
+                {"mean_force": mean, "constant_force": f}, "mean < constant", ok
+            )
         elif name == "friction_cone_fails":
             cone = metrics.get("friction_cone")
             hold = metrics.get("lugrip_no_pivot", m)
@@ -623,34 +823,36 @@ def run_scenario(
     short: bool = False,
     baselines: bool = True,
     seed: int | None = None,
+    frame_callback=None,
 ) -> ScenarioResult:
     """Run a scenario with lugrip's controller and (optionally) the baselines.
 
     Args:
         scenario: a Scenario, a name or a YAML path.
-        plant_model: "patch" (default of the files) or "lumped" (faster; no translational slip).
+        plant_model: "patch" (default of the files), "lumped" (faster; no translational slip)
+            or "mujoco" (the MuJoCo gripper of the file's ``mujoco`` block; the criteria of
+            ``criteria_by_plant.mujoco`` when given).
         short: apply the scenario's ``short`` overrides and a coarser constant-force search (5 %
             instead of 1 %), for CI.
         baselines: also run the constant-force search and the friction-cone baseline (as the
             scenario's ``baselines`` block enables them; both without the pivoting schedule).
         seed: override the plant's noise seed.
+        frame_callback: MuJoCo plant: f(model, data, t) at every sensor sample of lugrip's
+            run (rendering frames).
     """
     t_start = time.perf_counter()
     scn = scenario if isinstance(scenario, Scenario) else load_scenario(scenario)
     if short:
         scn = scn.shortened()
-    cfg = scn.plant_config(plant_model, seed)
-    estimator = scn.estimator_for(cfg.model)
+    model = scn.plant_model(plant_model)
+    scn = scn.for_plant(model)
+    cfg = scn.plant_config(model, seed)
     runs: dict[str, ClosedLoopRun] = {}
     metrics: dict[str, dict] = {}
-    runs["lugrip"] = run_closed_loop(
-        cfg, scn.controller, scn.observer, scn.schedule, scn.duration, estimator=estimator
-    )
+    runs["lugrip"] = simulate(scn, cfg, model, scn.schedule, frame_callback=frame_callback)
     metrics["lugrip"] = compute_metrics(scn, runs["lugrip"], cfg=cfg)
     if scn.has_pivot:
-        runs["lugrip_no_pivot"] = run_closed_loop(
-            cfg, scn.controller, scn.observer, None, scn.duration, estimator=estimator
-        )
+        runs["lugrip_no_pivot"] = simulate(scn, cfg, model, None)
         metrics["lugrip_no_pivot"] = compute_metrics(
             scn, runs["lugrip_no_pivot"], cfg=cfg, pivot=False
         )
@@ -659,27 +861,23 @@ def run_scenario(
         steady = metrics.get("lugrip_no_pivot", metrics["lugrip"]).get("steady_force") or 1.0
         reference = metrics.get("lugrip_no_pivot", metrics["lugrip"])
         search = constant_force_search(
-            scn, cfg, start=0.5 * steady, reference=reference, tolerance=0.05 if short else 0.01
+            scn,
+            cfg,
+            start=0.5 * steady,
+            reference=reference,
+            tolerance=0.05 if short else 0.01,
+            model=model,
         )
         runs["constant_force"] = search["run"]
         metrics["constant_force"] = dict(search["metrics"], constant_force=search["force"])
     if baselines and scn.baselines.get("friction_cone", True):
         cone = scn.baselines.get("friction_cone")
         opts = dict(cone) if isinstance(cone, Mapping) else {}
-        runs["friction_cone"] = run_closed_loop(
-            cfg,
-            scn.controller,
-            scn.observer,
-            None,
-            scn.duration,
-            kind="friction_cone",
-            estimator=estimator,
-            **opts,
-        )
+        runs["friction_cone"] = simulate(scn, cfg, model, None, kind="friction_cone", **opts)
         metrics["friction_cone"] = compute_metrics(scn, runs["friction_cone"], cfg=cfg, pivot=False)
     criteria = _evaluate(scn, metrics, search)
     return ScenarioResult(
-        scn, cfg.model, short, runs, metrics, search, criteria, time.perf_counter() - t_start
+        scn, model, short, runs, metrics, search, criteria, time.perf_counter() - t_start
     )
 
 

@@ -1,0 +1,365 @@
+"""A MuJoCo rubbing rig: a compliant fingertip pad driven over a fixed slider.
+
+The plant is MuJoCo's contact solver, not lugrip's model. A rigid mount (the robot's finger
+base) moves in the slider plane with a **prescribed** planar motion about a centre of
+rotation fixed in the finger frame (the maneuvers of :mod:`lugrip.rigs.motion`); a force motor
+on a normal slide presses the finger with the planned normal force; the pad
+(:mod:`lugrip.sim.mujoco.pad`) hangs from the finger on its in-plane and twist springs and
+touches the slider through one condim-4 contact on an elliptic cone, with noslip. The wrench
+therefore builds up through presliding (the pad's springs deflect while the pad sticks) before
+the contact slides, and stays loaded after the motion stops.
+
+Friction is Coulomb only (mu, no Stribeck, no viscous term). MuJoCo's elliptic cone bounds the
+contact wrench by (f_t / (mu f_n))^2 + (tau / tau_max(f_n))^2 <= 1, with
+tau_max = mu xi delta f_n^(gamma + 1) set by the pad's per-step torsional law: the limit
+surface is an ellipse in the normalised (f_t, tau) plane (docs: validation/mujoco/README.md).
+
+    >>> from lugrip.rigs import RubbingDesign
+    >>> from lugrip.rigs.mujoco_rig import MujocoRubbingRig
+    >>> data = MujocoRubbingRig().simulate(RubbingDesign(), n=2, seed=1)   # doctest: +SKIP
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+import time
+from dataclasses import asdict, dataclass
+
+import numpy as np
+
+from ..io import SlidingLog
+from ..sim.mujoco.pad import CONTACT_OPTIONS, Pad, PadSpec, model_xml, pad_body_xml, pair_xml
+from ._data import RigTruth, RubbingData
+from .motion import ManeuverPlan, RubbingDesign, plan_maneuvers, stack_times
+
+__all__ = ["MujocoRubbingRig", "RigSettings", "mount_pose"]
+
+
+def _default_pad() -> PadSpec:
+    return PadSpec(name="pad", mu=0.7)
+
+
+@dataclass(frozen=True)
+class RigSettings:
+    """Mechanics of the rig around the pad (SI units)."""
+
+    finger_mass: float = 0.02  #: mass on the normal slide between mount and pad [kg]
+    normal_damping: float = 1.0  #: damping of the normal slide [N s/m]
+    #: mount mass [kg]: its motion is prescribed (position and velocity set before every step);
+    #: heavy, so that the springs' reaction within a step does not change its velocity
+    mount_mass: float = 1e4
+    settle: float = 0.05  #: pressed settling time before each maneuver, not logged [s]
+    cone_tolerance: float = 1e-3  #: gross sliding: cone utilisation >= 1 - this [-]
+    slip_speed: float = 1e-4  #: gross sliding: slip speed |v| + |omega| rho above this [m/s]
+    noslip_iterations: int = int(CONTACT_OPTIONS["noslip_iterations"])  #: MuJoCo noslip
+    impratio: float = float(CONTACT_OPTIONS["impratio"])  #: MuJoCo impratio
+    timestep: float = float(CONTACT_OPTIONS["timestep"])  #: MuJoCo step [s]
+
+
+def _theta_segments(plan: ManeuverPlan):
+    """Cumulative pad angle at the knots of the plan's angular-velocity profile [rad]."""
+    kt, kw = np.asarray(plan.knots_t), np.asarray(plan.knots_omega)
+    span = np.diff(kt)
+    # integral of kw_j + (kw_j+1 - kw_j) (1 - cos(pi x)) / 2 over one segment: the mean value
+    seg = span * 0.5 * (kw[:-1] + kw[1:])
+    return kt, kw, np.concatenate([[0.0], np.cumsum(seg)])
+
+
+def _theta_at(t: float, kt, kw, cum) -> float:
+    """The pad's angle relative to the slider at time t: the integral of omega_pad [rad]."""
+    if t <= kt[0]:
+        return kw[0] * (t - kt[0])
+    if t >= kt[-1]:
+        return cum[-1] + kw[-1] * (t - kt[-1])
+    j = int(np.searchsorted(kt, t, side="right") - 1)
+    span = kt[j + 1] - kt[j]
+    x = (t - kt[j]) / span
+    dw = kw[j + 1] - kw[j]
+    return cum[j] + span * (kw[j] * x + dw * (0.5 * x - math.sin(math.pi * x) / (2 * math.pi)))
+
+
+def mount_pose(cor: np.ndarray, theta: float, omega: float) -> tuple[np.ndarray, np.ndarray]:
+    """Planar pose (x, y, theta) and its rate of a mount turning by ``theta`` at ``omega``
+    about the point ``cor`` of its own frame, starting at the origin with theta = 0: the
+    mount-frame point ``cor`` stays where it was at the start."""
+    c, s = math.cos(theta), math.sin(theta)
+    cx, cy = float(cor[0]), float(cor[1])
+    rc = np.array([c * cx - s * cy, s * cx + c * cy])  # R(theta) cor
+    pos = np.array([cx - rc[0], cy - rc[1], theta])
+    # d/dt (cor - R cor) = -omega J R cor, J = rotation by +90 deg
+    vel = np.array([omega * rc[1], -omega * rc[0], omega])
+    return pos, vel
+
+
+class MujocoRubbingRig:
+    """A fingertip pad on a compliant mount rubbing a fixed slider in MuJoCo.
+
+    Attributes:
+        pad: the pad (its mu is the plant's Coulomb coefficient, its delta/gamma/xi the
+            torsional law).
+        settings: the rig's mechanics and MuJoCo options.
+    """
+
+    name = "mujoco"
+
+    def __init__(
+        self, mu: float = 0.7, pad: PadSpec | None = None, settings: RigSettings | None = None
+    ):
+        base = pad if pad is not None else _default_pad()
+        if pad is None or mu != 0.7:
+            base = dataclasses.replace(base, mu=float(mu))
+        self.pad = base
+        self.settings = settings if settings is not None else RigSettings()
+        self._model = None
+
+    # --- the plant's truth ---------------------------------------------------------------------
+    def radius(self, f_n):
+        """The pad law's contact radius rho = delta f_n^gamma [m]."""
+        return self.pad.contact_radius(f_n)
+
+    def truth(self) -> RigTruth:
+        """mu, the torsional law and what the plant does not model."""
+        p = self.pad
+        forces = (0.25, 0.5, 1.0, 2.0, 4.0, 8.0, 12.0, 16.0, 24.0)
+        return RigTruth(
+            name="mujoco",
+            mu_static=p.mu,
+            mu_kinetic=p.mu,
+            mu=p.mu,
+            beta_a=None,
+            viscous=False,
+            delta=p.delta,
+            gamma=p.gamma,
+            pressure=(
+                "none: one point contact (MuJoCo soft contact, condim 4, elliptic cone); "
+                "the torsional capacity follows mu xi delta f_n^(gamma+1), "
+                f"xi = {p.xi:.6g}"
+            ),
+            tau_max_points=tuple((f, float(p.tau_max(f))) for f in forces),
+            notes=(
+                "Coulomb friction only. Limit surface: the ellipse (f_t/(mu f_n))^2 + "
+                "(tau/tau_max)^2 = 1. Presliding from the pad's springs: in-plane "
+                f"{p.k_slide:g} N/m, twist {p.k_twist:g} N m/rad."
+            ),
+        )
+
+    # --- the model -----------------------------------------------------------------------------
+    def model_xml(self) -> str:
+        """The MJCF: a slider plane (top at z = 0), the mount on planar joints (x, y, yaw),
+        the finger on a normal slide with a force motor, the pad facing down."""
+        s, p = self.settings, self.pad
+        im = s.mount_mass * 0.01
+        fi = s.finger_mass * 1e-4
+        bodies = (
+            '<geom name="slider" type="plane" size="0.3 0.3 0.01" rgba="0.7 0.7 0.6 1"/>'
+            '<body name="mount" pos="0 0 0">'
+            '<joint name="mount_x" type="slide" axis="1 0 0"/>'
+            '<joint name="mount_y" type="slide" axis="0 1 0"/>'
+            '<joint name="mount_theta" type="hinge" axis="0 0 1"/>'
+            f'<inertial pos="0 0 0.05" mass="{s.mount_mass:g}" diaginertia="{im:g} {im:g} {im:g}"/>'
+            '<body name="finger" pos="0 0 0">'
+            f'<joint name="press" type="slide" axis="0 0 1" damping="{s.normal_damping:g}"/>'
+            f'<inertial pos="0 0 0.02" mass="{s.finger_mass:g}" '
+            f'diaginertia="{fi:g} {fi:g} {fi:g}"/>' + pad_body_xml(p) + "</body></body>"
+        )
+        return model_xml(
+            bodies,
+            pairs=pair_xml(p, ["slider"]),
+            actuators='<motor name="press" joint="press" gear="1"/>',
+            name="lugrip_rubbing_rig",
+            gravity=(0.0, 0.0, 0.0),
+            timestep=s.timestep,
+            noslip_iterations=s.noslip_iterations,
+            impratio=s.impratio,
+        )
+
+    def build(self):
+        """(MjModel, MjData, Pad) of the rig."""
+        import mujoco
+
+        m = mujoco.MjModel.from_xml_string(self.model_xml())
+        d = mujoco.MjData(m)
+        return m, d, Pad(m, self.pad)
+
+    # --- one maneuver --------------------------------------------------------------------------
+    def run_maneuver(self, plan: ManeuverPlan, model=None) -> dict[str, np.ndarray]:
+        """Simulate one maneuver; per-sample arrays (averages over each sample period of the
+        1 ms steps): true wrench ``f_n, f_x, f_y, tau`` on the pad [N, N m], ``omega`` of the
+        slider relative to the pad [rad/s], ``v`` slip speed of the contact [m/s],
+        ``sliding`` (bool: every step of the sample at the cone limit and slipping),
+        ``cor_distance`` from the contact point (the pad origin, displaced from the mount
+        frame's origin by the pad springs) to the prescribed CoR [m],
+        ``utilisation`` of the cone (its maximum over the sample) [-], ``load_ratio`` (the same:
+        the plant's friction utilisation) [-], ``c_tilde_slip`` (the CoR of the actual slip
+        over rho, signed as ``c_tilde_true``) [-]."""
+        import mujoco
+
+        if model is None:
+            m, d, pad = self.build()
+        else:
+            m, d, pad = model
+            mujoco.mj_resetData(m, d)
+        s = self.settings
+        h = m.opt.timestep
+        dt = float(plan.t[1] - plan.t[0]) if len(plan.t) > 1 else 0.002
+        ratio = max(1, round(dt / h))
+        kt, kw, cum = _theta_segments(plan)
+        jq = [m.joint(j).qposadr[0] for j in ("mount_x", "mount_y", "mount_theta")]
+        jv = [m.joint(j).dofadr[0] for j in ("mount_x", "mount_y", "mount_theta")]
+        cor = np.asarray(plan.cor, dtype=float)
+        mu = self.pad.mu
+        n_samples = len(plan.t)
+        n_settle = round(s.settle / h)
+        n_steps = n_settle + (n_samples - 1) * ratio + ratio
+        t0 = -(n_settle + ratio) * h  # the first logged sample averages the steps ending at 0
+        keys = ("f_n", "f_x", "f_y", "tau", "omega", "v", "cor_distance")
+        out = {k: np.zeros(n_samples) for k in keys}
+        qx, qy = int(pad.joint_qpos[0]), int(pad.joint_qpos[1])
+        util = np.zeros(n_samples)
+        sliding = np.zeros(n_samples, dtype=bool)
+        acc = np.zeros(7)
+        slide_all = True
+        util_max = 0.0
+        pad.update(m, f_n=float(plan.f_n_at(0.0)))
+        # the mount's pose at each step start; its velocity over a step is the secant to the
+        # next pose, so that the Euler position update lands on the planned pose (no drift)
+        pos_next = mount_pose(cor, _theta_at(max(t0, 0.0), kt, kw, cum), 0.0)[0]
+        for n in range(n_steps):
+            t = t0 + n * h
+            tm = max(t, 0.0)
+            pos = pos_next
+            pos_next = mount_pose(cor, _theta_at(max(t + h, 0.0), kt, kw, cum), 0.0)[0]
+            vel = (pos_next - pos) / h
+            for k in range(3):
+                d.qpos[jq[k]] = pos[k]
+                d.qvel[jv[k]] = vel[k]
+            d.ctrl[0] = -float(plan.f_n_at(tm))
+            spin = pad.update(m, d)
+            mujoco.mj_step(m, d)
+            w = pad.wrench(m, d)
+            rel = pad.slip_velocity(m, d)
+            i_rel = n - n_settle - ratio  # steps of sample k: i_rel in ((k-1) ratio, k ratio]
+            if i_rel < -ratio:
+                continue
+            fn = w[0]
+            if fn > 0.0:
+                u = math.hypot(math.hypot(w[1], w[2]) / (mu * fn), w[3] / (spin * fn))
+                speed = math.hypot(rel[0], rel[1]) + abs(rel[2]) * float(
+                    pad.spec.contact_radius(fn)
+                )
+                slipping = u >= 1.0 - s.cone_tolerance and speed > s.slip_speed
+            else:
+                u, slipping = 0.0, False
+            acc[:4] += w
+            acc[4] += rel[2] if np.isfinite(rel[2]) else 0.0
+            acc[5] += math.hypot(rel[0], rel[1]) if np.isfinite(rel[0]) else 0.0
+            # the CoR seen from the contact point: the pad's springs shift the pad (and its
+            # contact) from the mount-frame origin by their deflection
+            acc[6] += math.hypot(cor[0] - d.qpos[qx], cor[1] - d.qpos[qy])
+            slide_all = slide_all and slipping
+            util_max = max(util_max, u)
+            if (i_rel + ratio) % ratio == ratio - 1:
+                k = (i_rel + ratio) // ratio
+                a = acc / ratio
+                for j, key in enumerate(keys):
+                    out[key][k] = a[j]
+                sliding[k] = slide_all
+                util[k] = util_max
+                acc[:] = 0.0
+                slide_all = True
+                util_max = 0.0
+        # the load ratio is the cone utilisation (f~_t^2 + tau~^2)^(1/2): it bounds the friction
+        # moment about the prescribed CoR over its full-sliding maximum on the elliptic cone from
+        # above, and equals it where the wrench is the cone's maximum-dissipation point for that CoR
+        out.update(sliding=sliding, utilisation=util, load_ratio=util.copy())
+        # the CoR of the slider's actual motion relative to the pad over rho, signed like
+        # c_tilde_true (sign(c~) = -sign(omega)); NaN where the contact does not turn
+        w_rel = out["omega"]
+        with np.errstate(divide="ignore", invalid="ignore"):
+            c_slip = -np.sign(w_rel) * out["v"] / np.abs(w_rel) / self.radius(out["f_n"])
+        out["c_tilde_slip"] = np.where(np.abs(w_rel) > 1e-6, c_slip, np.nan)
+        return out
+
+    # --- a campaign ----------------------------------------------------------------------------
+    def plans(self, design: RubbingDesign, n: int, seed: int = 0) -> list[ManeuverPlan]:
+        """The maneuvers of :func:`plan_maneuvers` with this pad's radius law."""
+        return plan_maneuvers(design, n, seed, radius=lambda f: float(self.radius(f)))
+
+    def simulate(
+        self, design: RubbingDesign | None = None, n: int = 160, seed: int = 0
+    ) -> RubbingData:
+        """Run ``n`` maneuvers of ``design`` (default :class:`RubbingDesign`) drawn from
+        ``seed``; the sensor log (the plan's noise and offsets on the true wrench) with its
+        labels. Gross sliding (phase 2) is where MuJoCo's contact is at its cone limit and
+        slipping for the whole sample while the motion runs. ``load_ratio`` is the cone
+        utilisation; ``c_tilde_true`` in gross sliding the CoR of the pad's actual slip over
+        rho(f_n) (from MuJoCo's state), elsewhere the distance from the contact point to the
+        prescribed CoR over rho(f_n), signed -sign(omega) (the two agree once the pad's slip
+        has settled; at small c~ that takes about a second, longer than most legs);
+        ``v_true`` the contact's slip speed and the
+        log's ``omega`` the slider's angular velocity relative to the pad, both from MuJoCo's
+        state (averages over each sample period)."""
+        import mujoco
+
+        design = design if design is not None else RubbingDesign()
+        wall = time.perf_counter()
+        plans = self.plans(design, n, seed)
+        dt = 1.0 / design.sample_rate
+        starts = stack_times(plans, dt)
+        built = self.build()
+        cols: dict[str, list[np.ndarray]] = {
+            k: [] for k in ("t", "f_n", "f_x", "f_y", "tau", "omega", "maneuver")
+        }
+        phase, load, c_tilde, v_true = [], [], [], []
+        for plan, t_start in zip(plans, starts):
+            r = self.run_maneuver(plan, built)
+            f_n, f_x, f_y, tau = plan.sensor(r["f_n"], r["f_x"], r["f_y"], r["tau"])
+            cols["t"].append(t_start + plan.t)
+            cols["f_n"].append(f_n)
+            cols["f_x"].append(f_x)
+            cols["f_y"].append(f_y)
+            cols["tau"].append(tau)
+            cols["omega"].append(r["omega"])
+            cols["maneuver"].append(np.full(len(plan.t), plan.index, dtype=np.int64))
+            ph = plan.commanded_phase()
+            ph[(ph == 1) & r["sliding"]] = 2
+            phase.append(ph)
+            load.append(r["load_ratio"])
+            # in gross sliding the CoR of the pad's actual slip; elsewhere (no slip) that of the
+            # prescribed motion seen from the contact point
+            sign = np.sign(plan.c_tilde_signed(1.0))
+            c_geom = sign * r["cor_distance"] / self.radius(np.maximum(r["f_n"], 1e-9))
+            slip_ok = (ph == 2) & np.isfinite(r["c_tilde_slip"])
+            c_tilde.append(np.where(slip_ok, r["c_tilde_slip"], c_geom))
+            v_true.append(r["v"])
+        cat = {k: np.concatenate(v) for k, v in cols.items()}
+        log = SlidingLog.from_arrays(
+            cat["t"],
+            cat["f_n"],
+            cat["tau"],
+            f_x=cat["f_x"],
+            f_y=cat["f_y"],
+            omega=cat["omega"],
+            maneuver=cat["maneuver"],
+            meta={"plant": "mujoco", "seed": int(seed)},
+        )
+        meta = {
+            "plant": "mujoco",
+            "mujoco": mujoco.__version__,
+            "seed": int(seed),
+            "n_maneuvers": int(n),
+            "design": design.to_dict(),
+            "pad": asdict(self.pad),
+            "settings": asdict(self.settings),
+            "wall_time_s": time.perf_counter() - wall,
+        }
+        return RubbingData(
+            log=log,
+            phase=np.concatenate(phase),
+            load_ratio=np.concatenate(load),
+            c_tilde_true=np.concatenate(c_tilde),
+            v_true=np.concatenate(v_true),
+            truth=self.truth(),
+            meta=meta,
+        )
