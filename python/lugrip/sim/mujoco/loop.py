@@ -350,6 +350,7 @@ def run_mujoco_loop(
                     f_t=list(ft_meas),
                     status=[int(o.status) for o in samples],
                     omega_resolution=[o.omega_resolution for o in samples],
+                    tau=list(meas[:, 3]),
                 )
                 command = out.force
                 issued, pf, pend = int(out.command_issued), int(out.pivot_finished), int(out.pivot_end)
