@@ -412,7 +412,7 @@ void GraspController::issue_command(bool valid, double slip) noexcept {
         last_.static_force > 0.0)
       e_i = slip * std::pow(1.0 + last_.dynamic_force / last_.static_force, 1.0 + gamma_) - s_.s_ref;
     double k_p, k_i;
-    if (s_.slope_gain) {  // loop gain k |dS/df_n| independent of the force (docs/model.md §9.10)
+    if (s_.slope_gain) {  // loop gain k |dS/df_n| independent of the force (docs/controller.md)
       // Force at the operating point: the static part when the PI regulates its own slippage.
       const double f_op = s_.static_equivalent_slippage && s_.dynamic_enabled && last_.static_force > 0.0
                               ? std::min(last_.static_force, command_)

@@ -33,11 +33,13 @@ struct GraspControllerSettings {
   double k_p = 4.0;    //!< (*) [N] proportional gain (e > 0 raises the force), > 0
   double k_i = 10.0;   //!< (*) [N/s] integral gain, > 0
   bool anti_windup = true;  //!< (*) back-calculation I = f_ns,clipped - k_p e when clipped
-  //! (*) [N] gain scheduling, not in the paper; 0 = off (paper). When > 0, k_p and k_i are scaled
-  //! by (last command / gain_schedule_force), which keeps the loop gain k_p |dS/df_n| (S ~ 1/f_n)
-  //! the same at every force. Without it the 50 Hz loop on a quasi-static S(f_n) is unstable
-  //! when (k_p - k_i T) |dS/df_n| > 1, i.e. below ~3 N for a translational load (S = 0.8 f*/f_n),
-  //! and limit-cycles there (tests: ControllerClosedLoop.*). >= 0, finite.
+  //! (*) [N] the older gain scheduling, not in the paper; 0 = off. When > 0 (needs slope_gain
+  //! off), k_p and k_i are scaled by (last command / gain_schedule_force), which also keeps the
+  //! loop gain k_p |dS/df_n| (S ~ 1/f_n) the same at every force, at a level set by the chosen
+  //! force instead of the loop gain itself (slope_gain). With constant gains the 50 Hz loop on a
+  //! quasi-static S(f_n) is unstable when (k_p - k_i T) |dS/df_n| > 1, i.e. below ~3 N for a
+  //! translational load (S = 0.8 f*/f_n), and limit-cycles there (tests: ControllerClosedLoop.*,
+  //! ControllerSlopeGain.*). >= 0, finite.
   double gain_schedule_force = 0.0;
   //! (*) not in the paper (default true; false = paper). When true the PI integrates the
   //! slippage the static part alone would give, S_s = S ((f_ns + f_nd) / f_ns)^(1 + gamma) (g
@@ -275,7 +277,7 @@ class StaticForceSolver {
 //! * Invalid input (a present finger with NaN/Inf/out-of-range values or status InvalidSample,
 //!   SensorFault, NoContact): its C_d state is held; a command due in such a call holds the last
 //!   command (plus invalid_raise_step), never lower, and the static law restarts bumplessly.
-//! * Beyond the paper (each a setting, docs/model.md §9.10): PI gains from the plant's slope
+//! * Beyond the paper (each a setting, docs/controller.md): PI gains from the plant's slope
 //!   (slope_gain), a floor on the static part from the static grasp force of the measured load
 //!   (feedforward) and from reflex_factor x the last command after S reached reflex_slippage
 //!   (slip_reflex). Both floors act in slipping avoidance only, on the static part, before the

@@ -887,7 +887,7 @@ TEST(ControllerClosedLoop, LowForcesNeedGainScheduling) {
   EXPECT_NEAR(0.5 * (full.first + full.second), 4.7495, 0.05);
 }
 
-// --- beyond the paper: slope gain, feed-forward, slip reflex (docs/model.md §9.10) ----------------
+// --- beyond the paper: slope gain, feed-forward, slip reflex (docs/controller.md) ----------------
 // Consistency tests: the plant below is lugrip's own static map S_static(f_n) (StaticForceSolver)
 // behind a first-order force lag; they check the law, not the contact physics (the closed loops
 // on the patch and MuJoCo plants are in tests/python/test_controller.py).

@@ -319,7 +319,7 @@ def test_dead_band_ignores_speeds_below_the_observer_resolution():
     assert out.dynamic_force == 0.0
 
 
-# --- beyond the paper: slope gain, feed-forward, slip reflex (docs/model.md §9.10) ----------------
+# --- beyond the paper: slope gain, feed-forward, slip reflex (docs/controller.md) ----------------
 
 def test_feedforward_is_the_static_grasp_force_of_the_measured_load():
     """Consistency: the feed-forward force of a command is static_grasp_force of the mean load of
