@@ -41,14 +41,17 @@ struct GraspControllerSettings {
   //! translational load (S = 0.8 f*/f_n), and limit-cycles there (tests: ControllerClosedLoop.*,
   //! ControllerSlopeGain.*). >= 0, finite.
   double gain_schedule_force = 0.0;
-  //! (*) not in the paper (default true; false = paper). When true the PI integrates the
+  //! (*) not in the paper (default false = paper; superseded by feedforward, which holds f_ns
+  //! at the measured load's static force from the wrench itself). When true the PI integrates the
   //! slippage the static part alone would give, S_s = S ((f_ns + f_nd) / f_ns)^(1 + gamma) (g
   //! grows as f_n^(1 + gamma) at a fixed CoR; f_ns, f_nd of the last command), instead of S; the
   //! proportional term keeps S. While f_nd holds the object after a slip, S is low because of
   //! f_nd, and the paper's PI unwinds f_ns, so the object slips again when f_nd has decayed (a
   //! slip / force-spike cycle on heavy rotational loads); with S_s, f_ns keeps rising to the
-  //! force the load needs. Identical to the paper when f_nd = 0.
-  bool static_equivalent_slippage = true;
+  //! force the load needs. Identical to the paper when f_nd = 0. It uses the commanded forces,
+  //! which the gripper's force lags after a slip: f_ns overshoots (+2 % mean force on the paper's
+  //! scenarios with feedforward on).
+  bool static_equivalent_slippage = false;
   //! (*) not in the paper (default 1; 0 = off = paper). Dead band of the dynamic part in multiples of each
   //! finger's FingerInput::omega_resolution: C_d sees sign(w) max(0, |w| - band) with
   //! band = omega_deadband * omega_resolution. The slip speed enters the wrench only through

@@ -23,7 +23,7 @@ constexpr double kPi = 3.14159265358979323846;
 ContactParams can() { return object_params("aluminium_can"); }
 
 // The paper's static law (constant gains, the sample's S, no feed-forward, no reflex); the
-// static_equivalent_slippage and omega_deadband defaults are kept (tested on their own).
+// omega_deadband default is kept (tested on its own).
 GraspControllerSettings paper_law(GraspControllerSettings s = {}) {
   s.slope_gain = false;
   s.feedforward = false;
@@ -296,6 +296,7 @@ TEST(ControllerStaticPart, StaticEquivalentSlippageKeepsRaisingWhileTheDynamicPa
   // the slippage at the static force alone, which is above s_ref here: f_ns keeps rising.
   const ContactParams p = can();
   GraspControllerSettings on = paper_law(), off = paper_law();
+  on.static_equivalent_slippage = true;
   on.max_rate_up = on.max_rate_down = off.max_rate_up = off.max_rate_down = kInf;
   off.static_equivalent_slippage = false;
   GraspController a(p, on), b(p, off);

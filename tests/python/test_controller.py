@@ -13,8 +13,8 @@ from lugrip import ControllerMode, GraspController, PivotEnd, Status
 from scipy import signal
 
 CAN = lugrip.ContactParams.preset("aluminium_can")
-#: The paper's static law (constant gains, S of the sample, no feed-forward, no reflex); the other
-#: two additions (static_equivalent_slippage, omega_deadband) keep their defaults here.
+#: The paper's static law (constant gains, S of the sample, no feed-forward, no reflex); the
+#: dead band (omega_deadband) keeps its default here.
 PAPER_PI = {k: lugrip.PAPER_SETTINGS[k]
             for k in ("slope_gain", "feedforward", "slip_reflex", "average_slippage")}
 T_SENSOR = 1.0 / 500.0
