@@ -31,7 +31,7 @@ import numpy as np
 from lugrip.sim import scenarios as sc
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
-from sections import write_section  # noqa: E402
+from sections import markers, write_section  # noqa: E402
 
 #: the additions to the paper's law, each switched off alone
 SINGLE_OFF = {
@@ -104,9 +104,15 @@ def fmt(v, spec=".3g"):
     return "-" if v is None else format(v, spec)
 
 
+def section_name(plant: str) -> str:
+    """BENCHMARKS.md section of this plant's table."""
+    return "controller" if plant == "patch" else f"controller-{plant}"
+
+
 def markdown(results: dict, plant: str, seeds: list[int | None], elapsed: float) -> str:
+    begin, end = markers(section_name(plant))
     lines = [
-        "<!-- controller:begin -->",
+        begin,
         f"## Controller: lugrip's defaults against the paper's law ({plant} plant)",
         "",
         "`python benchmarks/bench_controller.py"
@@ -136,7 +142,7 @@ def markdown(results: dict, plant: str, seeds: list[int | None], elapsed: float)
         for var, d in per["variants"].items():
             if d["all"]["failed"]:
                 lines.append(f"- {name} / {var}: {', '.join(d['all']['failed'])}")
-    lines.append("<!-- controller:end -->")
+    lines.append(end)
     return "\n".join(lines) + "\n"
 
 
@@ -176,7 +182,7 @@ def main(argv: list[str] | None = None) -> int:
     if args.json:
         args.json.write_text(json.dumps(results, indent=1, default=float))
     if args.section:
-        write_section(args.section, text, "controller")
+        write_section(args.section, text, section_name(plant))
     return 0
 
 
