@@ -8,7 +8,7 @@ OUT    ?= out
 
 SOURCES := $(shell find src include bindings python -type f \( -name '*.cpp' -o -name '*.hpp' -o -name '*.py' \)) pyproject.toml CMakeLists.txt
 
-.PHONY: all install demo test test-cpp test-python validate bench sanitize clean
+.PHONY: all install demo test test-cpp test-python test-install deps-cpp validate bench sanitize clean
 
 all: install
 
@@ -28,13 +28,25 @@ install: $(VENV)/.installed
 demo: install
 	$(VENV)/bin/lugrip demo --out $(OUT)
 
-test: test-cpp test-python
+test: test-cpp test-install test-python
+
+# yaml-cpp for the optional lugrip::yaml target (parameter-file loader): installed from Debian's
+# packages when running as root (CI, fresh machines); elsewhere the target is skipped if absent.
+deps-cpp:
+	@if [ "$$(id -u)" = 0 ] && command -v apt-get > /dev/null && ! dpkg -s libyaml-cpp-dev > /dev/null 2>&1; then \
+	  apt-get install -y -q libyaml-cpp-dev > /dev/null 2>&1 || \
+	  { apt-get update -q > /dev/null && apt-get install -y -q libyaml-cpp-dev > /dev/null; } || \
+	  echo "libyaml-cpp-dev could not be installed: lugrip::yaml is not built"; fi
+
+# The installed CMake package: lugrip::core alone links the 500 Hz loop example (nm check).
+test-install: deps-cpp
+	JOBS=$(JOBS) tests/install/check_core_install.sh build/install-check
 
 # lugrip in closed loop on MuJoCo (validation/mujoco/README.md): out/mujoco_grasp.{json,png}
 validate: install
 	$(VPY) validation/mujoco/grasp.py --out $(OUT)
 
-test-cpp:
+test-cpp: deps-cpp
 	cmake -S . -B $(CPP_BUILD) -DCMAKE_BUILD_TYPE=Release -DLUGRIP_BUILD_TESTS=ON -DLUGRIP_BUILD_BENCHMARKS=ON > /dev/null
 	cmake --build $(CPP_BUILD) -j $(JOBS)
 	cd $(CPP_BUILD) && ctest --output-on-failure -j $(JOBS)
@@ -56,6 +68,7 @@ bench: install
 	$(VPY) benchmarks/run_benchmarks.py --cpp-dir $(CPP_BUILD)/benchmarks --out BENCHMARKS.md
 	$(VPY) benchmarks/observer_report.py --cpp-dir $(CPP_BUILD)/benchmarks --out BENCHMARKS.md
 	$(VPY) benchmarks/bench_identify.py --out BENCHMARKS.md
+	$(VPY) benchmarks/bench_slip_control.py --out BENCHMARKS.md
 	$(VPY) benchmarks/bench_rigs.py --out BENCHMARKS.md
 	$(CPP_BUILD)/benchmarks/bench_closed_loop --markdown > build/issue5.md
 	$(VPY) benchmarks/sections.py BENCHMARKS.md issue5 build/issue5.md

@@ -34,6 +34,9 @@ void bind_closed_loop(nb::module_& m) {
            "time"_a, "action"_a)
       .def_prop_ro("n_events", [](const ClosedLoopConfig& c) { return c.schedule.size(); });
   def_fields_rw(config);
+  nb::class_<ClosedLoopSample> sample(m, "ClosedLoopSample");
+  sample.def(nb::init<>());
+  def_fields_ro(sample);
   m.def("validate_closed_loop_config", &validation_message<ClosedLoopConfig>, "Empty string when valid, else one line per problem.");
 
   using Loop = Guarded<ClosedLoop>;
@@ -52,63 +55,22 @@ void bind_closed_loop(nb::module_& m) {
         .def("run", [](Loop& c, int64_t samples) {
           c.guard.check("ClosedLoop");
           if (samples < 0) throw std::invalid_argument("samples must be >= 0");
-          auto* log = new ClosedLoopLog();
-          try {
+          const size_t n = static_cast<size_t>(samples);
+          Columns<ClosedLoopSample, uint8_t> cols(n);
+          {
             nb::gil_scoped_release release;
-            c.run(samples, *log);
-          } catch (...) {
-            delete log;
-            throw;
+            ClosedLoopSample s;
+            for (size_t k = 0; k < n; ++k) {
+              c.step(s);
+              cols.set(k, s);
+            }
           }
-          // One capsule owns the log; every column is a view into it.
-          nb::capsule owner(log, [](void* p) noexcept { delete static_cast<ClosedLoopLog*>(p); });
           nb::dict d;
-          auto put = [&](const char* name, auto& v) {
-            using T = typename std::decay_t<decltype(v)>::value_type;
-            d[name] = nb::ndarray<nb::numpy, T, nb::ndim<1>>(v.data(), {v.size()}, owner);
-          };
-          put("t", log->t);
-          put("command", log->command);
-          put("static_force", log->static_force);
-          put("dynamic_force", log->dynamic_force);
-          put("f_n", log->f_n);
-          const char* suffix[] = {"_0", "_1"};
-          for (int i = 0; i < 2; ++i) {
-            const std::string s = suffix[i];
-            put(("f_n_meas" + s).c_str(), log->f_n_meas[i]);
-            put(("f_t_meas" + s).c_str(), log->f_t_meas[i]);
-            put(("tau_meas" + s).c_str(), log->tau_meas[i]);
-            put(("f_t_true" + s).c_str(), log->f_t_true[i]);
-            put(("tau_true" + s).c_str(), log->tau_true[i]);
-            put(("omega_hat" + s).c_str(), log->omega_hat[i]);
-            put(("S" + s).c_str(), log->slippage[i]);
-            put(("c_tilde" + s).c_str(), log->c_tilde[i]);
-            put(("omega_true" + s).c_str(), log->omega_true[i]);
-            put(("c_tilde_true" + s).c_str(), log->c_tilde_true[i]);
-            put(("observer_status" + s).c_str(), log->observer_status[i]);
-          }
-          put("slip_x", log->slip_x);
-          put("slip_y", log->slip_y);
-          put("slip", log->slip);
-          put("rotation", log->rotation);
-          put("theta", log->theta);
-          put("cog_x", log->cog_x);
-          put("cog_y", log->cog_y);
-          put("gripper_y", log->gripper_y);
-          put("ext_fx", log->ext_fx);
-          put("ext_fy", log->ext_fy);
-          put("ext_tau", log->ext_tau);
-          put("mode", log->mode);
-          put("pivot_end", log->pivot_end);
-          put("command_issued", log->command_issued);
-          put("pivot_finished", log->pivot_finished);
-          put("supported", log->supported);
-          put("dropped", log->dropped);
-          put("finite", log->finite);
+          cols.into(d);
           return d;
         }, "samples"_a,
            "Runs `samples` closed-loop samples in C++ from the current state; returns a dict of "
-           "arrays (per-finger columns suffixed _0/_1; flags as uint8).");
+           "arrays (ClosedLoopSample.fields; per-finger columns suffixed _0/_1; flags as uint8).");
   }
 }
 

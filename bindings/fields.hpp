@@ -40,6 +40,14 @@ void for_each_field(Fn&& fn) {
 
 using Pair = std::array<double, 2>;
 
+//! std::array<double, 2> or std::array<int, 2>: one value per finger.
+template <class T>
+struct is_pair : std::false_type {};
+template <class E>
+struct is_pair<std::array<E, 2>> : std::bool_constant<std::is_arithmetic_v<E>> {};
+template <class T>
+inline constexpr bool is_pair_v = is_pair<T>::value;
+
 //! Kind of a field for the Python side: float, int, bool, enum, pair (two floats) or struct.
 template <class T>
 constexpr const char* kind_name() {
@@ -47,7 +55,7 @@ constexpr const char* kind_name() {
   else if constexpr (std::is_floating_point_v<T>) return "float";
   else if constexpr (std::is_integral_v<T>) return "int";
   else if constexpr (std::is_enum_v<T>) return "enum";
-  else if constexpr (std::is_same_v<T, Pair>) return "pair";
+  else if constexpr (is_pair_v<T>) return "pair";
   else return "struct";
 }
 
@@ -69,7 +77,7 @@ template <class S, class... Opts>
 void def_fields_ro(nb::class_<S, Opts...>& cls) {
   for_each_field<S>([&](const auto& f) {
     using T = std::decay_t<decltype(std::declval<S>().*(f.member))>;
-    if constexpr (std::is_same_v<T, Pair>) {
+    if constexpr (is_pair_v<T>) {
       auto m = f.member;
       cls.def_prop_ro(f.name, [m](const S& s) { return nb::make_tuple((s.*m)[0], (s.*m)[1]); }, f.doc);
     } else {
@@ -87,22 +95,23 @@ void def_fields_rw(nb::class_<S, Opts...>& cls) {
 }
 
 //! One numpy array per scalar field of S (two for a pair, none for a nested struct), named
-//! <field><suffix> (a pair: <field>_0<suffix>, <field>_1<suffix>). set() only writes into the
-//! arrays, so it runs with the GIL released.
-template <class S>
+//! <field><suffix> (a pair: <field>_0<suffix>, <field>_1<suffix>); bools stored as BoolT.
+//! set() only writes into the arrays, so it runs with the GIL released.
+template <class S, class BoolT = bool>
 class Columns {
  public:
   explicit Columns(size_t n, const std::string& suffix = "") {
     for_each_field<S>([&](const auto& f) {
       using T = std::decay_t<decltype(std::declval<S>().*(f.member))>;
       const std::string name = f.name;
-      if constexpr (std::is_same_v<T, bool>) add(name + suffix, new_array<bool>(n));
+      if constexpr (std::is_same_v<T, bool>) add(name + suffix, new_array<BoolT>(n));
       else if constexpr (std::is_floating_point_v<T>) add(name + suffix, new_array<double>(n));
       else if constexpr (std::is_same_v<T, int64_t>) add(name + suffix, new_array<int64_t>(n));
       else if constexpr (std::is_integral_v<T> || std::is_enum_v<T>) add(name + suffix, new_array<int32_t>(n));
-      else if constexpr (std::is_same_v<T, Pair>) {
-        add(name + "_0" + suffix, new_array<double>(n));
-        add(name + "_1" + suffix, new_array<double>(n));
+      else if constexpr (is_pair_v<T>) {
+        using E = std::conditional_t<std::is_floating_point_v<typename T::value_type>, double, int32_t>;
+        add(name + "_0" + suffix, new_array<E>(n));
+        add(name + "_1" + suffix, new_array<E>(n));
       }
     });
   }
@@ -112,14 +121,15 @@ class Columns {
     for_each_field<S>([&](const auto& f) {
       using T = std::decay_t<decltype(std::declval<S>().*(f.member))>;
       const T& v = s.*(f.member);
-      if constexpr (std::is_same_v<T, bool>) static_cast<bool*>(ptr_[j++])[i] = v;
+      if constexpr (std::is_same_v<T, bool>) static_cast<BoolT*>(ptr_[j++])[i] = static_cast<BoolT>(v);
       else if constexpr (std::is_floating_point_v<T>) static_cast<double*>(ptr_[j++])[i] = v;
       else if constexpr (std::is_same_v<T, int64_t>) static_cast<int64_t*>(ptr_[j++])[i] = v;
       else if constexpr (std::is_integral_v<T> || std::is_enum_v<T>)
         static_cast<int32_t*>(ptr_[j++])[i] = static_cast<int32_t>(v);
-      else if constexpr (std::is_same_v<T, Pair>) {
-        static_cast<double*>(ptr_[j++])[i] = v[0];
-        static_cast<double*>(ptr_[j++])[i] = v[1];
+      else if constexpr (is_pair_v<T>) {
+        using E = std::conditional_t<std::is_floating_point_v<typename T::value_type>, double, int32_t>;
+        static_cast<E*>(ptr_[j++])[i] = static_cast<E>(v[0]);
+        static_cast<E*>(ptr_[j++])[i] = static_cast<E>(v[1]);
       }
     });
   }

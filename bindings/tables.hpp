@@ -101,6 +101,16 @@ struct Table<GraspControllerSettings> {
       field("static_equivalent_slippage", &S::static_equivalent_slippage,
             "integrate the slippage of the static part alone"),
       field("omega_deadband", &S::omega_deadband, "C_d dead band in speed resolutions [-]"),
+      field("slope_gain", &S::slope_gain, "PI gains from the plant's slope dS/df_n"),
+      field("loop_gain_p", &S::loop_gain_p, "proportional loop gain k_p |dS/df_n| [-]"),
+      field("loop_gain_i", &S::loop_gain_i, "integral loop gain k_i |dS/df_n| [1/s]"),
+      field("average_slippage", &S::average_slippage, "PI on the mean S of the command period"),
+      field("feedforward", &S::feedforward, "static part floored at the measured load's static force"),
+      field("feedforward_slippage", &S::feedforward_slippage, "S of the feed-forward force [-]"),
+      field("slip_reflex", &S::slip_reflex, "raise the force when S reaches reflex_slippage"),
+      field("reflex_slippage", &S::reflex_slippage, "reflex threshold on S [-]"),
+      field("reflex_samples", &S::reflex_samples, "consecutive samples at or above the threshold"),
+      field("reflex_factor", &S::reflex_factor, "static-part raise per period of detected slip [-]"),
       field("f_min", &S::f_min, "minimum force [N]"),
       field("f_max", &S::f_max, "maximum force [N]"),
       field("max_rate_up", &S::max_rate_up, "command increase limit (inf: off) [N/s]"),
@@ -112,17 +122,7 @@ struct Table<GraspControllerSettings> {
       field("pivot_floor_factor", &S::pivot_floor_factor, "pivoting floor factor on f_t / mu [-]"),
       field("pivot_end_c_tilde", &S::pivot_end_c_tilde, "pivoting ends above this mean |c~| [-]"),
       field("pivot_end_samples", &S::pivot_end_samples, "consecutive samples above the threshold"),
-      field("pivot_timeout", &S::pivot_timeout, "pivoting timeout (inf: off) [s]"),
-      field("slope_gain", &S::slope_gain, "PI gains from the plant's slope dS/df_n"),
-      field("loop_gain_p", &S::loop_gain_p, "proportional loop gain k_p |dS/df_n| [-]"),
-      field("loop_gain_i", &S::loop_gain_i, "integral loop gain k_i |dS/df_n| [1/s]"),
-      field("feedforward", &S::feedforward, "static part floored at the measured load's static force"),
-      field("feedforward_slippage", &S::feedforward_slippage, "S of the feed-forward force [-]"),
-      field("slip_reflex", &S::slip_reflex, "raise the force when S reaches reflex_slippage"),
-      field("reflex_slippage", &S::reflex_slippage, "threshold on the peak of S [-]"),
-      field("reflex_samples", &S::reflex_samples, "consecutive samples at or above the threshold"),
-      field("reflex_factor", &S::reflex_factor, "static-part raise per period of detected slip [-]"),
-      field("average_slippage", &S::average_slippage, "PI on the mean S of the command period"));
+      field("pivot_timeout", &S::pivot_timeout, "pivoting timeout (inf: off) [s]"));
 };
 
 template <>
@@ -388,6 +388,41 @@ struct Table<ClosedLoopConfig> {
       field("controller_start", &S::controller_start, "[s]"),
       field("constant_force", &S::constant_force, "[N]"), field("cone_margin", &S::cone_margin, "[-]"),
       field("cone_release_rate", &S::cone_release_rate, "[N/s]"));
+};
+
+template <>
+struct Table<ClosedLoopSample> {
+  using S = ClosedLoopSample;
+  static constexpr auto fields = std::make_tuple(
+      field("index", &S::index, "sample number"), field("t", &S::t, "[s]"),
+      field("command", &S::command, "grasp-force command sent to the gripper [N]"),
+      field("static_force", &S::static_force, "f_ns of the last command [N]"),
+      field("dynamic_force", &S::dynamic_force, "f_nd of the last command [N]"),
+      field("f_n", &S::f_n, "true normal force of each finger [N]"),
+      field("f_n_meas", &S::f_n_meas, "measured normal force per finger [N]"),
+      field("f_t_meas", &S::f_t_meas, "measured tangential force per finger [N]"),
+      field("tau_meas", &S::tau_meas, "measured torque per finger [N m]"),
+      field("f_t_true", &S::f_t_true, "true tangential load per finger [N]"),
+      field("tau_true", &S::tau_true, "true torque per finger [N m]"),
+      field("omega_hat", &S::omega_hat, "estimated slip velocity per finger [rad/s]"),
+      field("S", &S::slippage, "slippage indicator per finger [-]"),
+      field("c_tilde", &S::c_tilde, "estimated CoR per finger [-]"),
+      field("omega_true", &S::omega_true, "true slip velocity per finger [rad/s]"),
+      field("c_tilde_true", &S::c_tilde_true, "true CoR per finger [-]"),
+      field("observer_status", &S::observer_status, "Status code per finger"),
+      field("slip_x", &S::slip_x, "[m]"), field("slip_y", &S::slip_y, "[m]"),
+      field("slip", &S::slip, "slip distance (lumped: path length) [m]"),
+      field("rotation", &S::rotation, "theta - theta0 [rad]"), field("theta", &S::theta, "[rad]"),
+      field("cog_x", &S::cog_x, "CoG relative to the grasp point [m]"), field("cog_y", &S::cog_y, "[m]"),
+      field("gripper_y", &S::gripper_y, "grasp-point height [m]"), field("ext_fx", &S::ext_fx, "[N]"),
+      field("ext_fy", &S::ext_fy, "[N]"), field("ext_tau", &S::ext_tau, "[N m]"),
+      field("mode", &S::mode, "ControllerMode code"),
+      field("command_issued", &S::command_issued, "a command was computed at this sample"),
+      field("pivot_finished", &S::pivot_finished, "pivoting ended at this sample"),
+      field("pivot_end", &S::pivot_end, "PivotEnd code"),
+      field("supported", &S::supported, "object resting on the support"),
+      field("dropped", &S::dropped, "a drop criterion has been met (latched)"),
+      field("finite", &S::finite, "every value of this sample is finite"));
 };
 
 }  // namespace lugrip_bind

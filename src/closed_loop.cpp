@@ -228,7 +228,7 @@ void ClosedLoop::cone_command() noexcept {
   cone_count_ = 0;
 }
 
-void ClosedLoop::step(ClosedLoopSample& out) noexcept {
+Status ClosedLoop::step(ClosedLoopSample& out) noexcept {
   const double t = static_cast<double>(n_) * dt_;
   apply_events(t);
   const bool tick = n_ % ratio_ == 0;
@@ -245,8 +245,7 @@ void ClosedLoop::step(ClosedLoopSample& out) noexcept {
     sin.fingers[i] = FingerWrench{s.f_n, s.f_x, s.f_y, s.tau};
   }
   const bool lugrip_active = started_ && cfg_.kind == ControllerKind::Lugrip;
-  if (lugrip_active) sc_.step(sin, sout_);
-  else sc_.observe(sin, sout_);
+  const Status status = lugrip_active ? sc_.step(sin, sout_) : sc_.observe(sin, sout_);
   for (int i = 0; i < 2; ++i) {
     const FingerSample& s = plant_.sensor_sample(i);
     const ObserverOutput& o = sout_.fingers[i];
@@ -327,6 +326,7 @@ void ClosedLoop::step(ClosedLoopSample& out) noexcept {
 
   plant_.advance_sample();
   ++n_;
+  return status;
 }
 
 void ClosedLoop::run(int64_t samples, ClosedLoopLog& log) {

@@ -332,6 +332,15 @@ bool GraspPlant::step() noexcept {
   return false;
 }
 
+Status GraspPlant::step(const PlantInput& in, PlantOutput& out) noexcept {
+  const bool valid = !std::isnan(in.command);
+  if (valid) set_command(in.command);
+  advance_sample();
+  out.state = st_;
+  out.fingers = sample_;
+  return valid ? Status::Ok : Status::InvalidSample;
+}
+
 int64_t GraspPlant::advance_sample() noexcept {
   while (!step()) {
   }

@@ -147,8 +147,9 @@ class ClosedLoop {
   //! Back to t = 0 (plant, observers, controller, schedule).
   void reset() noexcept;
   //! Processes the current sensor sample (schedule, observers, controller, command), records it
-  //! in `out`, then advances the plant to the next sample.
-  void step(ClosedLoopSample& out) noexcept;
+  //! in `out`, then advances the plant to the next sample. Returns the status of the cycle
+  //! (SlipControl's while the lugrip law runs, else the worst observer status; Ok when valid).
+  Status step(ClosedLoopSample& out) noexcept;
   //! Runs `samples` steps, appending to `log` (allocates: not for real-time use).
   void run(int64_t samples, ClosedLoopLog& log);
 

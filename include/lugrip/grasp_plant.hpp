@@ -18,11 +18,13 @@
 
 #include <array>
 #include <cstdint>
+#include <limits>
 #include <string>
 #include <vector>
 
 #include "lugrip/contact.hpp"
 #include "lugrip/params.hpp"
+#include "lugrip/status.hpp"
 
 namespace lugrip {
 
@@ -312,6 +314,17 @@ class NormalRng {
   uint64_t s_[4] = {0, 0, 0, 0};
 };
 
+//! Input of one sensor-rate step() of the plant.
+struct PlantInput {
+  double command = std::numeric_limits<double>::quiet_NaN();  //!< grasp-force command [N]; NaN: keep the last
+};
+
+//! Output of one sensor-rate step(): the state and both fingertip samples at the new sample.
+struct PlantOutput {
+  PlantState state;                      //!< plant state at the new sample
+  std::array<FingerSample, 2> fingers{};  //!< sensor sample of each finger
+};
+
 //! The grasp simulator. Lifecycle: construct (validates, allocates) -> set_command / step
 //! (noexcept, no allocation) -> reset. One step advances 1/rate seconds; a sensor sample of both
 //! fingers is taken at t = 0 and every rate/sensor.rate steps.
@@ -343,6 +356,10 @@ class GraspPlant {
   bool step() noexcept;
   //! Steps until the next sensor sample; returns its index.
   int64_t advance_sample() noexcept;
+  //! The component shape of the library: set_command(in.command), advance_sample(), then the
+  //! new state and samples into `out`. Returns Ok, or InvalidSample for a command that is not a
+  //! number (ignored: the last command is kept).
+  Status step(const PlantInput& in, PlantOutput& out) noexcept;
 
   //! Latest sample of finger 0 or 1 (taken at t = index / sensor.rate).
   const FingerSample& sensor_sample(int finger) const noexcept { return sample_[finger & 1]; }

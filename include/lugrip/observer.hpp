@@ -55,11 +55,11 @@ const char* to_string(GainMode m) noexcept;
 //! What the ranges guarantee, with ContactParams inside theirs (sigma0 >= 1e-12 among them):
 //! * finite outputs: rho = delta f_n^gamma < max(1, f_n^(1/3)) and |c| <= c_max rho (c_max <=
 //!   1e3), so forces <= 1e9 N give rho < 1e3 m, |y| <= |tau| + |c| f_t < 1e16 N m and g < 1e17 N m,
-//!   hence |z_hat| <= g / sigma0 < 1e29 rad; |omega_hat| <= omega_limit <= 1e6 rad/s and rho < 1e3 m
-//!   keep v_slip below 1e10 m/s; every other output is a ratio with a floored denominator. An
-//!   update that still overflows (a gain of 1e15 times a large sigma_1 over a long step) is the
-//!   divergence guard's case; a sample whose CoR or output is not finite is rejected like an
-//!   invalid input (InvalidSample: state untouched).
+//!   hence |z_hat| <= g / sigma0 < 1e29 rad; |omega_object| <= |omega_hat| <= omega_limit <= 1e6
+//!   rad/s keeps v_slip <= |omega_hat| rho (c_max + 1/(2 c_max)) below 1e12 m/s; every other
+//!   output is a ratio with a floored denominator. An update that still overflows (a gain of 1e15
+//!   times a large sigma_1 over a long step) is the divergence guard's case; a sample whose CoR
+//!   or outputs are not finite is rejected like an invalid input (InvalidSample: state untouched).
 //! * bounded work: each sample costs at most 8 x max_substeps integrator substeps (the adaptive
 //!   schemes retry up to eight times) plus a CoR solve of at most a few hundred limit-surface
 //!   evaluations. A substep takes about 0.1 us, so substeps = max_substeps = 5000 costs about
@@ -163,7 +163,7 @@ struct ObserverOutput {
   int cor_iterations = 0;   //!< root-finding iterations of the CoR estimate
   Status status = Status::NoContact;
   double c_tilde_unclipped = 0.0;  //!< normalized CoR before the clip [-], signed like c_tilde, |c~u| >= |c~|
-  double omega_object = 0.0;  //!< slip velocity about the unclipped CoR [rad/s] (= omega_hat unless saturated)
+  double omega_object = 0.0;  //!< slip velocity about the unclipped CoR [rad/s] (= omega_hat where c~u = c~)
   double v_slip = 0.0;        //!< slip speed of the patch centre [m/s], >= 0
 };
 

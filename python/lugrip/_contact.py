@@ -226,9 +226,9 @@ class CorEstimate:
         return (self.c_tilde, self.inside)[i]
 
 
-def estimate_cor(params, f_n, f_t, tau, *, f_n_min: float = 0.03, zero_force: float = 1e-4,
-                 zero_torque: float = 1e-4, force_limit: float = 1e4,
-                 torque_limit: float = 1e3) -> CorEstimate:
+def estimate_cor(params, f_n, f_t, tau, *, f_n_min: float | None = None,
+                 zero_force: float | None = None, zero_torque: float | None = None,
+                 force_limit: float | None = None, torque_limit: float | None = None) -> CorEstimate:
     """Estimate the signed normalized CoR c~ for each sample (paper eqs. 13-15, MODEL.md 5.7).
 
     Samples are processed in order (flattened, C order) by one C++ estimator, so undefined
@@ -240,18 +240,19 @@ def estimate_cor(params, f_n, f_t, tau, *, f_n_min: float = 0.03, zero_force: fl
         params: ContactParams, a preset name or a dict.
         f_n: normal force [N]; f_t: tangential force [N] (magnitude or signed); tau: torsional
             moment [N m]. Broadcast against each other.
-        f_n_min, zero_force, zero_torque, force_limit, torque_limit: see CorSettings (C++).
+        f_n_min, zero_force, zero_torque, force_limit, torque_limit: see CorSettings (C++);
+            None: the C++ default.
 
     Returns:
         CorEstimate (unpacks to ``c_tilde, inside``).
     """
     p = _as_params(params)
     settings = _core.CorSettings()
-    settings.f_n_min = f_n_min
-    settings.zero_force = zero_force
-    settings.zero_torque = zero_torque
-    settings.force_limit = force_limit
-    settings.torque_limit = torque_limit
+    given = {"f_n_min": f_n_min, "zero_force": zero_force, "zero_torque": zero_torque,
+             "force_limit": force_limit, "torque_limit": torque_limit}
+    for name, value in given.items():
+        if value is not None:
+            setattr(settings, name, float(value))
     message = _core.validate_cor_settings(settings)
     if message:
         raise ValueError("invalid CoR settings:\n" + message.rstrip())

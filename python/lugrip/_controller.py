@@ -7,7 +7,7 @@ Thin layer over the C++ ``lugrip::GraspController`` and ``lugrip::StaticForceSol
 from __future__ import annotations
 
 import enum
-from dataclasses import dataclass
+from dataclasses import make_dataclass
 from typing import Any
 
 import numpy as np
@@ -104,98 +104,45 @@ def _core_settings(values: dict[str, Any]) -> _core.GraspControllerSettings:
     return s
 
 
-@dataclass(frozen=True)
-class ControllerOutput:
-    """Output of one :meth:`GraspController.step` (see GraspControllerOutput in C++).
-
-    Attributes:
-        force: commanded grasp force [N] (held between commands), in [f_min, f_max].
-        static_force, dynamic_force: f_ns and f_nd of the last command [N].
-        floor: lower bound applied at the last command [N].
-        slippage: combined S = max_i S_i at the last command; error: S - S_ref (or S - S_p).
-        integrator: PI integrator [N]; gain_p, gain_i: k_p [N] and k_i [N/s] used at the last
-            command; feedforward_force: static grasp force of the measured load at the last
-            command [N] (0: none); peak_slippage: peak of S over the period before it;
-            reflex: the slip reflex raised it; dynamic_sample: signed C_d omega_hat per finger at this
-            sample [N]; dynamic_peak: running peak of max_i |C_d omega_hat_i| [N].
-        mean_c_tilde: mean |c~_i| of the valid fingers; pivot_time: time in pivoting [s].
-        mode, pivot_end, pivot_finished: mode after this call and the end-of-pivot event.
-        command_issued: a new command was computed in this call.
-        saturated, rate_limited, held: flags of the last command (held: safe hold on bad input).
-        status: Status.OK or the worst finger status of this sample.
-    """
-
-    force: float
-    static_force: float
-    dynamic_force: float
-    floor: float
-    slippage: float
-    error: float
-    integrator: float
-    gain_p: float
-    gain_i: float
-    feedforward_force: float
-    peak_slippage: float
-    reflex: bool
-    dynamic_sample: tuple
-    dynamic_peak: float
-    mean_c_tilde: float
-    pivot_time: float
-    mode: ControllerMode
-    pivot_end: PivotEnd
-    pivot_finished: bool
-    command_issued: bool
-    saturated: bool
-    rate_limited: bool
-    held: bool
-    status: Status
-
-    @classmethod
-    def _from_core(cls, o) -> ControllerOutput:
-        return cls(
-            force=o.force, static_force=o.static_force, dynamic_force=o.dynamic_force,
-            floor=o.floor, slippage=o.slippage, error=o.error, integrator=o.integrator,
-            gain_p=o.gain_p, gain_i=o.gain_i, feedforward_force=o.feedforward_force,
-            peak_slippage=o.peak_slippage, reflex=o.reflex,
-            dynamic_sample=tuple(o.dynamic_sample), dynamic_peak=o.dynamic_peak,
-            mean_c_tilde=o.mean_c_tilde, pivot_time=o.pivot_time,
-            mode=ControllerMode(_code(o.mode)), pivot_end=PivotEnd(_code(o.pivot_end)),
-            pivot_finished=o.pivot_finished, command_issued=o.command_issued,
-            saturated=o.saturated, rate_limited=o.rate_limited, held=o.held,
-            status=Status(_code(o.status)),
-        )
+#: (name, kind, doc) of every GraspControllerOutput field, from the C++ field table.
+OUTPUT_FIELDS = tuple(_core.GraspControllerOutput.fields)
+_ENUMS = {"mode": ControllerMode, "pivot_end": PivotEnd, "status": Status}
+_KIND_TYPES = {"float": float, "int": int, "bool": bool, "pair": tuple}
 
 
-@dataclass(frozen=True)
-class ControllerRun:
-    """Per-sample outputs of :meth:`GraspController.run`; arrays of shape (N,), except
+def _output_from_core(cls, o):
+    values = {}
+    for name, kind, _doc in OUTPUT_FIELDS:
+        v = getattr(o, name)
+        values[name] = _ENUMS[name](_code(v)) if kind == "enum" else v
+    return cls(**values)
+
+
+def _attribute_list(fields) -> str:
+    return "\n".join(f"        {name}: {doc}" for name, _kind, doc in fields)
+
+
+ControllerOutput = make_dataclass(
+    "ControllerOutput",
+    [(name, _ENUMS[name] if kind == "enum" else _KIND_TYPES[kind]) for name, kind, _d in OUTPUT_FIELDS],
+    frozen=True,
+    namespace={"_from_core": classmethod(_output_from_core), "__module__": __name__},
+)
+ControllerOutput.__doc__ = (
+    "Output of one :meth:`GraspController.step` (the C++ GraspControllerOutput).\n\n"
+    "    Attributes (generated from the C++ struct; mode, pivot_end and status as ControllerMode,\n"
+    "    PivotEnd and Status; dynamic_sample a tuple per finger):\n" + _attribute_list(OUTPUT_FIELDS) + "\n    "
+)
+
+ControllerRun = make_dataclass(
+    "ControllerRun",
+    [(name, np.ndarray) for name, _k, _d in OUTPUT_FIELDS],
+    frozen=True,
+    namespace={"__module__": __name__},
+)
+ControllerRun.__doc__ = """Per-sample outputs of :meth:`GraspController.run`; arrays of shape (N,), except
     ``dynamic_sample`` (N, 2). ``mode``, ``pivot_end`` and ``status`` hold the integer codes of
     ControllerMode, PivotEnd and Status. Fields as in :class:`ControllerOutput`."""
-
-    force: np.ndarray
-    static_force: np.ndarray
-    dynamic_force: np.ndarray
-    floor: np.ndarray
-    slippage: np.ndarray
-    error: np.ndarray
-    integrator: np.ndarray
-    gain_p: np.ndarray
-    gain_i: np.ndarray
-    feedforward_force: np.ndarray
-    peak_slippage: np.ndarray
-    reflex: np.ndarray
-    dynamic_sample: np.ndarray
-    dynamic_peak: np.ndarray
-    mean_c_tilde: np.ndarray
-    pivot_time: np.ndarray
-    mode: np.ndarray
-    pivot_end: np.ndarray
-    pivot_finished: np.ndarray
-    command_issued: np.ndarray
-    saturated: np.ndarray
-    rate_limited: np.ndarray
-    held: np.ndarray
-    status: np.ndarray
 
 
 def _per_finger(value, n: int | None, name: str, dtype) -> np.ndarray:
@@ -406,8 +353,10 @@ class GraspController:
         elif requests is not None:
             req[:] = np.asarray(requests, dtype=np.int32)
         r = self._ctrl.run(w, s, c, f, st, pres, req, res, tq)
-        dyn = np.stack([r.pop("dynamic_sample_0"), r.pop("dynamic_sample_1")], axis=1)
-        return ControllerRun(dynamic_sample=dyn, **r)
+        for name, kind, _doc in OUTPUT_FIELDS:
+            if kind == "pair":
+                r[name] = np.stack([r.pop(name + "_0"), r.pop(name + "_1")], axis=1)
+        return ControllerRun(**r)
 
     def __repr__(self) -> str:
         return f"GraspController({self._params!r}, mode={self.mode.name}, command={self.command!r})"

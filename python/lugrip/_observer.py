@@ -207,7 +207,10 @@ class Observer:
         torque_noise [N m], resolution_max [rad/s], omega_limit [rad/s], substeps,
         max_substeps) and of CorSettings (f_n_min [N], force_limit [N], torque_limit [N m],
         zero_force, zero_torque). None means "not given": the file's observer block, else
-        the C++ default.
+        the C++ default. The accepted ranges (the table of include/lugrip/observer.hpp) keep
+        every output finite and bound the work per sample, e.g. dt in [1e-9, 10] s,
+        max_substeps <= 5000, omega_limit <= 1e6 rad/s, f_n_min >= 1e-6 N, force_limit and
+        torque_limit <= 1e9.
 
     Raises:
         ValueError: naming every invalid setting (for a file's observer block: the file, the

@@ -5,6 +5,8 @@
 // the enum, the work counters inside their bounds; a twin observer fed only the samples the
 // first one accepted (with the skipped time added to the next dt) gives the same outputs; no
 // allocation inside step(). Consistency test of the implementation's guarantees (no plant).
+// Negative control: with a CoR failure integrated instead of rejected (the behaviour before
+// InvalidSample left the state alone) the default run reports over a hundred twin mismatches.
 //
 // LUGRIP_FUZZ_SAMPLES (default 400000) and LUGRIP_FUZZ_SEED (default 20261201) scale the run.
 #include <gtest/gtest.h>
@@ -203,6 +205,11 @@ TEST(NoAllocationObserverSettings, EdgeOfValiditySettingsKeepTheGuarantees) {
       else if (r < 0.12) in.f_n = f_lo * (1.0 - 1e-12);  // just below contact
       else if (r < 0.13) in.dt = s.dt * d.log_uniform(1e-6, 1e3);
       else if (r < 0.14) { in.f_n = s.cor.force_limit; in.f_t = s.cor.force_limit; in.tau = s.cor.torque_limit; }
+      else if (r < 0.15) {  // the whole sensor range at the smallest contact force: with a tiny
+        in.f_n = f_lo;      // mu or delta the CoR's normalisation overflows (rejected, not input)
+        in.f_t = s.cor.force_limit;
+        in.tau = (d.uniform() < 0.5 ? -1.0 : 1.0) * s.cor.torque_limit;
+      }
       const double dt_used = in.dt == 0.0 ? s.dt : in.dt;
       const bool dt_ok = std::isfinite(dt_used) && dt_used > 0.0;
       const Status st = a.step(in, oa);

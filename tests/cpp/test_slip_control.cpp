@@ -12,6 +12,8 @@
 #include <limits>
 #include <stdexcept>
 #include <string>
+#include <type_traits>
+#include <utility>
 
 #include "lugrip/closed_loop.hpp"
 #include "lugrip/slip_control.hpp"
@@ -296,4 +298,32 @@ TEST(SlipControl, ClosedLoopOnThePatchPlantMatchesTheHandWiredLoop) {
     ASSERT_EQ(s.theta, theta) << "sample " << n;
   }
   EXPECT_EQ(s.mode, static_cast<int>(ControllerMode::Pivoting));
+}
+
+TEST(StepShape, EveryComponentReturnsItsStatus) {
+  // One shape, Status step(const In&, Out&) noexcept, for the core and the plant.
+  static_assert(std::is_same_v<decltype(std::declval<GraspController&>().step(
+                                   std::declval<const GraspControllerInput&>(), std::declval<GraspControllerOutput&>())),
+                               Status>);
+  static_assert(noexcept(std::declval<SlipControl&>().step(std::declval<const SlipControlInput&>(),
+                                                           std::declval<SlipControlOutput&>())));
+  static_assert(noexcept(std::declval<GraspPlant&>().step(std::declval<const PlantInput&>(),
+                                                          std::declval<PlantOutput&>())));
+  ClosedLoopConfig c;
+  c.plant.contact = can();
+  c.plant.object.mass = 0.05;
+  c.plant.object.inertia = 1e-4;
+  GraspPlant a(c.plant), b(c.plant);
+  PlantOutput out;
+  for (int n = 0; n < 200; ++n) {
+    const double command = 1.0 + 0.01 * n;
+    EXPECT_EQ(a.step(PlantInput{command}, out), Status::Ok);
+    b.set_command(command);
+    b.advance_sample();
+    ASSERT_EQ(out.state.f_n, b.state().f_n);
+    ASSERT_EQ(out.fingers[1].tau, b.sensor_sample(1).tau);
+  }
+  const double held = a.state().f_cmd;
+  EXPECT_EQ(a.step(PlantInput{}, out), Status::InvalidSample);  // NaN: the last command kept
+  EXPECT_EQ(out.state.f_cmd, held);
 }

@@ -82,7 +82,8 @@ def test_simulate_sliding_writes_a_log_and_refuses_to_overwrite(tmp_path, capsys
 def test_observe_replays_csv_parquet_and_mcap(tmp_path, capsys, data, suffix):
     """The same log as CSV, Parquet or MCAP (written by write_log) gives the estimates of the
     in-process observer, with the columns t, omega_hat, z_hat, c_tilde, S, status,
-    speed_observable, maneuver, and the RMSE printed equals the library's score."""
+    speed_observable, maneuver, c_tilde_unclipped, omega_object, v_slip, and the RMSE printed
+    equals the library's score."""
     if suffix == ".parquet":
         pytest.importorskip("pyarrow")
     if suffix == ".mcap":
@@ -101,6 +102,9 @@ def test_observe_replays_csv_parquet_and_mcap(tmp_path, capsys, data, suffix):
         "status",
         "speed_observable",
         "maneuver",
+        "c_tilde_unclipped",
+        "omega_object",
+        "v_slip",
     ]
     n = len(data.log)
     assert len(cols["t"]) == n
@@ -111,6 +115,8 @@ def test_observe_replays_csv_parquet_and_mcap(tmp_path, capsys, data, suffix):
         np.array(cols["omega_hat"], float), ref.omega_hat, rtol=1e-9, atol=1e-12
     )
     np.testing.assert_allclose(np.array(cols["S"], float), ref.S, rtol=1e-9, atol=1e-12)
+    for name in ("c_tilde_unclipped", "omega_object", "v_slip"):
+        np.testing.assert_allclose(np.array(cols[name], float), getattr(ref, name), rtol=1e-9, atol=1e-12)
     assert set(cols["status"]) <= {s.name.lower() for s in lugrip.Status}
     assert cols["status"][0] == "reinitialized"
     np.testing.assert_array_equal(np.array(cols["maneuver"], int), data.log.maneuver)

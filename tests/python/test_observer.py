@@ -518,9 +518,20 @@ def test_settings_validation_and_modes():
         ({"max_dt_gap": 0.001}, "max_dt_gap"),
         ({"f_n_min": -1.0}, "cor.f_n_min"),
         ({"max_substeps": 0}, "max_substeps"),
+        # the ranges that keep outputs finite and bound the work per sample
+        ({"substeps": 10**8, "max_substeps": 10**8}, "max_substeps"),
+        ({"dt": 1e-12}, "dt"),
+        ({"omega_limit": 1e300}, "omega_limit"),
+        ({"gain_max": 1e300}, "gain_max"),
+        ({"f_n_min": 1e-300}, "cor.f_n_min"),
+        ({"force_limit": 1e300}, "cor.force_limit"),
+        ({"torque_noise": 1e4}, "torque_noise"),
     ]:
         with pytest.raises(ValueError, match=field):
             Observer(TABLE1, **kwargs)
+    # the edges themselves are accepted
+    Observer(TABLE1, substeps=5000, max_substeps=5000, dt=1e-9, omega_limit=1e6, f_n_min=1e-6,
+             force_limit=1e9, torque_limit=1e9)
     with pytest.raises(ValueError, match="integrator"):
         Observer(TABLE1, integrator="euler")
     with pytest.raises(ValueError, match="must be an integer"):
@@ -529,6 +540,8 @@ def test_settings_validation_and_modes():
         Observer(TABLE1, bogus=1.0)
     with pytest.raises(ValueError, match="sigma0"):
         Observer({**TABLE1.to_dict(), "sigma0": -1.0})
+    with pytest.raises(ValueError, match="sigma0"):  # z_hat = g / sigma0 would overflow
+        Observer({**TABLE1.to_dict(), "sigma0": 5e-324})
 
 
 # ---------------------------------------------------------------------------------------------

@@ -40,7 +40,7 @@ def valid_rule(name: str, v: float) -> bool:
     if name in ("beta_a", "sigma_z"):
         return math.isfinite(v) and v >= 0
     if name == "sigma0":
-        return math.isfinite(v) and v > 0
+        return math.isfinite(v) and v >= 1e-12
     if name == "delta":
         return math.isfinite(v) and 0 < v < 1
     if name == "gamma":

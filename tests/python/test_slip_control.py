@@ -301,3 +301,12 @@ def test_patch_plant_driven_through_slip_control_equals_the_simulator(name):
         plant.advance_sample()
     np.testing.assert_array_equal(command, ref["command"])
     assert not ref["dropped"][-1]
+
+
+def test_robot_loop_example_holds_through_the_contact_loss():
+    import runpy
+    from pathlib import Path
+
+    path = Path(__file__).resolve().parents[2] / "examples" / "04_robot_loop.py"
+    module = runpy.run_path(str(path), run_name="example_04")
+    assert module["main"]() >= 0.0

@@ -27,11 +27,16 @@ OUTPUT_COLUMNS = (
     "status",
     "speed_observable",
     "maneuver",
+    "c_tilde_unclipped",
+    "omega_object",
+    "v_slip",
 )
 """Columns of the estimate file: t [s], omega_hat [rad/s], z_hat [rad], c_tilde [-], S [-],
 status (ok, saturated, degenerate, no_contact, invalid_sample, sensor_fault, reinitialized),
 speed_observable (1 when the slip speed is resolvable through viscous friction, else 0),
-maneuver (the log's id)."""
+maneuver (the log's id), c_tilde_unclipped [-] (the CoR before the clip at c_max),
+omega_object [rad/s] (the slip about that unclipped CoR; omega_hat is about the clipped one and
+is what the grasp controller uses), v_slip [m/s] (slip speed of the patch centre)."""
 
 _EPILOG = """\
 examples:
@@ -199,7 +204,29 @@ def _columns(log, run) -> dict:
         "status": [names.get(int(v), str(int(v))) for v in run.status],
         "speed_observable": np.asarray(run.speed_observable, dtype=np.int64),
         "maneuver": np.asarray(log.maneuver, dtype=np.int64),
+        "c_tilde_unclipped": run.c_tilde_unclipped,
+        "omega_object": run.omega_object,
+        "v_slip": run.v_slip,
     }
+
+
+def _beyond_clip_line(log, run) -> str | None:
+    """One line comparing omega_hat and omega_object with the ground truth where the CoR was
+    clipped (None when no valid sample was)."""
+    import numpy as np
+
+    omega = np.asarray(log.omega, dtype=float)
+    m = run.valid & run.saturated & np.isfinite(omega)
+    if not m.any():
+        return None
+
+    def rmse(x):
+        return float(np.sqrt(np.mean((x[m] - omega[m]) ** 2)))
+
+    return (
+        f"CoR clipped at c_max on {int(m.sum())} samples: RMSE omega_hat {rmse(run.omega_hat):.4g}, "
+        f"omega_object {rmse(run.omega_object):.4g}, predicting zero {rmse(np.zeros_like(omega)):.4g} rad/s"
+    )
 
 
 def write_estimates(path: Path, log, run, *, force: bool = False) -> Path:
@@ -334,6 +361,9 @@ def run(args) -> int:
     if log.omega is not None:
         sc = score(log, est, omega_threshold=args.omega_threshold, s_threshold=args.s_threshold)
         for line in sc.lines():
+            print("  " + line)
+        line = _beyond_clip_line(log, est)
+        if line:
             print("  " + line)
     else:
         print("  no ground-truth omega in the log: RMSE not computed")

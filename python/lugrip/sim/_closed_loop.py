@@ -51,9 +51,10 @@ MODE_ACTIONS = {
 class ClosedLoopRun(_Columns):
     """Arrays of a closed-loop run, one row per sensor sample (500 Hz), readable as attributes.
 
-    Columns (SI units; per-finger columns end in ``_0`` / ``_1``):
+    Columns (the C++ ClosedLoopSample, ``lugrip._core.ClosedLoopSample.fields``; SI units;
+    per-finger columns end in ``_0`` / ``_1``):
 
-    * time and command: ``t`` [s], ``command`` (force sent to the gripper, held between
+    * time and command: ``index`` (sample number), ``t`` [s], ``command`` (force sent to the gripper, held between
       commands) [N], ``static_force`` / ``dynamic_force`` (f_ns, f_nd of the last command; for the
       baselines static_force = command, dynamic_force = 0) [N], ``f_n`` (true normal force of each
       finger) [N], ``mode`` (ControllerMode code), ``command_issued``, ``pivot_finished``,
