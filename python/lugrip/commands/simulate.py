@@ -34,12 +34,15 @@ DIR/mujoco_metrics.json). Without OpenGL the frames and the video are skipped wi
 def register(subparsers) -> None:
     p = subparsers.add_parser(
         "simulate",
-        help="closed-loop simulation of the paper's experiments (Figures 11, 13, 15, 17)",
+        help=(
+            "closed-loop simulation of the paper's experiments (Figures 11, 13, 15, 17) and "
+            "unseen objects, on the patch, lumped or MuJoCo plant"
+        ),
         description=(
             "Simulate scenarios in closed loop (plant -> fingertip sensors -> observers -> "
             "grasp-force controller, 500 Hz / 50 Hz), with the constant-force and friction-cone "
-            "baselines; write the paper's figures, a Markdown report (experiments.md) and "
-            "metrics.json with a pass flag per criterion."
+            "baselines; write the paper's figures, a Markdown report (experiments.md; MuJoCo: "
+            "mujoco.md) and the metrics JSON with a pass flag per criterion."
         ),
         epilog=_EPILOG,
         formatter_class=argparse.RawDescriptionHelpFormatter,

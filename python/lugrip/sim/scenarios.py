@@ -50,11 +50,13 @@ from ._plant import PlantConfig
 
 __all__ = [
     "CRITERIA",
+    "PLANT_MODELS",
     "Scenario",
     "ScenarioResult",
     "compute_metrics",
     "constant_force_search",
     "evaluate_cross",
+    "expand_disturbances",
     "find_scenario",
     "list_scenarios",
     "load_scenario",
@@ -62,8 +64,6 @@ __all__ = [
     "run_scenario",
     "scenario_dir",
     "simulate",
-    "expand_disturbances",
-    "PLANT_MODELS",
 ]
 
 #: Controller settings every scenario states: the gripper's force range [N] and rate limits [N/s].
@@ -85,7 +85,10 @@ CRITERIA = {
     "steady_slippage": "mean S in the steady window inside [lo, hi]",
     "steady_force_range": "steady grasp force inside [lo, hi] [N] (the paper's range)",
     "static_force_tolerance": "|steady / static_grasp_force - 1| <= limit",
-    "pivot_final_hang_deg": "after pivoting the CoG hangs below the grasp point within limit [deg]",
+    "pivot_final_hang_deg": (
+        "after pivoting the CoG hangs below the grasp point within limit [deg] (at the end, or "
+        "before a wrist roll tilts the held object)"
+    ),
     "pivot_returns_to_avoidance": "pivoting ends on |c~| > threshold and avoidance resumes",
     "force_ratio": "steady force / steady force of `reference` >= min",
     "constant_force_exceeds_steady": "the constant-force baseline needs more than lugrip's steady force",
@@ -335,9 +338,13 @@ class Scenario:
 
     @property
     def lift_end(self) -> float:
-        """End of the last gripper move [s] (0 without moves)."""
+        """End of the lift, the first gripper move [s] (0 without moves); later moves (a wrist
+        move after the pushes) belong to the hold."""
         cfg = self.plant_config()
-        return max((m.t_start + m.duration for m in cfg.moves), default=0.0)
+        if not cfg.moves:
+            return 0.0
+        first = min(cfg.moves, key=lambda m: m.t_start)
+        return first.t_start + first.duration
 
     @property
     def lift_start(self) -> float:
@@ -478,13 +485,25 @@ def compute_metrics(
         reason = int(run["pivot_end"][fin[0]]) if fin.size else 0
         phases = [(hold, p0)] + ([(p1, end)] if math.isfinite(p1) else [])
         axis = _axis_deg(run, cfg)
+        # the hang the pivot left: at the end, or before a later wrist roll (MuJoCo plant) tilts
+        # the held object with the hand
+        i_hang = len(t) - 1
+        if "roll" in run:
+            rolls = [
+                float(w["t_start"])
+                for w in scenario.mujoco.get("wrist") or []
+                if float(w.get("roll_deg", 0.0)) != 0.0
+            ]
+            if rolls:
+                i_hang = max(run.index(min(rolls)) - 1, 0)
         m.update(
             pivot_start=p0,
             pivot_end=p1 if math.isfinite(p1) else None,
             pivot_duration=(p1 - p0) if math.isfinite(p1) else None,
             pivot_end_reason={0: "none", 1: "cor_threshold", 2: "timeout", 3: "requested"}[reason],
             pivot_rotation_deg=float(np.degrees(run["theta"][-1] - run["theta"][run.index(p0)])),
-            final_hang_deg=float(abs(run.hang_deg[-1])),
+            final_hang_deg=float(abs(run.hang_deg[i_hang])),
+            final_hang_time=float(t[i_hang]),
             final_axis_deg=float(abs(axis[-1])),
             initial_axis_deg=float(abs(axis[run.index(p0)])),
             final_mode="slipping_avoidance" if int(run["mode"][-1]) == 0 else "pivoting",

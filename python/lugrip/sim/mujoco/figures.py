@@ -59,12 +59,21 @@ def figure_mujoco(
     ax = axes[0]
     ax.plot(t, run["f_n"], color="tab:blue", lw=1.2, label="MuJoCo: grip force")
     ax.plot(t, run["command"], color="k", lw=0.7, ls="--", label="MuJoCo: command")
-    if "constant_force" in result.metrics and result.metrics["constant_force"].get("constant_force"):
-        ax.axhline(result.metrics["constant_force"]["constant_force"], color="tab:green", lw=0.8,
-                   ls=":", label="smallest constant force that holds (MuJoCo)")
+    if "constant_force" in result.metrics and result.metrics["constant_force"].get(
+        "constant_force"
+    ):
+        ax.axhline(
+            result.metrics["constant_force"]["constant_force"],
+            color="tab:green",
+            lw=0.8,
+            ls=":",
+            label="smallest constant force that holds (MuJoCo)",
+        )
     if patch is not None:
         pr = patch.runs["lugrip"]
-        ax.plot(pr["t"], pr["f_n"], color="tab:orange", lw=1.0, ls="--", label="patch plant: grip force")
+        ax.plot(
+            pr["t"], pr["f_n"], color="tab:orange", lw=1.0, ls="--", label="patch plant: grip force"
+        )
     ax.set_ylabel("force [N]")
     tw = ax.twinx()
     tw.plot(t, 1e3 * np.abs(run["tau_meas_0"]), color="tab:pink", lw=0.7)
@@ -73,31 +82,61 @@ def figure_mujoco(
     ax.legend(loc="upper left", fontsize=7)
     ax = axes[1]
     i0 = run.index(s.lift_start)
-    ax.plot(t, 1e3 * np.hypot(run["slip_x"] - run["slip_x"][i0], run["slip_y"] - run["slip_y"][i0]),
-            color="tab:blue", label="MuJoCo: slip [mm]")
-    ax.plot(t, np.degrees(run["rotation"] - run["rotation"][i0]), color="tab:red",
-            label="MuJoCo: rotation [deg]")
+    ax.plot(
+        t,
+        1e3 * np.hypot(run["slip_x"] - run["slip_x"][i0], run["slip_y"] - run["slip_y"][i0]),
+        color="tab:blue",
+        label="MuJoCo: slip [mm]",
+    )
+    ax.plot(
+        t,
+        np.degrees(run["rotation"] - run["rotation"][i0]),
+        color="tab:red",
+        label="MuJoCo: rotation [deg]",
+    )
     if patch is not None:
         pr = patch.runs["lugrip"]
         j0 = pr.index(s.lift_start)
-        ax.plot(pr["t"], 1e3 * np.hypot(pr["slip_x"] - pr["slip_x"][j0], pr["slip_y"] - pr["slip_y"][j0]),
-                color="tab:blue", ls="--", lw=0.8, label="patch: slip [mm]")
-        ax.plot(pr["t"], np.degrees(pr["rotation"] - pr["rotation"][j0]), color="tab:red", ls="--",
-                lw=0.8, label="patch: rotation [deg]")
+        ax.plot(
+            pr["t"],
+            1e3 * np.hypot(pr["slip_x"] - pr["slip_x"][j0], pr["slip_y"] - pr["slip_y"][j0]),
+            color="tab:blue",
+            ls="--",
+            lw=0.8,
+            label="patch: slip [mm]",
+        )
+        ax.plot(
+            pr["t"],
+            np.degrees(pr["rotation"] - pr["rotation"][j0]),
+            color="tab:red",
+            ls="--",
+            lw=0.8,
+            label="patch: rotation [deg]",
+        )
     ax.axhline(1.0, color="k", lw=0.5, ls=":")
     ax.axhline(-1.0, color="k", lw=0.5, ls=":")
     ax.set_ylabel("from the lift start")
     ax.legend(loc="upper left", fontsize=7, ncol=2)
     ax = axes[2]
-    ax.plot(t, run["omega_true_0"], color="0.4", lw=1.0, label=r"MuJoCo: true slip rate $\omega$ (pad 0)")
-    ax.plot(t, run["omega_hat_0"], color="tab:blue", lw=0.8, label=r"$\hat\omega$ (observer, pad 0)")
+    ax.plot(
+        t,
+        run["omega_true_0"],
+        color="0.4",
+        lw=1.0,
+        label=r"MuJoCo: true slip rate $\omega$ (pad 0)",
+    )
+    ax.plot(
+        t, run["omega_hat_0"], color="tab:blue", lw=0.8, label=r"$\hat\omega$ (observer, pad 0)"
+    )
     ax.set_ylabel("[rad/s]")
     ax.set_xlabel("time $t$ [s]")
     ax.legend(loc="upper left", fontsize=7)
     for a in axes:
         a.axvspan(s.lift_start, s.lift_end, color="0.92", zorder=0)
         for dist in s.plant_config().disturbances:
-            a.axvspan(dist.t_start, dist.t_start + dist.duration, color="tab:orange", alpha=0.15, zorder=0)
+            a.axvspan(
+                dist.t_start, dist.t_start + dist.duration, color="tab:orange", alpha=0.15, zorder=0
+            )
         a.grid(alpha=0.3)
     scene = run.scene if hasattr(run, "scene") else {"status": "ok"}
     verdict = "pass" if result.passed else "FAIL"

@@ -26,8 +26,8 @@ from typing import Any
 import mujoco
 import numpy as np
 
-from ..._params import ContactParams
 from ..._contact import LimitSurface
+from ..._params import ContactParams
 from .pad import Pad, PadSpec, pad_body_xml, pair_xml
 
 __all__ = [
@@ -125,10 +125,12 @@ class SceneSpec:
             self.geom_center = _vec(self.geom_center, 2, "mujoco.geom_center")
         self.object_offset = _vec(self.object_offset, 3, "mujoco.object_offset")
         if not isinstance(self.pad, Mapping):
-            raise ValueError("mujoco.pad: expected a mapping of pad settings")
+            raise ValueError("mujoco.pad: expected a mapping of pad settings")  # noqa: TRY004 (file content)
         self.pad = dict(self.pad)
-        bad = sorted(set(self.pad) - {f.name for f in dataclasses.fields(PadSpec)} | (
-            set(self.pad) & {"name", "mu", "delta", "gamma", "xi"}))
+        bad = sorted(
+            set(self.pad) - {f.name for f in dataclasses.fields(PadSpec)}
+            | (set(self.pad) & {"name", "mu", "delta", "gamma", "xi"})
+        )
         if bad:
             raise ValueError(
                 f"mujoco.pad: unknown or fixed key(s) {', '.join(bad)} (mu and the contact "
@@ -162,7 +164,7 @@ def _build(cls, data, where: str):
     if isinstance(data, cls):
         return data
     if not isinstance(data, Mapping):
-        raise ValueError(f"{where}: expected a mapping, got {type(data).__name__}")
+        raise ValueError(f"{where}: expected a mapping, got {type(data).__name__}")  # noqa: TRY004
     names = {f.name for f in dataclasses.fields(cls)}
     unknown = sorted(set(data) - names)
     if unknown:
@@ -330,7 +332,7 @@ def build_scene(
       <inertial pos="0 0 0" mass="2.0" diaginertia="1e-2 1e-2 1e-2"/>
       <geom type="box" pos="0 0 0.06" size="{x_face + 2 * r + 0.02} 0.015 0.01" contype="0"
             conaffinity="0" rgba="0.3 0.3 0.35 1"/>
-      {''.join(pads)}
+      {"".join(pads)}
     </body>
   </worldbody>
   <contact>{pairs}</contact>
@@ -346,6 +348,8 @@ def build_scene(
     m = mujoco.MjModel.from_xml_string(xml)
     # the pad springs' damping, implicit (see PAD_DEFAULTS)
     for k in (0, 1):
-        for j, value in zip(pads_spec[k].joint_names, (spec.pad_damping[0],) * 2 + (spec.pad_damping[1],)):
+        for j, value in zip(
+            pads_spec[k].joint_names, (spec.pad_damping[0],) * 2 + (spec.pad_damping[1],)
+        ):
             m.dof_damping[m.joint(j).dofadr[0]] = value
     return m, [_ScenePad(m, ps) for ps in pads_spec]

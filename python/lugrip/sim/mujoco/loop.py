@@ -1,7 +1,7 @@
 """Closed loop on the MuJoCo gripper: MuJoCo at 1 kHz -> fingertip wrench sensors at 500 Hz
-(averaged over the sample, bias, noise) -> two lugrip observers -> lugrip.GraspController or a
-baseline -> a force command every 20 ms, held, through the gripper's first-order lag and rate
-limit to the finger motors.
+(averaged over the sample, bias, noise) -> lugrip.SlipControl (each finger's observer and the
+grasp-force controller behind one step) or a baseline -> a force command every 20 ms, held,
+through the gripper's first-order lag and rate limit to the finger motors.
 
 :func:`run_mujoco_loop` returns a :class:`~lugrip.sim.ClosedLoopRun` with the columns of the
 patch and lumped plants' runs (so one set of metrics serves every plant) plus MuJoCo's own:
@@ -24,9 +24,8 @@ from typing import Any
 import mujoco
 import numpy as np
 
-from ..._controller import GraspController, PivotEnd
-from ..._observer import Observer
 from ..._params import ContactParams
+from ..._slip_control import SlipControl
 from .._closed_loop import ClosedLoopRun, _schedule, estimator_params
 from .._plant import Disturbance, PlantConfig
 from .gripper import SceneSpec, build_scene, spin_coefficient
@@ -181,19 +180,27 @@ def run_mujoco_loop(
     ctrl_s = {"sensor_rate": 1.0 / T_s, "command_ratio": round(fs / plant.actuator.command_rate)}
     ctrl_s.update(dict(controller_settings or {}))
     n_cmd = int(ctrl_s["command_ratio"])
-    ctrl = GraspController(est, **ctrl_s)
-    limits = ctrl.settings
     obs_kw = {"torque_noise": float(plant.sensor.torque_noise), "dt": T_s}
     obs_kw.update(dict(observer_settings or {}))
-    observers = [Observer(est, **obs_kw) for _ in range(2)]
+    # the baselines command by their own law; SlipControl's observers still run for the log
+    ctrl = SlipControl(est, fingers=2, observer=obs_kw, **ctrl_s)
+    limits = {
+        k: getattr(ctrl.settings.controller, k)
+        for k in ("f_min", "f_max", "max_rate_up", "max_rate_down")
+    }
     events = sorted(_schedule(mode_schedule), key=lambda e: e[0]) if kind == "lugrip" else []
     rng = np.random.default_rng(plant.seed)
     bias = np.asarray(plant.sensor.bias, dtype=float)  # per finger f_n, f_x, f_y, tau
     noise = np.array([plant.sensor.force_noise] * 3 + [plant.sensor.torque_noise])
 
-    body = {n: mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_BODY, n) for n in ("object", "pad0", "pad1")}
+    body = {
+        n: mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_BODY, n) for n in ("object", "pad0", "pad1")
+    }
     obj_geom = mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_GEOM, "object")
-    q = {j: int(m.joint(j).qposadr[0]) for j in ("oy", "oz", "otheta", "hy", "hz", "hroll", "f0", "f1")}
+    q = {
+        j: int(m.joint(j).qposadr[0])
+        for j in ("oy", "oz", "otheta", "hy", "hz", "hroll", "f0", "f1")
+    }
     for k in (0, 1):
         jx, jy, jt = pads[k].spec.joint_names
         q[f"p{k}x"], q[f"p{k}y"], q[f"p{k}t"] = (int(m.joint(j).qposadr[0]) for j in (jx, jy, jt))
@@ -218,18 +225,33 @@ def run_mujoco_loop(
         cols[name] = np.zeros(n_samples, dtype=dtype)
         return cols[name]
 
-    names_f = (
-        "t command static_force dynamic_force f_n slip_x slip_y slip rotation theta cog_x cog_y "
-        "gripper_y ext_fx ext_fy ext_tau roll"
-    ).split()
+    names_f = ["t", "command", "static_force", "dynamic_force", "f_n", "slip_x", "slip_y", "slip", "rotation", "theta", "cog_x", "cog_y", "gripper_y", "ext_fx", "ext_fy", "ext_tau", "roll"]
     for name in names_f:
         col(name)
-    for name in ("mode", "command_issued", "pivot_finished", "pivot_end", "supported", "dropped", "finite"):
+    for name in (
+        "mode",
+        "command_issued",
+        "pivot_finished",
+        "pivot_end",
+        "supported",
+        "dropped",
+        "finite",
+    ):
         col(name, np.int64)
     for k in (0, 1):
         for name in (
-            "f_n_meas", "f_t_meas", "tau_meas", "f_t_true", "tau_true", "omega_hat", "S",
-            "c_tilde", "omega_true", "v_slip", "pad_deflection", "pad_twist",
+            "f_n_meas",
+            "f_t_meas",
+            "tau_meas",
+            "f_t_true",
+            "tau_true",
+            "omega_hat",
+            "S",
+            "c_tilde",
+            "omega_true",
+            "v_slip",
+            "pad_deflection",
+            "pad_twist",
         ):
             col(f"{name}_{k}")
         col(f"observer_status_{k}", np.int64)
@@ -300,9 +322,8 @@ def run_mujoco_loop(
                 k = next(k for k in (0, 1) if at_stop[k] and not touched[k])
                 between = _object_between(m, d, (body["pad0"], body["pad1"]), obj_geom)
                 status = "closed_on_nothing" if between else "object_not_reached"
-                detail = (
-                    f"finger {k} closed to its stop without contact"
-                    + ("" if between else "; the object is not between the fingers")
+                detail = f"finger {k} closed to its stop without contact" + (
+                    "" if between else "; the object is not between the fingers"
                 )
                 status_time = ts
             elif not all(touched) and ts >= lift_start:
@@ -331,29 +352,27 @@ def run_mujoco_loop(
                 ctrl.set_dynamic_enabled(False)
             ev += 1
         ft_meas = np.hypot(meas[:, 1], meas[:, 2])
-        samples = [observers[k].step(meas[k, 0], ft_meas[k], meas[k, 3]) for k in (0, 1)]
+        if not started:
+            out = None
+        else:
+            out = ctrl.step(meas)
+        samples = out.fingers if out is not None else None
         tick = i % n_cmd == 0
         if not started and contact_time is not None and tick:
             started, ctrl_start = True, ts
-            if kind == "lugrip":
-                ctrl.reset(current_force=command)
-            elif kind == "friction_cone":
+            ctrl.reset(force=command)  # bumpless from the closing force
+            if kind == "friction_cone":
                 command = limits["f_min"]
+            out = ctrl.step(meas)
+            samples = out.fingers
         issued = pf = 0
         pend = 0
         if started:
             if kind == "lugrip":
-                out = ctrl.step(
-                    omega_hat=[o.omega_hat for o in samples],
-                    S=[o.S for o in samples],
-                    c_tilde=[o.c_tilde for o in samples],
-                    f_t=list(ft_meas),
-                    status=[int(o.status) for o in samples],
-                    omega_resolution=[o.omega_resolution for o in samples],
-                    tau=list(meas[:, 3]),
-                )
+                c = out.controller
                 command = out.force
-                issued, pf, pend = int(out.command_issued), int(out.pivot_finished), int(out.pivot_end)
+                issued, pf = int(c.command_issued), int(c.pivot_finished)
+                pend = int(getattr(c.pivot_end, "value", c.pivot_end))
             elif kind == "constant_force":
                 if tick:
                     command, issued = float(constant_force), 1
@@ -364,8 +383,14 @@ def run_mujoco_loop(
                 if tick:
                     mean = cone_sum / cone_n
                     command = _cone_command(
-                        command, mean[:, 0], mean[:, 1], est.mu, cone_margin,
-                        cone_release_rate, n_cmd * T_s, limits,
+                        command,
+                        mean[:, 0],
+                        mean[:, 1],
+                        est.mu,
+                        cone_margin,
+                        cone_release_rate,
+                        n_cmd * T_s,
+                        limits,
                     )
                     cone_sum[:] = 0.0
                     cone_n = 0
@@ -399,9 +424,11 @@ def run_mujoco_loop(
         cols["t"][i] = ts
         cols["command"][i] = command
         lug = kind == "lugrip" and started and out is not None
-        cols["static_force"][i] = out.static_force if lug else command
-        cols["dynamic_force"][i] = out.dynamic_force if lug else 0.0
-        cols["mode"][i] = int(out.mode) if lug else 0
+        cols["static_force"][i] = out.controller.static_force if lug else command
+        cols["dynamic_force"][i] = out.controller.dynamic_force if lug else 0.0
+        cols["mode"][i] = (
+            int(getattr(out.controller.mode, "value", out.controller.mode)) if lug else 0
+        )
         cols["command_issued"][i] = issued
         cols["pivot_finished"][i] = pf
         cols["pivot_end"][i] = pend
@@ -417,26 +444,36 @@ def run_mujoco_loop(
         cols["supported"][i] = int(not all(touched) or ts < lift_start)
         cols["dropped"][i] = int(dropped)
         for k in (0, 1):
-            o = samples[k]
+            o = samples[k] if samples is not None else None
             cols[f"f_n_meas_{k}"][i] = meas[k, 0]
             cols[f"f_t_meas_{k}"][i] = ft_meas[k]
             cols[f"tau_meas_{k}"][i] = meas[k, 3]
             cols[f"f_t_true_{k}"][i] = math.hypot(true[k, 1], true[k, 2])
             cols[f"tau_true_{k}"][i] = true[k, 3]
-            cols[f"omega_hat_{k}"][i] = o.omega_hat
-            cols[f"S_{k}"][i] = o.S
-            cols[f"c_tilde_{k}"][i] = o.c_tilde
-            cols[f"observer_status_{k}"][i] = int(o.status)
+            if o is not None:
+                cols[f"omega_hat_{k}"][i] = o.omega_hat
+                cols[f"S_{k}"][i] = o.S
+                cols[f"c_tilde_{k}"][i] = o.c_tilde
+                cols[f"observer_status_{k}"][i] = int(getattr(o.status, "value", o.status))
+            else:  # before the first touch: no contact, nothing observed
+                cols[f"observer_status_{k}"][i] = 3
             # the object's motion relative to pad k at the pad face: spin about the pad's z
             # (the sensor's torque axis) and the in-plane slip speed
             cols[f"omega_true_{k}"][i] = slip_v[k, 2] if in_contact[k] else 0.0
-            cols[f"v_slip_{k}"][i] = math.hypot(slip_v[k, 0], slip_v[k, 1]) if in_contact[k] else 0.0
+            cols[f"v_slip_{k}"][i] = (
+                math.hypot(slip_v[k, 0], slip_v[k, 1]) if in_contact[k] else 0.0
+            )
             cols[f"pad_deflection_{k}"][i] = math.hypot(d.qpos[q[f"p{k}x"]], d.qpos[q[f"p{k}y"]])
             cols[f"pad_twist_{k}"][i] = twist[k]
             cols[f"contact_{k}"][i] = int(in_contact[k])
-        row_ok = math.isfinite(command) and all(math.isfinite(cols[c][i]) for c in ("slip", "theta"))
+        row_ok = math.isfinite(command) and all(
+            math.isfinite(cols[c][i]) for c in ("slip", "theta")
+        )
         row_ok = row_ok and bool(np.all(np.isfinite(meas)))
-        row_ok = row_ok and all(math.isfinite(x.omega_hat) and math.isfinite(x.S) for x in samples)
+        if samples is not None:
+            row_ok = row_ok and all(
+                math.isfinite(samples[k].omega_hat) and math.isfinite(samples[k].S) for k in (0, 1)
+            )
         cols["finite"][i] = int(row_ok)
         if frame_callback is not None:
             frame_callback(m, d, ts)

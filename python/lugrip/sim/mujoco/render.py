@@ -21,6 +21,7 @@ from ..report import GL_PACKAGES, choose_gl_backend
 
 __all__ = ["FrameRecorder", "RenderUnavailable", "choose_gl_backend", "video_writer_available"]
 
+
 class RenderUnavailable(RuntimeError):
     """No OpenGL back end (or no video writer) is available; the message says what to install."""
 
@@ -75,7 +76,7 @@ class FrameRecorder:
         self.video_frames = 0
         if self.video is not None and not video_writer_available():
             raise RenderUnavailable(
-                "writing MP4 needs imageio-ffmpeg (pip install \"lugrip[video]\")"
+                'writing MP4 needs imageio-ffmpeg (pip install "lugrip[video]")'
             )
 
     def _render(self, m, d) -> np.ndarray:
@@ -84,20 +85,26 @@ class FrameRecorder:
         if self._renderer is None:
             try:
                 self._renderer = mujoco.Renderer(m, *self.size)
-            except Exception as err:  # noqa: BLE001 (any GL failure means: no rendering)
+            except Exception as err:
                 raise RenderUnavailable(_no_gl_message(err)) from err
         self._renderer.update_scene(d, camera=self.camera)
         return self._renderer.render().copy()
 
     def __call__(self, m, d, t: float) -> None:
-        snap = self._next_snap < len(self.snapshot_times) and t >= self.snapshot_times[self._next_snap] - 1e-9
+        snap = (
+            self._next_snap < len(self.snapshot_times)
+            and t >= self.snapshot_times[self._next_snap] - 1e-9
+        )
         vid = self.video is not None and t >= self._next_video - 1e-9
         if not (snap or vid):
             return
         img = self._render(m, d)
         if snap:
             self.frames.append((t, img))
-            while self._next_snap < len(self.snapshot_times) and t >= self.snapshot_times[self._next_snap] - 1e-9:
+            while (
+                self._next_snap < len(self.snapshot_times)
+                and t >= self.snapshot_times[self._next_snap] - 1e-9
+            ):
                 self._next_snap += 1
         if vid:
             if self._writer is None:
@@ -105,8 +112,11 @@ class FrameRecorder:
 
                 self.video.parent.mkdir(parents=True, exist_ok=True)
                 self._writer = imageio_ffmpeg.write_frames(
-                    str(self.video), (self.size[1], self.size[0]), fps=self.fps,
-                    macro_block_size=8, quality=6,
+                    str(self.video),
+                    (self.size[1], self.size[0]),
+                    fps=self.fps,
+                    macro_block_size=8,
+                    quality=6,
                 )
                 self._writer.send(None)
             self._writer.send(np.ascontiguousarray(img))
