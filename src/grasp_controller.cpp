@@ -102,6 +102,17 @@ bool validate(const GraspControllerSettings& s, std::string* message) {
   positive("pivot_end_c_tilde", s.pivot_end_c_tilde);
   if (!(s.pivot_end_samples >= 1)) bad("pivot_end_samples", s.pivot_end_samples, "must be >= 1");
   positive_or_inf("pivot_timeout", s.pivot_timeout);
+  positive("loop_gain_p", s.loop_gain_p);
+  positive("loop_gain_i", s.loop_gain_i);
+  if (s.slope_gain && s.gain_schedule_force > 0.0)
+    bad("gain_schedule_force", s.gain_schedule_force, "must be 0 when slope_gain is on (one gain law)");
+  if (!(s.feedforward_slippage > 0.0 && s.feedforward_slippage <= 1.0))
+    bad("feedforward_slippage", s.feedforward_slippage, "must satisfy 0 < feedforward_slippage <= 1");
+  if (!(s.reflex_slippage > 0.0 && s.reflex_slippage <= 1.0))
+    bad("reflex_slippage", s.reflex_slippage, "must satisfy 0 < reflex_slippage <= 1");
+  if (!(s.reflex_samples >= 1)) bad("reflex_samples", s.reflex_samples, "must be >= 1");
+  if (!(std::isfinite(s.reflex_factor) && s.reflex_factor > 1.0))
+    bad("reflex_factor", s.reflex_factor, "must be finite and > 1");
   if (message) *message = msg;
   return msg.empty();
 }
@@ -123,7 +134,11 @@ std::string to_string(const GraspControllerSettings& s) {
          ", pivot_floor_factor=" + num(s.pivot_floor_factor) +
          ", pivot_end_c_tilde=" + num(s.pivot_end_c_tilde) +
          ", pivot_end_samples=" + std::to_string(s.pivot_end_samples) +
-         ", pivot_timeout=" + num(s.pivot_timeout) + ")";
+         ", pivot_timeout=" + num(s.pivot_timeout) + ", slope_gain=" + flag(s.slope_gain) +
+         ", loop_gain_p=" + num(s.loop_gain_p) + ", loop_gain_i=" + num(s.loop_gain_i) +
+         ", feedforward=" + flag(s.feedforward) + ", feedforward_slippage=" + num(s.feedforward_slippage) +
+         ", slip_reflex=" + flag(s.slip_reflex) + ", reflex_slippage=" + num(s.reflex_slippage) +
+         ", reflex_samples=" + std::to_string(s.reflex_samples) + ", reflex_factor=" + num(s.reflex_factor) + ", average_slippage=" + flag(s.average_slippage) + ")";
 }
 
 const char* to_string(ControllerMode m) noexcept {
@@ -156,8 +171,11 @@ LagFilter::LagFilter(double k, double z, double p, double sample_time) noexcept 
 // --- controller ------------------------------------------------------------------------------
 
 GraspController::GraspController(const ContactParams& params, const GraspControllerSettings& settings)
-    : s_(checked(settings)) {
-  validate_or_throw(params);
+    : GraspController(ContactModel(params), settings) {}
+
+GraspController::GraspController(const ContactModel& model, const GraspControllerSettings& settings)
+    : s_(checked(settings)), solver_(model) {
+  const ContactParams& params = model.params();
   mu_ = params.mu;
   gamma_ = params.gamma;
   dt_ = 1.0 / s_.sensor_rate;
@@ -178,6 +196,13 @@ void GraspController::reset(double current_force) noexcept {
   pivot_samples_ = 0;
   pivot_count_ = 0;
   last_f_t_ = 0.0;
+  last_kp_ = last_e_ = 0.0;
+  sum_f_t_.fill(0.0);
+  sum_tau_.fill(0.0);
+  n_load_.fill(0);
+  peak_s_ = sum_s_ = 0.0;
+  n_s_ = run_s_ = 0;
+  reflex_armed_ = false;
   reset_dynamic();
   last_ = GraspControllerOutput();
   last_.force = command_;
@@ -218,8 +243,16 @@ void GraspController::set_settings(const GraspControllerSettings& settings) {
 void GraspController::set_mu(double mu) {
   ContactParams p = table1_params();
   p.mu = mu;
-  validate_or_throw(p);
-  mu_ = mu;
+  validate_or_throw(p);  // names a bad mu before the tables are rebuilt
+  p = solver_.model().params();
+  p.mu = mu;
+  set_contact_model(ContactModel(p));
+}
+
+void GraspController::set_contact_model(const ContactModel& model) {
+  solver_ = StaticForceSolver(model);
+  mu_ = model.params().mu;
+  gamma_ = model.params().gamma;
 }
 
 void GraspController::end_pivot(PivotEnd why, GraspControllerOutput& out) noexcept {
@@ -273,6 +306,11 @@ Status GraspController::step(const GraspControllerInput& in, GraspControllerOutp
     c_sum += std::fabs(f.c_tilde);
     f_t_max = std::max(f_t_max, std::fabs(f.f_t));
     ++n_valid;
+    if (std::isfinite(f.tau) && std::fabs(f.tau) <= kMaxInput) {  // load for the static floor
+      sum_f_t_[i] += std::fabs(f.f_t);
+      sum_tau_[i] += f.tau;
+      ++n_load_[i];
+    }
     if (dynamic) {
       double w = f.omega_hat;
       if (s_.omega_deadband > 0.0) {
@@ -290,7 +328,16 @@ Status GraspController::step(const GraspControllerInput& in, GraspControllerOutp
     valid = false;
     worst = Status::NoContact;
   }
-  if (valid) last_f_t_ = f_t_max;
+  if (valid) {
+    last_f_t_ = f_t_max;
+    peak_s_ = std::max(peak_s_, slip);
+    sum_s_ += slip;
+    ++n_s_;
+    run_s_ = slip >= s_.reflex_slippage ? run_s_ + 1 : 0;
+    if (run_s_ >= s_.reflex_samples) reflex_armed_ = true;
+  } else {
+    run_s_ = 0;
+  }
   out.status = valid ? Status::Ok : worst;
   out.mean_c_tilde = n_valid > 0 ? c_sum / n_valid : 0.0;
 
@@ -309,7 +356,8 @@ Status GraspController::step(const GraspControllerInput& in, GraspControllerOutp
   out.pivot_time = mode_ == ControllerMode::Pivoting ? static_cast<double>(pivot_samples_) * dt_ : 0.0;
 
   if (phase_ == 0) {
-    issue_command(valid, slip);
+    // The PI's S: this sample (paper) or the mean over the command period (anti-aliasing).
+    issue_command(valid, s_.average_slippage && n_s_ > 0 ? sum_s_ / n_s_ : slip);
     out.command_issued = true;
   }
   phase_ = phase_ + 1 >= s_.command_ratio ? 0 : phase_ + 1;
@@ -321,6 +369,11 @@ Status GraspController::step(const GraspControllerInput& in, GraspControllerOutp
   out.slippage = last_.slippage;
   out.error = last_.error;
   out.integrator = last_.integrator;
+  out.gain_p = last_.gain_p;
+  out.gain_i = last_.gain_i;
+  out.feedforward_force = last_.feedforward_force;
+  out.peak_slippage = last_.peak_slippage;
+  out.reflex = last_.reflex;
   out.saturated = last_.saturated;
   out.rate_limited = last_.rate_limited;
   out.held = last_.held;
@@ -338,10 +391,15 @@ void GraspController::issue_command(bool valid, double slip) noexcept {
   c.saturated = false;
   c.rate_limited = false;
 
+  c.reflex = false;
+  c.feedforward_force = 0.0;
+  c.peak_slippage = peak_s_;
+
   if (!valid) {  // safe command: hold (or raise), never below the floor; restart bumplessly
     command_ = clamp(std::max(command_ + s_.invalid_raise_step, floor), s_.f_min, s_.f_max);
     init_static_ = true;
     peak_ = 0.0;
+    clear_period();
     c.force = command_;
     c.held = true;
     return;
@@ -350,6 +408,16 @@ void GraspController::issue_command(bool valid, double slip) noexcept {
 
   double f_ns, f_nd = 0.0, e;
   if (mode_ == ControllerMode::SlippingAvoidance) {
+    // Floor of the static part: feed-forward of the measured load and the slip reflex.
+    double n_slope = 1.0;
+    double lift = static_floor(n_slope);
+    c.feedforward_force = lift;
+    if (s_.slip_reflex && reflex_armed_) {
+      // On the static part: a transient f_nd would otherwise be multiplied into f_ns.
+      lift = std::max(lift, s_.reflex_factor * std::min(last_.static_force, command_));
+      c.reflex = true;
+    }
+    clear_period();
     // PI on e = S - s_ref: e > 0 (closer to slip than wanted) raises the force (MODEL.md 9.4).
     e = slip - s_.s_ref;
     // Integrated error: with static_equivalent_slippage the slippage the static part alone would
@@ -360,19 +428,42 @@ void GraspController::issue_command(bool valid, double slip) noexcept {
     if (s_.static_equivalent_slippage && s_.dynamic_enabled && last_.dynamic_force > 0.0 &&
         last_.static_force > 0.0)
       e_i = slip * std::pow(1.0 + last_.dynamic_force / last_.static_force, 1.0 + gamma_) - s_.s_ref;
-    const double scale = s_.gain_schedule_force > 0.0 ? command_ / s_.gain_schedule_force : 1.0;
-    const double k_p = s_.k_p * scale, k_i = s_.k_i * scale;
+    double k_p, k_i;
+    if (s_.slope_gain) {  // loop gain k |dS/df_n| independent of the force (docs/controller.md)
+      // Force at the operating point: the static part when the PI regulates its own slippage.
+      const double f_op = s_.static_equivalent_slippage && s_.dynamic_enabled && last_.static_force > 0.0
+                              ? std::min(last_.static_force, command_)
+                              : command_;
+      const double s_f = n_slope * s_.s_ref / f_op;
+      k_p = s_.loop_gain_p / s_f;
+      k_i = s_.loop_gain_i / s_f;
+    } else {
+      const double scale = s_.gain_schedule_force > 0.0 ? command_ / s_.gain_schedule_force : 1.0;
+      k_p = s_.k_p * scale;
+      k_i = s_.k_i * scale;
+    }
     if (init_static_) {  // bumpless (re)start from the last command
       integrator_ = command_ - k_p * e;
       init_static_ = false;
+    } else if (s_.slope_gain) {
+      integrator_ += (last_kp_ - k_p) * last_e_;  // gain change without a jump of f_ns
     }
     const double u = k_p * e + integrator_;
-    f_ns = clamp(u, s_.f_min, s_.f_max);
+    const double lo = clamp(lift, s_.f_min, s_.f_max);
+    f_ns = clamp(u, lo, s_.f_max);
     if (f_ns != u) {
-      c.saturated = true;
-      if (s_.anti_windup) integrator_ = f_ns - k_p * e;  // back-calculation, static part only
+      if (u < lo && lo > s_.f_min) {
+        integrator_ = f_ns - k_p * e;  // the floor lifted the PI: restart it there
+      } else {
+        c.saturated = true;
+        if (s_.anti_windup) integrator_ = f_ns - k_p * e;  // back-calculation, static part only
+      }
     }
     integrator_ += k_i * t_cmd_ * e_i;  // forward Euler
+    last_kp_ = k_p;
+    last_e_ = e;
+    c.gain_p = k_p;
+    c.gain_i = k_i;
     if (s_.dynamic_enabled) {
       const double head_room = s_.f_max - f_ns;
       f_nd = clamp(peak_, 0.0, head_room);
@@ -381,6 +472,8 @@ void GraspController::issue_command(bool valid, double slip) noexcept {
   } else {
     // tau_p df/dt = -f + k_f (S - s_pivot), exact discretisation at the command rate; output is
     // the state before the update, so the first pivoting command equals the last command.
+    clear_period();
+    c.gain_p = c.gain_i = 0.0;
     e = slip - s_.s_pivot;
     if (init_static_) {
       pivot_state_ = command_;
@@ -405,6 +498,39 @@ void GraspController::issue_command(bool valid, double slip) noexcept {
   c.slippage = slip;
   c.error = e;
   c.integrator = integrator_;
+}
+
+void GraspController::clear_period() noexcept {
+  sum_f_t_.fill(0.0);
+  sum_tau_.fill(0.0);
+  n_load_.fill(0);
+  peak_s_ = sum_s_ = 0.0;
+  n_s_ = 0;
+  reflex_armed_ = false;
+}
+
+double GraspController::static_floor(double& slope_exponent) noexcept {
+  // Per finger: the mean load of the last command period; the feed-forward force is the larger
+  // static grasp force, the slope exponent that of the finger nearest to slip at the command.
+  constexpr double kStep = 1.1;  // relative force step of the slope's finite difference
+  double force = 0.0, s_max = -1.0;
+  slope_exponent = 1.0;
+  for (int i = 0; i < kMaxFingers; ++i) {
+    if (n_load_[i] == 0) continue;
+    const double ft = sum_f_t_[i] / n_load_[i], tau = sum_tau_[i] / n_load_[i];
+    if (s_.feedforward) {
+      const double f = solver_.solve(ft, tau, s_.feedforward_slippage).force;
+      if (std::isfinite(f)) force = std::max(force, f);
+    }
+    if (s_.slope_gain) {
+      const double s0 = solver_.slippage(command_, ft, tau), s1 = solver_.slippage(kStep * command_, ft, tau);
+      if (std::isfinite(s0) && std::isfinite(s1) && s0 > 0.0 && s1 > 0.0 && s0 > s_max) {
+        s_max = s0;
+        slope_exponent = clamp(std::log(s0 / s1) / std::log(kStep), 1.0, 1.0 + gamma_);
+      }
+    }
+  }
+  return force;
 }
 
 // --- static grasp force ----------------------------------------------------------------------

@@ -51,7 +51,7 @@ SlipControl::SlipControl(const ContactParams& params, const SlipControlSettings&
 SlipControl::SlipControl(const ContactModel& model, const SlipControlSettings& settings)
     : s_(checked(settings)),
       obs_{Observer(model, s_.observer), Observer(model, s_.observer)},
-      ctrl_(model.params(), s_.controller) {
+      ctrl_(model, s_.controller) {
   for (int i = 0; i < kMaxFingers; ++i) cin_.fingers[i].present = i < s_.fingers;
 }
 
@@ -68,6 +68,7 @@ Status SlipControl::observe(const SlipControlInput& in, SlipControlOutput& out) 
     f.slippage = o.S;
     f.c_tilde = o.c_tilde;
     f.f_t = oin.f_t;
+    f.tau = oin.tau;
     f.status = o.status;
     if (!is_valid(o.status) && (worst == Status::Ok || static_cast<int>(o.status) > static_cast<int>(worst)))
       worst = o.status;
@@ -93,7 +94,7 @@ void SlipControl::set_mu(double mu) {
   p.mu = mu;
   validate_or_throw(p);
   const ContactModel model(p);
-  ctrl_.set_mu(mu);
+  ctrl_.set_contact_model(model);
   for (auto& o : obs_) o = Observer(model, s_.observer);
 }
 

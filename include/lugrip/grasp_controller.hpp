@@ -33,26 +33,78 @@ struct GraspControllerSettings {
   double k_p = 4.0;    //!< (*) [N] proportional gain (e > 0 raises the force), > 0
   double k_i = 10.0;   //!< (*) [N/s] integral gain, > 0
   bool anti_windup = true;  //!< (*) back-calculation I = f_ns,clipped - k_p e when clipped
-  //! (*) [N] gain scheduling, not in the paper; 0 = off (paper). When > 0, k_p and k_i are scaled
-  //! by (last command / gain_schedule_force), which keeps the loop gain k_p |dS/df_n| (S ~ 1/f_n)
-  //! the same at every force. Without it the 50 Hz loop on a quasi-static S(f_n) is unstable
-  //! when (k_p - k_i T) |dS/df_n| > 1, i.e. below ~3 N for a translational load (S = 0.8 f*/f_n),
-  //! and limit-cycles there (tests: ControllerClosedLoop.*). >= 0, finite.
+  //! (*) [N] the older gain scheduling, not in the paper; 0 = off. When > 0 (needs slope_gain
+  //! off), k_p and k_i are scaled by (last command / gain_schedule_force), which also keeps the
+  //! loop gain k_p |dS/df_n| (S ~ 1/f_n) the same at every force, at a level set by the chosen
+  //! force instead of the loop gain itself (slope_gain). With constant gains the 50 Hz loop on a
+  //! quasi-static S(f_n) is unstable when (k_p - k_i T) |dS/df_n| > 1, i.e. below ~3 N for a
+  //! translational load (S = 0.8 f*/f_n), and limit-cycles there (tests: ControllerClosedLoop.*,
+  //! ControllerSlopeGain.*). >= 0, finite.
   double gain_schedule_force = 0.0;
-  //! (*) not in the paper (default true; false = paper). When true the PI integrates the
+  //! (*) not in the paper (default false = paper; superseded by feedforward, which holds f_ns
+  //! at the measured load's static force from the wrench itself). When true the PI integrates the
   //! slippage the static part alone would give, S_s = S ((f_ns + f_nd) / f_ns)^(1 + gamma) (g
   //! grows as f_n^(1 + gamma) at a fixed CoR; f_ns, f_nd of the last command), instead of S; the
   //! proportional term keeps S. While f_nd holds the object after a slip, S is low because of
   //! f_nd, and the paper's PI unwinds f_ns, so the object slips again when f_nd has decayed (a
   //! slip / force-spike cycle on heavy rotational loads); with S_s, f_ns keeps rising to the
-  //! force the load needs. Identical to the paper when f_nd = 0.
-  bool static_equivalent_slippage = true;
+  //! force the load needs. Identical to the paper when f_nd = 0. It uses the commanded forces,
+  //! which the gripper's force lags after a slip: f_ns overshoots (+2 % mean force on the paper's
+  //! scenarios with feedforward on).
+  bool static_equivalent_slippage = false;
   //! (*) not in the paper (default 1; 0 = off = paper). Dead band of the dynamic part in multiples of each
   //! finger's FingerInput::omega_resolution: C_d sees sign(w) max(0, |w| - band) with
   //! band = omega_deadband * omega_resolution. The slip speed enters the wrench only through
   //! viscous friction, so below the resolution omega_hat is sensor noise seen through 1/sigma_1;
   //! rectified by |C_d .| it would add a noise-driven force. >= 0, finite.
   double omega_deadband = 1.0;
+
+  // --- loop gain from the plant's slope (not in the paper) ------------------------------------
+  //! (*) default true; false = the paper's constant k_p, k_i. The loop gain of the PI on S is
+  //! k_p |dS/df_n|, and |dS/df_n| = n S / f_n (S ~ f_n^-n: n = 1 for a translational load,
+  //! 1 + gamma for a torsional one), so constant gains give a loop gain ~ 1/f_n that limit-cycles
+  //! at low force. With slope_gain the gains follow the slope at the operating point,
+  //! k_p = loop_gain_p / s_f, k_i = loop_gain_i / s_f, s_f = n s_ref / f (f: last command; n:
+  //! -d ln S_static / d ln f_n of the contact model for the load measured over the last command
+  //! period, clamped to [1, 1 + gamma]); the gains change bumplessly (velocity form). Cannot be
+  //! combined with gain_schedule_force > 0.
+  bool slope_gain = true;
+  double loop_gain_p = 0.5;  //!< (*) [-] k_p |dS/df_n| with slope_gain, finite, > 0
+  double loop_gain_i = 2.0;  //!< (*) [1/s] k_i |dS/df_n| with slope_gain, finite, > 0
+
+  //! (*) default true; false = paper (S of the sample at the command). The PI's S is the mean of
+  //! max_i S_i over the valid samples of the command period: S is sampled at the sensor rate and
+  //! its noise would otherwise alias into the 50 Hz command (sqrt(command_ratio) less noise).
+  bool average_slippage = true;
+
+  // --- feed-forward from the measured wrench (not in the paper) -------------------------------
+  //! (*) default true; false = paper. At each command the static part is raised to at least the
+  //! static grasp force (StaticForceSolver) of the load measured over the last command period
+  //! (mean f_t and tau of each valid finger; the larger of the two forces) at
+  //! S = feedforward_slippage; the integrator then restarts from that force (bumpless). The load
+  //! arriving at lift-off is met at the next command instead of after the PI has integrated.
+  //! Not applied while pivoting.
+  bool feedforward = true;
+  //! (*) [-] S the feed-forward force is computed for, in (0, 1]: above s_ref, so in steady hold
+  //! the force stays the PI's (the feed-forward, noisier, only acts when the load jumps).
+  double feedforward_slippage = 0.9;
+
+  // --- slip reflex (not in the paper) ---------------------------------------------------------
+  //! (*) default true; false = paper. When S = max_i S_i stays at or above reflex_slippage on
+  //! reflex_samples consecutive valid samples (the dry capacity is used up: the contact slides or
+  //! is about to), the next command raises the static part to at least reflex_factor x the static
+  //! part of the last command and restarts the integrator there. It acts whether or not the slip speed is observable (with
+  //! Coulomb-like contacts omega_hat carries no speed and C_d adds nothing). Not applied while
+  //! pivoting.
+  bool slip_reflex = true;
+  //! (*) [-] threshold on the peak of S, in (0, 1]. A translational slip with the CoR at the
+  //! c_max = 1.5 clip reads S = 0.95 at f_t = mu f_n, hence a threshold below 0.95.
+  double reflex_slippage = 0.93;
+  //! (*) consecutive samples at or above the threshold, >= 1 (a run of S at the projection
+  //! bound S = 1 while sliding, not a single noisy sample); <= command_ratio keeps the reaction
+  //! within one command period.
+  int reflex_samples = 3;
+  double reflex_factor = 1.25;  //!< (*) [-] raise of the static part per period of detected slip, > 1
 
   // --- force range and rate limits (MODEL.md 9.5) --------------------------------------------
   double f_min = 0.1;   //!< [N] minimum force (keeps contact), > 0
@@ -109,6 +161,7 @@ struct FingerInput {
   //! speed resolution of omega_hat [rad/s] (ObserverOutput::omega_resolution), >= 0; used by
   //! the dead band (GraspControllerSettings::omega_deadband); 0: none
   double omega_resolution = 0.0;
+  double tau = 0.0;  //!< measured torsional moment [N m] (signed; feed-forward and slope)
 };
 
 //! Input of one step(): the two fingertips at one sensor sample.
@@ -126,6 +179,11 @@ struct GraspControllerOutput {
   double slippage = 0.0;       //!< combined S = max_i S_i used at the last command [-]
   double error = 0.0;          //!< S - S-bar (S-bar_a or S-bar_p) at the last command [-]
   double integrator = 0.0;     //!< PI integrator I after the last command [N]
+  double gain_p = 0.0;         //!< k_p used at the last command [N]
+  double gain_i = 0.0;         //!< k_i used at the last command [N/s]
+  double feedforward_force = 0.0;  //!< feed-forward force at the last command [N] (0: none)
+  double peak_slippage = 0.0;  //!< peak of max_i S_i over the period before the last command [-]
+  bool reflex = false;         //!< last command: the slip reflex raised the static part
   //! signed C_d omega_hat_i of each finger at this sample [N] (0 for absent fingers)
   std::array<double, kMaxFingers> dynamic_sample{};
   double dynamic_peak = 0.0;   //!< peak of max_i |C_d omega_hat_i| since the last command [N]
@@ -168,86 +226,6 @@ class LagFilter {
   double b0_ = 0.0, b1_ = 0.0, a1_ = 0.0, u_ = 0.0, y_ = 0.0;
 };
 
-//! Two-mode grasp-force controller f_n = f_ns + f_nd (eq. 34, MODEL.md 9).
-//!
-//! * step() runs at the sensor rate. Every call updates one C_d filter per present finger
-//!   (Tustin at the sensor rate) and the peak of max_i |C_d omega_hat_i|; every command_ratio-th
-//!   call (the first call after construction/reset included) computes a new command, which is
-//!   held in between (zero-order hold).
-//! * Slipping avoidance: f_ns = k_p e + I, e = S - s_ref, forward-Euler integrator at the command
-//!   rate; f_ns clipped to [f_min, f_max] with back-calculation anti-windup; f_nd = the peak of
-//!   |C_d omega_hat| over the last command period clipped to [0, f_max - f_ns].
-//! * Pivoting: f_nd = 0; tau_p df/dt = -f + k_f (S - s_pivot), exact discretisation at the
-//!   command rate, started from the last command; floor max(f_min, factor max_i |f_t,i| / mu)
-//!   on the output and the filter state; ends on mean |c~_i| > pivot_end_c_tilde for
-//!   pivot_end_samples consecutive sensor samples, on timeout or on request, then returns to
-//!   slipping avoidance bumplessly (I = last command - k_p e at the next command, C_d reset).
-//! * Two fingers (MODEL.md 9.8): S = max_i S_i, f_nd from max_i |C_d omega_hat_i|, pivot end on
-//!   the mean of |c~_i|; absent fingers are ignored.
-//! * Rate limits act on the total command after the force range; the floor wins over them.
-//! * Invalid input (a present finger with NaN/Inf/out-of-range values or status InvalidSample,
-//!   SensorFault, NoContact): its C_d state is held; a command due in such a call holds the last
-//!   command (plus invalid_raise_step), never lower, and the static law restarts bumplessly.
-class GraspController {
- public:
-  //! Validates params (uses mu) and settings; throws std::invalid_argument naming bad fields.
-  GraspController(const ContactParams& params, const GraspControllerSettings& settings = {});
-
-  //! One sensor sample. Never throws, never allocates; out.force is finite, in [f_min, f_max].
-  //! Returns out.status.
-  Status step(const GraspControllerInput& in, GraspControllerOutput& out) noexcept;
-
-  //! Back to slipping avoidance with zeroed filters; current_force [N] (clipped to the range,
-  //! f_min if not finite) is the command held until the next step(), which issues a command
-  //! and starts the PI bumplessly from it.
-  void reset(double current_force) noexcept;
-  void reset() noexcept { reset(s_.f_min); }
-
-  //! Latched requests, applied at the next step(). Pivoting starts from the last command.
-  void request_pivoting() noexcept;
-  void request_slipping_avoidance() noexcept;
-
-  //! Enables/disables the dynamic part; re-enabling resets the C_d states.
-  void set_dynamic_enabled(bool enabled) noexcept;
-  //! Replaces the settings marked (*) (rates, C_d and force range must not change); throws
-  //! std::invalid_argument when invalid or when a fixed field differs.
-  void set_settings(const GraspControllerSettings& settings);
-  //! Replaces the friction coefficient used by the pivoting floor; throws std::invalid_argument
-  //! unless 0 < mu <= 10 (ContactParams::mu).
-  void set_mu(double mu);
-
-  ControllerMode mode() const noexcept { return mode_; }
-  double command() const noexcept { return command_; }
-  double command_period() const noexcept { return t_cmd_; }  //!< [s]
-  const GraspControllerSettings& settings() const noexcept { return s_; }
-  const LagFilter& dynamic_filter(int finger) const noexcept { return cd_[finger]; }
-  double mu() const noexcept { return mu_; }
-
- private:
-  enum class Request { None, Pivot, Avoid };
-  void end_pivot(PivotEnd why, GraspControllerOutput& out) noexcept;
-  void reset_dynamic() noexcept;
-  void issue_command(bool valid, double slip) noexcept;
-
-  GraspControllerSettings s_;
-  double mu_ = 1.0;
-  double gamma_ = 0.25;
-  double dt_ = 0.002, t_cmd_ = 0.02, pivot_decay_ = 0.0;
-  std::array<LagFilter, kMaxFingers> cd_{};
-  ControllerMode mode_ = ControllerMode::SlippingAvoidance;
-  Request request_ = Request::None;
-  bool init_static_ = true;   // bumpless (re)start of the static law at the next command
-  int phase_ = 0;             // calls since the last command
-  double command_ = 0.0;      // last command [N]
-  double integrator_ = 0.0;   // PI integrator I [N]
-  double pivot_state_ = 0.0;  // pivoting filter state [N]
-  double peak_ = 0.0;         // running peak of max_i |C_d omega_i| [N]
-  long pivot_samples_ = 0;    // samples since pivoting started
-  int pivot_count_ = 0;       // consecutive samples with mean |c~| above the threshold
-  double last_f_t_ = 0.0;     // last valid max_i |f_t,i| [N] (pivot floor)
-  GraspControllerOutput last_{};  // command fields of the last command
-};
-
 //! Static utilization and static grasp force for a constant load (MODEL.md 6, 9.4).
 //!
 //! S_static(f_n) = |tau - c f_t| / g(f_n, c) = (|tau| + |c| f_t) / g(f_n, c), with c~ from the
@@ -280,6 +258,110 @@ class StaticForceSolver {
 
  private:
   CorEstimator est_;
+};
+
+//! Two-mode grasp-force controller f_n = f_ns + f_nd (eq. 34, MODEL.md 9).
+//!
+//! * step() runs at the sensor rate. Every call updates one C_d filter per present finger
+//!   (Tustin at the sensor rate) and the peak of max_i |C_d omega_hat_i|; every command_ratio-th
+//!   call (the first call after construction/reset included) computes a new command, which is
+//!   held in between (zero-order hold).
+//! * Slipping avoidance: f_ns = k_p e + I, e = S - s_ref, forward-Euler integrator at the command
+//!   rate; f_ns clipped to [f_min, f_max] with back-calculation anti-windup; f_nd = the peak of
+//!   |C_d omega_hat| over the last command period clipped to [0, f_max - f_ns].
+//! * Pivoting: f_nd = 0; tau_p df/dt = -f + k_f (S - s_pivot), exact discretisation at the
+//!   command rate, started from the last command; floor max(f_min, factor max_i |f_t,i| / mu)
+//!   on the output and the filter state; ends on mean |c~_i| > pivot_end_c_tilde for
+//!   pivot_end_samples consecutive sensor samples, on timeout or on request, then returns to
+//!   slipping avoidance bumplessly (I = last command - k_p e at the next command, C_d reset).
+//! * Two fingers (MODEL.md 9.8): S = max_i S_i, f_nd from max_i |C_d omega_hat_i|, pivot end on
+//!   the mean of |c~_i|; absent fingers are ignored.
+//! * Rate limits act on the total command after the force range; the floor wins over them.
+//! * Invalid input (a present finger with NaN/Inf/out-of-range values or status InvalidSample,
+//!   SensorFault, NoContact): its C_d state is held; a command due in such a call holds the last
+//!   command (plus invalid_raise_step), never lower, and the static law restarts bumplessly.
+//! * Beyond the paper (each a setting, docs/controller.md): PI gains from the plant's slope
+//!   (slope_gain), a floor on the static part from the static grasp force of the measured load
+//!   (feedforward) and from reflex_factor x the last command after S reached reflex_slippage
+//!   (slip_reflex). Both floors act in slipping avoidance only, on the static part, before the
+//!   force range and the rate limits.
+class GraspController {
+ public:
+  //! Validates params (uses mu; the feed-forward and the slope use the whole contact model) and
+  //! settings; throws std::invalid_argument naming bad fields. Builds the contact tables (a few
+  //! tens of ms); the ContactModel overload copies them.
+  GraspController(const ContactParams& params, const GraspControllerSettings& settings = {});
+  GraspController(const ContactModel& model, const GraspControllerSettings& settings = {});
+
+  //! One sensor sample. Never throws, never allocates; out.force is finite, in [f_min, f_max].
+  //! Returns out.status.
+  Status step(const GraspControllerInput& in, GraspControllerOutput& out) noexcept;
+
+  //! Back to slipping avoidance with zeroed filters; current_force [N] (clipped to the range,
+  //! f_min if not finite) is the command held until the next step(), which issues a command
+  //! and starts the PI bumplessly from it.
+  void reset(double current_force) noexcept;
+  void reset() noexcept { reset(s_.f_min); }
+
+  //! Latched requests, applied at the next step(). Pivoting starts from the last command.
+  void request_pivoting() noexcept;
+  void request_slipping_avoidance() noexcept;
+
+  //! Enables/disables the dynamic part; re-enabling resets the C_d states.
+  void set_dynamic_enabled(bool enabled) noexcept;
+  //! Replaces the settings marked (*) (rates, C_d and force range must not change); throws
+  //! std::invalid_argument when invalid or when a fixed field differs.
+  void set_settings(const GraspControllerSettings& settings);
+  //! Replaces the friction coefficient used by the pivoting floor and the static grasp force
+  //! (rebuilds the contact tables: allocates, not real-time); throws std::invalid_argument
+  //! unless 0 < mu <= 10 (ContactParams::mu).
+  void set_mu(double mu);
+  //! Replaces the contact model (mu, feed-forward, slope) by a copy of `model`'s (allocates).
+  void set_contact_model(const ContactModel& model);
+
+  ControllerMode mode() const noexcept { return mode_; }
+  double command() const noexcept { return command_; }
+  double command_period() const noexcept { return t_cmd_; }  //!< [s]
+  const GraspControllerSettings& settings() const noexcept { return s_; }
+  const LagFilter& dynamic_filter(int finger) const noexcept { return cd_[finger]; }
+  double mu() const noexcept { return mu_; }
+  const ContactModel& contact_model() const noexcept { return solver_.model(); }
+
+ private:
+  enum class Request { None, Pivot, Avoid };
+  void end_pivot(PivotEnd why, GraspControllerOutput& out) noexcept;
+  void reset_dynamic() noexcept;
+  void issue_command(bool valid, double slip) noexcept;
+  double static_floor(double& slope_exponent) noexcept;
+  void clear_period() noexcept;
+
+  GraspControllerSettings s_;
+  StaticForceSolver solver_;  // feed-forward force and slope exponent
+  double mu_ = 1.0;
+  double gamma_ = 0.25;
+  double dt_ = 0.002, t_cmd_ = 0.02, pivot_decay_ = 0.0;
+  std::array<LagFilter, kMaxFingers> cd_{};
+  ControllerMode mode_ = ControllerMode::SlippingAvoidance;
+  Request request_ = Request::None;
+  bool init_static_ = true;   // bumpless (re)start of the static law at the next command
+  int phase_ = 0;             // calls since the last command
+  double command_ = 0.0;      // last command [N]
+  double integrator_ = 0.0;   // PI integrator I [N]
+  double pivot_state_ = 0.0;  // pivoting filter state [N]
+  double peak_ = 0.0;         // running peak of max_i |C_d omega_i| [N]
+  long pivot_samples_ = 0;    // samples since pivoting started
+  int pivot_count_ = 0;       // consecutive samples with mean |c~| above the threshold
+  double last_f_t_ = 0.0;     // last valid max_i |f_t,i| [N] (pivot floor)
+  double last_kp_ = 0.0;      // k_p of the last command [N] (bumpless gain change)
+  double last_e_ = 0.0;       // proportional error of the last command [-]
+  std::array<double, kMaxFingers> sum_f_t_{}, sum_tau_{};  // valid samples since the last command
+  std::array<int, kMaxFingers> n_load_{};
+  double peak_s_ = 0.0;       // peak of max_i S_i since the last command
+  double sum_s_ = 0.0;        // sum of max_i S_i over the valid samples since the last command
+  int n_s_ = 0;
+  int run_s_ = 0;              // consecutive valid samples with S >= reflex_slippage
+  bool reflex_armed_ = false;  // such a run reached reflex_samples since the last command
+  GraspControllerOutput last_{};  // command fields of the last command
 };
 
 //! Convenience: per-finger static grasp force [N] (builds a ContactModel; prefer

@@ -37,6 +37,7 @@ from ._observer import (
 )
 from ._params import PRESETS, ContactParams, read_observer_settings
 from ._controller import (
+    PAPER_SETTINGS,
     ControllerMode,
     GraspController,
     PivotEnd,
@@ -75,6 +76,7 @@ __all__ = [
     "ControllerMode",
     "PivotEnd",
     "controller_settings",
+    "PAPER_SETTINGS",
     "static_grasp_force",
     "static_slippage",
     "SlipControl",

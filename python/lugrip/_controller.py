@@ -17,6 +17,7 @@ from ._contact import Status, _as_params, _flat, _model, _shaped
 from ._params import ContactParams
 
 __all__ = [
+    "PAPER_SETTINGS",
     "REQUEST_NONE",
     "REQUEST_PIVOTING",
     "REQUEST_SLIPPING_AVOIDANCE",
@@ -37,6 +38,19 @@ REQUEST_NONE, REQUEST_PIVOTING, REQUEST_SLIPPING_AVOIDANCE = 0, 1, 2
 _SETTINGS_FIELDS = tuple(name for name, _kind, _doc in _core.GraspControllerSettings.fields)
 _INT_FIELDS = tuple(name for name, kind, _doc in _core.GraspControllerSettings.fields if kind == "int")
 _BOOL_FIELDS = tuple(name for name, kind, _doc in _core.GraspControllerSettings.fields if kind == "bool")
+
+
+#: The settings that turn off every addition to the paper's law (eqs. 34-37): constant PI gains,
+#: no feed-forward, no slip reflex, the PI on S itself, no dead band on C_d. Pass them to compare
+#: with lugrip's defaults: ``GraspController(params, **PAPER_SETTINGS)``.
+PAPER_SETTINGS: dict[str, Any] = {
+    "slope_gain": False,
+    "feedforward": False,
+    "slip_reflex": False,
+    "average_slippage": False,
+    "static_equivalent_slippage": False,
+    "omega_deadband": 0.0,
+}
 
 
 class ControllerMode(enum.IntEnum):
@@ -158,12 +172,18 @@ class GraspController:
       finger): the command is held (plus ``invalid_raise_step``), never lowered.
 
     Args:
-        params: ContactParams, a preset name or a dict (mu is used for the pivoting floor).
+        params: ContactParams, a preset name or a dict (mu for the pivoting floor; the whole
+            contact model for the feed-forward and the slope).
         **settings: any GraspControllerSettings field (see :func:`controller_settings` for the
             names and defaults): rates (sensor_rate [Hz], command_ratio), C_d (k_cd [N s/rad],
             p_cd, z_cd [rad/s], dynamic_enabled), PI (s_ref, k_p [N], k_i [N/s], anti_windup,
             gain_schedule_force [N], 0 = off; static_equivalent_slippage: regulate the S of the
             static part alone; omega_deadband: dead band of C_d in omega resolutions, 0 = off),
+            slope_gain, loop_gain_p [-], loop_gain_i [1/s]: PI gains from the plant's slope
+            dS/df_n; feedforward, feedforward_slippage: static part floored at the static grasp
+            force of the measured load; slip_reflex, reflex_slippage, reflex_factor: raise the
+            command when the peak of S reaches the threshold (see
+            :data:`PAPER_SETTINGS` for the paper's law),
             range (f_min, f_max [N]), rate
             limits (max_rate_up, max_rate_down [N/s], inf = off), invalid_raise_step [N], pivoting
             (s_pivot, tau_pivot [s], k_f [N], pivot_floor_factor, pivot_end_c_tilde,
@@ -184,7 +204,7 @@ class GraspController:
         self._params = _as_params(params)
         core = _core_settings(settings)
         try:
-            self._ctrl = _core.GraspController(self._params.to_core(), core)
+            self._ctrl = _core.GraspController(_model(self._params), core)
         except ValueError as err:
             raise ValueError(str(err)) from None
 
@@ -248,7 +268,7 @@ class GraspController:
 
     # --- stepping --------------------------------------------------------------------------
     def step(self, omega_hat, S, c_tilde=0.0, f_t=0.0, status=Status.OK,
-             present=None, omega_resolution=0.0) -> ControllerOutput:
+             present=None, omega_resolution=0.0, tau=0.0) -> ControllerOutput:
         """One sensor sample. Scalars describe finger 0 alone (finger 1 absent unless `present`
         says otherwise, then it gets the same values); length-2 sequences describe both fingers.
 
@@ -258,9 +278,11 @@ class GraspController:
             present: per-finger bools (default: the fingers given).
             omega_resolution: the observer's speed resolution [rad/s] (``omega_resolution`` of
                 its output), used by the dead band of the dynamic part (``omega_deadband``).
+            tau: measured torsional moment [N m] (signed), with f_t the load of the
+                feed-forward and of the slope (``feedforward``, ``slope_gain``).
         """
         vals = [np.atleast_1d(np.asarray(v, dtype=np.float64))
-                for v in (omega_hat, S, c_tilde, f_t, omega_resolution)]
+                for v in (omega_hat, S, c_tilde, f_t, omega_resolution, tau)]
         st = np.atleast_1d(np.asarray(status, dtype=np.int64))
         n_fingers = max(len(v) for v in vals + [st])
         if n_fingers > 2 or any(len(v) not in (1, n_fingers) for v in vals + [st]):
@@ -272,13 +294,13 @@ class GraspController:
         else:
             p = np.broadcast_to(np.asarray(present, dtype=bool), (2,))
             pres = (bool(p[0]), bool(p[1]))
-        w, s, c, f, r = (tuple(float(x) for x in v) for v in vals)
+        w, s, c, f, r, tq = (tuple(float(x) for x in v) for v in vals)
         o = self._ctrl.step(w[0], s[0], c[0], f[0], int(st[0]), pres[0],
-                            w[1], s[1], c[1], f[1], int(st[1]), pres[1], r[0], r[1])
+                            w[1], s[1], c[1], f[1], int(st[1]), pres[1], r[0], r[1], tq[0], tq[1])
         return ControllerOutput._from_core(o)
 
     def run(self, omega_hat, S, c_tilde=0.0, f_t=0.0, status=None, present=None,
-            requests=None, omega_resolution=0.0) -> ControllerRun:
+            requests=None, omega_resolution=0.0, tau=0.0) -> ControllerRun:
         """Step over N sensor samples in one C++ loop (state carried over between calls).
 
         Args:
@@ -292,11 +314,12 @@ class GraspController:
                 "slipping_avoidance"}.
             omega_resolution: the observers' speed resolution [rad/s], like omega_hat (used by
                 the dead band ``omega_deadband``; default 0: no dead band).
+            tau: measured torsional moment [N m], like f_t (feed-forward and slope load).
 
         Returns:
             ControllerRun with (N,) arrays.
         """
-        arrays = [np.asarray(v) for v in (omega_hat, S, c_tilde, f_t, omega_resolution)]
+        arrays = [np.asarray(v) for v in (omega_hat, S, c_tilde, f_t, omega_resolution, tau)]
         extra = [np.asarray(v) for v in (status,) if v is not None]
         shaped = [a for a in arrays + extra if a.ndim >= 1]
         if not shaped:
@@ -308,9 +331,11 @@ class GraspController:
             raise ValueError("all per-sample inputs must have the same number of samples")
         n = lengths.pop()
         two = any(a.ndim == 2 and a.shape[1] == 2 for a in shaped)
-        w, s, c, f, res = (
+        w, s, c, f, res, tq = (
             _per_finger(a, n, name, np.float64)
-            for a, name in zip(arrays, ("omega_hat", "S", "c_tilde", "f_t", "omega_resolution"))
+            for a, name in zip(
+                arrays, ("omega_hat", "S", "c_tilde", "f_t", "omega_resolution", "tau")
+            )
         )
         st = _per_finger(Status.OK if status is None else status, n, "status", np.int32)
         if present is None:
@@ -327,7 +352,7 @@ class GraspController:
                 req[int(index)] = codes[what]
         elif requests is not None:
             req[:] = np.asarray(requests, dtype=np.int32)
-        r = self._ctrl.run(w, s, c, f, st, pres, req, res)
+        r = self._ctrl.run(w, s, c, f, st, pres, req, res, tq)
         for name, kind, _doc in OUTPUT_FIELDS:
             if kind == "pair":
                 r[name] = np.stack([r.pop(name + "_0"), r.pop(name + "_1")], axis=1)

@@ -185,7 +185,12 @@ TEST(ClosedLoop, SteadyForceMatchesTheStaticGraspForce) {
 }
 
 TEST(ClosedLoop, ForceDecaysToTheFloorBeforeTheLiftAndRisesAtLiftOff) {
-  ClosedLoop loop(lift_config());
+  // The paper's PI (constant gains) drains the unloaded command at k_i S_ref = 8 N/s; lugrip's
+  // default slope gain drains it exponentially (below).
+  ClosedLoopConfig c = lift_config();
+  c.controller.slope_gain = c.controller.feedforward = c.controller.slip_reflex = false;
+  c.controller.average_slippage = false;
+  ClosedLoop loop(c);
   const auto log = run(loop, 3.0);
   // At the floor f_min = 0.1 N: no load on the table. The mean sits a little above it: at 0.1 N
   // g is tiny, S carries sensor noise of +-0.05..0.1 and k_p = 4 N turns a noise sample into a
@@ -196,6 +201,16 @@ TEST(ClosedLoop, ForceDecaysToTheFloorBeforeTheLiftAndRisesAtLiftOff) {
   for (const auto& s : log)
     if (s.t > 0.5) peak_dyn = std::max(peak_dyn, s.dynamic_force);
   EXPECT_GT(peak_dyn, 0.5) << "the dynamic part reacts to the lift-off";
+  EXPECT_GT(mean_command(log, 2.5, 3.0), 0.5 * 0.5 * kG / 0.85) << "above the translational slip force";
+}
+
+TEST(ClosedLoop, DefaultControllerDrainsTheUnloadedCommandExponentiallyAndHoldsAfterTheLift) {
+  ClosedLoop loop(lift_config());
+  const auto log = run(loop, 3.0);
+  const double f0 = mean_command(log, 0.0, 0.02);
+  const double rate = GraspControllerSettings().loop_gain_i;  // [1/s]
+  // f(t) = f0 exp(-loop_gain_i t) while S ~ 0 (within the S noise and the 20 ms steps)
+  EXPECT_NEAR(mean_command(log, 0.4, 0.5), f0 * std::exp(-rate * 0.45), 0.15 * f0 * std::exp(-rate * 0.45));
   EXPECT_GT(mean_command(log, 2.5, 3.0), 0.5 * 0.5 * kG / 0.85) << "above the translational slip force";
 }
 

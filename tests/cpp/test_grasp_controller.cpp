@@ -22,6 +22,16 @@ constexpr double kPi = 3.14159265358979323846;
 
 ContactParams can() { return object_params("aluminium_can"); }
 
+// The paper's static law (constant gains, the sample's S, no feed-forward, no reflex); the
+// omega_deadband default is kept (tested on its own).
+GraspControllerSettings paper_law(GraspControllerSettings s = {}) {
+  s.slope_gain = false;
+  s.feedforward = false;
+  s.slip_reflex = false;
+  s.average_slippage = false;
+  return s;
+}
+
 // One present finger with the given observer values.
 GraspControllerInput one(double S, double omega = 0.0, double c_tilde = 0.5, double f_t = 0.5,
                          Status st = Status::Ok) {
@@ -98,6 +108,13 @@ TEST(ControllerSettings, EachBadFieldIsNamed) {
       {"pivot_end_c_tilde", [](GraspControllerSettings& s) { s.pivot_end_c_tilde = 0.0; }},
       {"pivot_end_samples", [](GraspControllerSettings& s) { s.pivot_end_samples = 0; }},
       {"pivot_timeout", [](GraspControllerSettings& s) { s.pivot_timeout = -1.0; }},
+      {"loop_gain_p", [](GraspControllerSettings& s) { s.loop_gain_p = 0.0; }},
+      {"loop_gain_i", [](GraspControllerSettings& s) { s.loop_gain_i = kInf; }},
+      {"gain_schedule_force", [](GraspControllerSettings& s) { s.gain_schedule_force = 3.0; }},  // with slope_gain
+      {"feedforward_slippage", [](GraspControllerSettings& s) { s.feedforward_slippage = 1.2; }},
+      {"reflex_slippage", [](GraspControllerSettings& s) { s.reflex_slippage = 0.0; }},
+      {"reflex_samples", [](GraspControllerSettings& s) { s.reflex_samples = 0; }},
+      {"reflex_factor", [](GraspControllerSettings& s) { s.reflex_factor = 1.0; }},
   };
   for (const Case& c : cases) {
     GraspControllerSettings s;
@@ -121,7 +138,7 @@ TEST(ControllerSettings, EachBadFieldIsNamed) {
 }
 
 TEST(ControllerSettings, RunTimeChangesKeepFixedFields) {
-  GraspController c(can());
+  GraspController c(can(), paper_law());
   GraspControllerSettings s = c.settings();
   s.k_p = 2.0;
   s.f_max = 1.0;
@@ -152,7 +169,7 @@ TEST(ControllerDynamicPart, TustinCoefficientsMatchTheSpecTable) {
     EXPECT_NEAR((f->b0() + f->b1()) / (1 + f->a1()), 2500.0 / 7.0, 1e-9);
     EXPECT_NEAR((f->b0() - f->b1()) / (1 - f->a1()), 10.0, 1e-12);
   }
-  GraspController c(can());
+  GraspController c(can(), paper_law());
   EXPECT_EQ(c.dynamic_filter(0).b0(), f500.b0());
   EXPECT_EQ(c.dynamic_filter(1).a1(), f500.a1());
 }
@@ -174,7 +191,7 @@ TEST(ControllerDynamicPart, FrequencyResponseIsTheWarpedContinuousOne) {
 
 TEST(ControllerDynamicPart, StepResponseThroughTheControllerMatchesTheContinuousOne) {
   // Unit step of omega_hat; continuous response y(t) = k (z/p + (1 - z/p) e^{-p t}).
-  GraspController c(can());
+  GraspController c(can(), paper_law());
   const auto in = one(0.8, 1.0);
   GraspControllerOutput out;
   const double T = 1.0 / 500, k = 10, z = 250, p = 7;
@@ -194,7 +211,7 @@ TEST(ControllerDynamicPart, StepResponseThroughTheControllerMatchesTheContinuous
 }
 
 TEST(ControllerDynamicPart, AbsoluteValueAfterFilteringAndPeakHold) {
-  GraspControllerSettings s;
+  GraspControllerSettings s = paper_law();
   s.max_rate_up = s.max_rate_down = kInf;
   GraspController c(can(), s);
   c.reset(2.0);
@@ -224,7 +241,7 @@ TEST(ControllerDynamicPart, AbsoluteValueAfterFilteringAndPeakHold) {
 }
 
 TEST(ControllerDynamicPart, ClippedToTheHeadRoomWithoutTouchingTheIntegrator) {
-  GraspControllerSettings s;
+  GraspControllerSettings s = paper_law();
   s.max_rate_up = s.max_rate_down = kInf;
   s.static_equivalent_slippage = false;  // the paper's PI: e = S - s_ref
   GraspController c(can(), s);
@@ -240,7 +257,7 @@ TEST(ControllerDynamicPart, ClippedToTheHeadRoomWithoutTouchingTheIntegrator) {
 TEST(ControllerDynamicPart, DeadBandRemovesSpeedsBelowTheObserverResolution) {
   // C_d sees sign(w) max(0, |w| - k r): below the band no dynamic force at all, above it the
   // output equals that of a band-free controller fed the shrunk speed.
-  GraspControllerSettings banded, plain;
+  GraspControllerSettings banded = paper_law(), plain = paper_law();
   banded.omega_deadband = 2.0;
   plain.omega_deadband = 0.0;
   banded.static_equivalent_slippage = plain.static_equivalent_slippage = false;  // dead band alone
@@ -278,7 +295,8 @@ TEST(ControllerStaticPart, StaticEquivalentSlippageKeepsRaisingWhileTheDynamicPa
   // unwinds f_ns; with static_equivalent_slippage it integrates S_s = S ((f_ns + f_nd)/f_ns)^(1+gamma),
   // the slippage at the static force alone, which is above s_ref here: f_ns keeps rising.
   const ContactParams p = can();
-  GraspControllerSettings on, off;
+  GraspControllerSettings on = paper_law(), off = paper_law();
+  on.static_equivalent_slippage = true;
   on.max_rate_up = on.max_rate_down = off.max_rate_up = off.max_rate_down = kInf;
   off.static_equivalent_slippage = false;
   GraspController a(p, on), b(p, off);
@@ -319,7 +337,7 @@ TEST(ControllerStaticPart, StaticEquivalentSlippageKeepsRaisingWhileTheDynamicPa
 }
 
 TEST(ControllerDynamicPart, DisabledAndReenabledFromRest) {
-  GraspController c(can());
+  GraspController c(can(), paper_law());
   auto out = run(c, one(0.8, 1.0), 200);  // filter state far from rest
   EXPECT_GT(out.dynamic_sample[0], 100.0);
   c.set_dynamic_enabled(false);
@@ -336,7 +354,7 @@ TEST(ControllerDynamicPart, DisabledAndReenabledFromRest) {
 TEST(ControllerStaticPart, SAboveTheReferenceRaisesTheForceAndBelowLowersIt) {
   const double T = 0.02;
   for (double S : {0.9, 0.7}) {
-    GraspController c(can());
+    GraspController c(can(), paper_law());
     c.reset(5.0);
     GraspControllerOutput out;
     c.step(one(S), out);
@@ -355,7 +373,7 @@ TEST(ControllerStaticPart, SAboveTheReferenceRaisesTheForceAndBelowLowersIt) {
 }
 
 TEST(ControllerStaticPart, ProportionalStepHasTheRightSign) {
-  GraspControllerSettings s;
+  GraspControllerSettings s = paper_law();
   s.max_rate_up = s.max_rate_down = kInf;
   GraspController c(can(), s);
   c.reset(5.0);
@@ -367,7 +385,7 @@ TEST(ControllerStaticPart, ProportionalStepHasTheRightSign) {
 
 TEST(ControllerStaticPart, NoLoadDecaysToTheFloorInAQuarterSecond) {
   // MODEL.md 9.5: from 2 N with S = 0 the integrator drains at k_i S_ref = 8 N/s.
-  GraspController c(can());
+  GraspController c(can(), paper_law());
   c.reset(2.0);
   GraspControllerOutput out;
   double t_floor = -1;
@@ -383,7 +401,7 @@ namespace {
 // Saturates at f_max with S = 1 for `hold` seconds, then reverses the error (S = 0.5); returns
 // the number of commands until the force leaves f_max.
 int commands_to_leave_ceiling(bool anti_windup, double hold) {
-  GraspControllerSettings s;
+  GraspControllerSettings s = paper_law();
   s.anti_windup = anti_windup;
   s.max_rate_up = s.max_rate_down = kInf;
   GraspController c(can(), s);
@@ -409,7 +427,7 @@ TEST(ControllerStaticPart, AntiWindupLeavesTheCeilingAtOnce) {
 }
 
 TEST(ControllerStaticPart, AntiWindupAtTheFloorToo) {
-  GraspControllerSettings s;
+  GraspControllerSettings s = paper_law();
   s.max_rate_up = s.max_rate_down = kInf;
   GraspController c(can(), s);
   c.reset(1.0);
@@ -420,7 +438,7 @@ TEST(ControllerStaticPart, AntiWindupAtTheFloorToo) {
 }
 
 TEST(ControllerStaticPart, RateLimitsBoundEachCommandChange) {
-  GraspControllerSettings s;
+  GraspControllerSettings s = paper_law();
   s.max_rate_up = 10.0;  // 0.2 N per command
   s.max_rate_down = 5.0;
   GraspController c(can(), s);
@@ -440,7 +458,7 @@ TEST(ControllerStaticPart, RateLimitsBoundEachCommandChange) {
 // --- multi-rate -----------------------------------------------------------------------------------
 
 TEST(ControllerMultiRate, CommandChangesOnlyEveryTenthCall) {
-  GraspController c(can());
+  GraspController c(can(), paper_law());
   c.reset(3.0);
   std::mt19937 rng(7);
   std::uniform_real_distribution<double> u(0.0, 1.0);
@@ -458,7 +476,7 @@ TEST(ControllerMultiRate, CommandChangesOnlyEveryTenthCall) {
     held = out.force;
   }
   EXPECT_GT(changes, 90);  // random inputs: (almost) every command differs
-  GraspControllerSettings s;
+  GraspControllerSettings s = paper_law();
   s.command_ratio = 4;
   GraspController c4(can(), s);
   EXPECT_NEAR(c4.command_period(), 4.0 / 500, 1e-15);
@@ -471,7 +489,7 @@ TEST(ControllerMultiRate, CommandChangesOnlyEveryTenthCall) {
 // --- two fingers (MODEL.md 9.8) -------------------------------------------------------------------
 
 TEST(ControllerTwoFingers, MaxOfSMaxOfDynamicPartMeanOfCoR) {
-  GraspControllerSettings s;
+  GraspControllerSettings s = paper_law();
   s.max_rate_up = s.max_rate_down = kInf;
   GraspController c(can(), s);
   c.reset(5.0);
@@ -500,7 +518,7 @@ TEST(ControllerTwoFingers, MaxOfSMaxOfDynamicPartMeanOfCoR) {
 }
 
 TEST(ControllerTwoFingers, AbsentFingerIsIgnoredEvenWithGarbage) {
-  GraspController c(can());
+  GraspController c(can(), paper_law());
   GraspControllerInput in = one(0.7);
   in.fingers[1] = FingerInput{kNaN, kNaN, kNaN, kNaN, Status::SensorFault, false};
   GraspControllerOutput out;
@@ -527,7 +545,7 @@ TEST(ControllerBadInput, InvalidStatusesAndValuesHoldTheCommand) {
                              Status::InvalidSample, Status::InvalidSample, Status::InvalidSample,
                              Status::InvalidSample, Status::InvalidSample, Status::InvalidSample};
   for (int k = 0; k < 9; ++k) {
-    GraspController c(can());
+    GraspController c(can(), paper_law());
     c.reset(3.0);
     GraspControllerInput in = one(0.8);
     in.fingers[1] = bad[k];  // S = 0 on the bad finger would lower the force if it were used
@@ -543,7 +561,7 @@ TEST(ControllerBadInput, InvalidStatusesAndValuesHoldTheCommand) {
     EXPECT_FALSE(out.held);
   }
   // The worst status wins.
-  GraspController c(can());
+  GraspController c(can(), paper_law());
   GraspControllerInput in;
   in.fingers[0] = bad[2];
   in.fingers[1] = bad[1];
@@ -553,7 +571,7 @@ TEST(ControllerBadInput, InvalidStatusesAndValuesHoldTheCommand) {
 }
 
 TEST(ControllerBadInput, ConfigurableRaiseStepUpToTheCeiling) {
-  GraspControllerSettings s;
+  GraspControllerSettings s = paper_law();
   s.invalid_raise_step = 0.5;
   GraspController c(can(), s);
   c.reset(3.0);
@@ -569,7 +587,7 @@ TEST(ControllerBadInput, ConfigurableRaiseStepUpToTheCeiling) {
 TEST(ControllerBadInput, RandomAdversarialInputsKeepTheCommandFiniteAndInRange) {
   // Property: 1e6 seeded samples (NaN, Inf, huge, negative, random statuses, presence, mode
   // requests and resets) -> command finite and in [f_min, f_max]; never lowered by a held command.
-  GraspControllerSettings s;
+  GraspControllerSettings s = paper_law();
   s.f_min = 0.3;
   s.f_max = 12.0;
   s.invalid_raise_step = 0.01;
@@ -622,7 +640,7 @@ TEST(ControllerBadInput, RandomAdversarialInputsKeepTheCommandFiniteAndInRange) 
 // --- pivoting (MODEL.md 9.6) ----------------------------------------------------------------------
 
 TEST(ControllerPivoting, NoDynamicPartExponentialDecayNoJump) {
-  GraspControllerSettings s;
+  GraspControllerSettings s = paper_law();
   s.max_rate_up = s.max_rate_down = kInf;
   GraspController c(can(), s);
   c.reset(8.0);
@@ -649,7 +667,7 @@ TEST(ControllerPivoting, NoDynamicPartExponentialDecayNoJump) {
 }
 
 TEST(ControllerPivoting, FloorFromTheTangentialForceHoldsTheFilterState) {
-  GraspController c(can());
+  GraspController c(can(), paper_law());
   c.reset(3.0);
   GraspControllerOutput out;
   c.step(one(0.8), out);
@@ -673,7 +691,7 @@ TEST(ControllerPivoting, FloorFromTheTangentialForceHoldsTheFilterState) {
 }
 
 TEST(ControllerPivoting, EndsOnThreeConsecutiveSamplesAboveOneThenBumplessReturn) {
-  GraspControllerSettings s;
+  GraspControllerSettings s = paper_law();
   s.max_rate_up = s.max_rate_down = kInf;
   GraspController c(can(), s);
   c.reset(6.0);
@@ -711,7 +729,7 @@ TEST(ControllerPivoting, EndsOnThreeConsecutiveSamplesAboveOneThenBumplessReturn
 }
 
 TEST(ControllerPivoting, TwoFingersEndOnTheMeanOfTheCoR) {
-  GraspController c(can());
+  GraspController c(can(), paper_law());
   GraspControllerInput in;
   in.fingers[0] = FingerInput{0.0, 1.0, 1.5, 0.2, Status::Ok, true};
   in.fingers[1] = FingerInput{0.0, 1.0, 0.4, 0.2, Status::Ok, true};  // mean 0.95
@@ -726,7 +744,7 @@ TEST(ControllerPivoting, TwoFingersEndOnTheMeanOfTheCoR) {
 }
 
 TEST(ControllerPivoting, TimeoutAndRequestEndIt) {
-  GraspControllerSettings s;
+  GraspControllerSettings s = paper_law();
   s.pivot_timeout = 1.0;
   GraspController c(can(), s);
   c.request_pivoting();
@@ -750,7 +768,7 @@ TEST(ControllerPivoting, TimeoutAndRequestEndIt) {
 }
 
 TEST(ControllerPivoting, InvalidInputHoldsInsteadOfDecaying) {
-  GraspController c(can());
+  GraspController c(can(), paper_law());
   c.reset(5.0);
   c.request_pivoting();
   auto out = run(c, one(1.0, 0, 0.3, 0.1), 100);
@@ -849,7 +867,7 @@ TEST(ControllerClosedLoop, SettlesAtTheStaticGraspForce) {
                         Load{"small_resin_block", 1.2, 4.15e-3}}) {
     const ContactParams p = object_params(l.object);
     const double f_static = StaticForceSolver(p).solve(l.ft, l.tau).force;
-    const auto range = quasi_static_loop(p, l.ft, l.tau, GraspControllerSettings{}, 40.0, 5.0);
+    const auto range = quasi_static_loop(p, l.ft, l.tau, paper_law(), 40.0, 5.0);
     EXPECT_NEAR(range.first, f_static, 0.01 * f_static) << l.object << " " << l.ft;
     EXPECT_NEAR(range.second, f_static, 0.01 * f_static) << l.object << " " << l.ft;
   }
@@ -859,13 +877,235 @@ TEST(ControllerClosedLoop, LowForcesNeedGainScheduling) {
   // Empty can (0.12 N per finger -> 0.190 N): k_p |dS/df| = 4 * 0.8 / 0.19 = 17 > 1, the 50 Hz
   // loop with the paper's gains limit-cycles; with gain scheduling it settles.
   const double f_static = StaticForceSolver(can()).solve(0.12, 0.0).force;
-  const auto paper = quasi_static_loop(can(), 0.12, 0.0, GraspControllerSettings{}, 20.0, 5.0);
+  const auto paper = quasi_static_loop(can(), 0.12, 0.0, paper_law(), 20.0, 5.0);
   EXPECT_GT(paper.second - paper.first, 0.5);
-  GraspControllerSettings s;
+  GraspControllerSettings s = paper_law();
   s.gain_schedule_force = 5.0;
   const auto scheduled = quasi_static_loop(can(), 0.12, 0.0, s, 20.0, 5.0);
   EXPECT_NEAR(scheduled.first, f_static, 0.01 * f_static);
   EXPECT_NEAR(scheduled.second, f_static, 0.01 * f_static);
   const auto full = quasi_static_loop(can(), 2.0, 3e-3, s, 40.0, 5.0);
   EXPECT_NEAR(0.5 * (full.first + full.second), 4.7495, 0.05);
+}
+
+// --- beyond the paper: slope gain, feed-forward, slip reflex (docs/controller.md) ----------------
+// Consistency tests: the plant below is lugrip's own static map S_static(f_n) (StaticForceSolver)
+// behind a first-order force lag; they check the law, not the contact physics (the closed loops
+// on the patch and MuJoCo plants are in tests/python/test_controller.py).
+
+namespace {
+// S = S_static(f_act) with f_act following the command through a 30 ms first-order lag at the
+// sensor rate; returns {min, max} of the command over the last `tail` seconds.
+std::pair<double, double> lagged_loop(const ContactParams& p, double ft, double tau,
+                                      const GraspControllerSettings& s, double duration, double tail,
+                                      double f0 = 2.0) {
+  StaticForceSolver plant(p);
+  GraspController c(p, s);
+  c.reset(f0);
+  GraspControllerOutput out;
+  double lo = 1e9, hi = 0, f_act = f0;
+  const double decay = std::exp(-0.002 / 0.03);
+  const int n = static_cast<int>(duration * 500);
+  for (int k = 0; k < n; ++k) {
+    double ct = 0;
+    const double S = std::min(plant.slippage(f_act, ft, tau, &ct), 1.0);
+    GraspControllerInput in = one(S, 0.0, ct, ft);
+    in.fingers[0].tau = tau;
+    c.step(in, out);
+    f_act = out.force + (f_act - out.force) * decay;
+    if (k >= n - tail * 500) {
+      lo = std::min(lo, out.force);
+      hi = std::max(hi, out.force);
+    }
+  }
+  return {lo, hi};
+}
+}  // namespace
+
+TEST(ControllerSlopeGain, LoopGainIsTheSameAtEveryForce) {
+  // k_p |dS/df_n| at the settled force, with the slope from the model by central differences.
+  double paper_lo = kInf, paper_hi = 0.0;
+  for (const double tau : {0.0, 2e-3}) {
+    for (const double ft : {0.1, 0.3, 1.0, 3.0, 6.0}) {
+      const ContactParams p = can();
+      StaticForceSolver solver(p);
+      GraspControllerSettings s;
+      s.max_rate_up = s.max_rate_down = kInf;
+      GraspController c(p, s);
+      const double f = solver.solve(ft, tau).force;
+      c.reset(f);
+      GraspControllerInput in = one(0.8, 0.0, 1.5, ft);
+      in.fingers[0].tau = tau;
+      const auto out = run(c, in, 21);  // three commands at the set point
+      const double h = 1e-4 * f;
+      const double slope = (solver.slippage(f - h, ft, tau) - solver.slippage(f + h, ft, tau)) / (2 * h);
+      EXPECT_NEAR(out.force, f, 1e-9 * f);
+      // n is clamped to [1, 1 + gamma]: mixed loads whose exponent lies inside are exact.
+      EXPECT_NEAR(out.gain_p * slope, s.loop_gain_p, 0.03 * s.loop_gain_p) << ft << " " << tau << " f " << f;
+      EXPECT_NEAR(out.gain_i * slope, s.loop_gain_i, 0.03 * s.loop_gain_i) << ft << " " << tau;
+      paper_lo = std::min(paper_lo, 4.0 * slope);  // the paper's constant k_p = 4 N
+      paper_hi = std::max(paper_hi, 4.0 * slope);
+    }
+  }
+  // The paper's loop gain spans the force range (0.13-9 N): unstable (> 1) at the low end.
+  EXPECT_GT(paper_hi, 10.0);
+  EXPECT_LT(paper_lo, 0.5);
+}
+
+TEST(ControllerSlopeGain, NoLimitCycleAnywhereInTheForceRange) {
+  // Static forces from 0.14 N to 17 N (pure translation): with the slope gain the command settles
+  // (peak-to-peak < 0.5 % of the force); the paper's constant gains limit-cycle below ~3 N.
+  const ContactParams p = can();
+  StaticForceSolver solver(p);
+  GraspControllerSettings s;
+  s.f_max = 40.0;
+  for (const double ft : {0.09, 0.3, 1.0, 3.0, 7.0}) {
+    const double f = solver.solve(ft, 0.0).force;
+    const auto r = lagged_loop(p, ft, 0.0, s, 20.0, 3.0);
+    EXPECT_LT(r.second - r.first, 0.005 * f) << "ft " << ft << " f " << f;
+    EXPECT_NEAR(0.5 * (r.first + r.second), f, 0.01 * f) << ft;
+    const auto paper = lagged_loop(p, ft, 0.0, paper_law(s), 20.0, 3.0);
+    if (f < 1.0) EXPECT_GT(paper.second - paper.first, 0.5 * f) << "paper law at " << f << " N";
+  }
+}
+
+TEST(ControllerFeedForward, StaticGraspForceOfTheMeanLoadAtTheNextCommand) {
+  const ContactParams p = can();
+  StaticForceSolver solver(p);
+  GraspControllerSettings s;
+  s.max_rate_up = s.max_rate_down = kInf;
+  GraspController c(p, s);
+  c.reset(0.1);
+  GraspControllerOutput out;
+  GraspControllerInput in = one(0.05, 0.0, 1.5, 0.0);
+  c.step(in, out);  // first command: unloaded
+  ASSERT_TRUE(out.command_issued);
+  EXPECT_EQ(out.feedforward_force, 0.0);
+  // The load arrives inside the period (two values of f_t, tau): the next command uses the mean.
+  double sum_ft = 0, sum_tau = 0;
+  for (int k = 1; k < 10; ++k) {
+    in.fingers[0].f_t = k < 5 ? 1.0 : 2.0;
+    in.fingers[0].tau = k < 5 ? 1e-3 : 3e-3;
+    in.fingers[0].slippage = 0.5;
+    sum_ft += in.fingers[0].f_t;
+    sum_tau += in.fingers[0].tau;
+    c.step(in, out);
+    EXPECT_FALSE(out.command_issued);
+  }
+  c.step(in, out);  // the next command (this sample included)
+  ASSERT_TRUE(out.command_issued);
+  sum_ft += in.fingers[0].f_t;
+  sum_tau += in.fingers[0].tau;
+  const double f_ff = solver.solve(sum_ft / 10, sum_tau / 10, s.feedforward_slippage).force;
+  EXPECT_NEAR(out.feedforward_force, f_ff, 1e-12 * f_ff);
+  EXPECT_NEAR(out.static_force, f_ff, 1e-12 * f_ff);  // the PI alone would be far lower
+  // Two fingers: the larger of the two forces.
+  GraspController two(p, s);
+  two.reset(0.1);
+  GraspControllerInput in2;
+  in2.fingers[0] = FingerInput{0.0, 0.5, 1.5, 1.0, Status::Ok, true, 0.0, 0.0};
+  in2.fingers[1] = FingerInput{0.0, 0.5, 0.3, 0.5, Status::Ok, true, 0.0, 4e-3};
+  const auto o2 = run(two, in2, 11);
+  const double f0 = solver.solve(1.0, 0.0, 0.9).force, f1 = solver.solve(0.5, 4e-3, 0.9).force;
+  EXPECT_NEAR(o2.feedforward_force, std::max(f0, f1), 1e-12);
+  // Off: the PI alone.
+  GraspControllerSettings off = s;
+  off.feedforward = false;
+  GraspController c_off(p, off);
+  c_off.reset(0.1);
+  const auto o3 = run(c_off, in2, 11);
+  EXPECT_EQ(o3.feedforward_force, 0.0);
+  EXPECT_LT(o3.force, 0.2);
+}
+
+TEST(ControllerFeedForward, RangeAndRateLimitsStillBound) {
+  const ContactParams p = can();
+  GraspControllerSettings s;
+  s.f_max = 5.0;
+  s.max_rate_up = 10.0;  // 0.2 N per command
+  GraspController c(p, s);
+  c.reset(0.1);
+  GraspControllerInput in = one(0.5, 0.0, 1.5, 20.0);  // needs ~30 N
+  GraspControllerOutput out;
+  double last = 0.1;
+  for (int k = 0; k < 500; ++k) {
+    c.step(in, out);
+    if (out.command_issued) {
+      EXPECT_LE(out.force, last + 0.2 + 1e-12);
+      last = out.force;
+    }
+    EXPECT_LE(out.force, 5.0);
+  }
+  EXPECT_EQ(out.force, 5.0);
+  EXPECT_EQ(out.static_force, 5.0);
+  // Pivoting: no feed-forward, the force decays.
+  c.request_pivoting();
+  const double before = c.command();
+  in.fingers[0].c_tilde = 0.5;  // below the pivot end threshold
+  in.fingers[0].f_t = 1.0;       // pivoting floor 1.1 f_t / mu below f_max
+  out = run(c, in, 100);
+  ASSERT_EQ(out.mode, ControllerMode::Pivoting);
+  EXPECT_EQ(out.feedforward_force, 0.0);
+  EXPECT_LT(out.force, before);
+}
+
+TEST(ControllerReflex, RaisesWithinOneCommandPeriodWhenTheSpeedIsUnobservable) {
+  // omega_hat = 0 throughout (Coulomb-like contact: C_d adds nothing); S at the projection bound
+  // on three consecutive samples inside a period.
+  GraspControllerSettings s;
+  s.feedforward = false;
+  s.max_rate_up = s.max_rate_down = kInf;
+  GraspController c(can(), s);
+  c.reset(2.0);
+  GraspControllerOutput out = run(c, one(0.8), 11);  // two commands at the set point
+  const double f0 = out.force;
+  EXPECT_NEAR(f0, 2.0, 1e-12);
+  for (int k = 0; k < 9; ++k) {
+    c.step(one(k >= 4 && k < 7 ? 1.0 : 0.8), out);
+    EXPECT_FALSE(out.command_issued);
+  }
+  c.step(one(0.8), out);
+  ASSERT_TRUE(out.command_issued);
+  EXPECT_TRUE(out.reflex);
+  EXPECT_GE(out.force, s.reflex_factor * f0 - 1e-12);
+  // Isolated samples above the threshold (noise) do not trigger it.
+  GraspController d(can(), s);
+  d.reset(2.0);
+  out = run(d, one(0.8), 11);
+  for (int k = 0; k < 50; ++k) {
+    d.step(one(k % 2 ? 1.0 : 0.8), out);
+    EXPECT_FALSE(out.reflex);
+  }
+  // Without the reflex only the PI moves (one command: + k_p e at most).
+  GraspControllerSettings off = s;
+  off.slip_reflex = false;
+  GraspController e(can(), off);
+  e.reset(2.0);
+  out = run(e, one(0.8), 11);
+  for (int k = 0; k < 9; ++k) e.step(one(k >= 4 && k < 7 ? 1.0 : 0.8), out);
+  e.step(one(0.8), out);
+  EXPECT_FALSE(out.reflex);
+  EXPECT_LT(out.force, 1.1 * f0);
+}
+
+TEST(ControllerReflex, RepeatsWhileSlidingAndStopsAtTheCeiling) {
+  GraspControllerSettings s;
+  s.feedforward = false;
+  s.max_rate_up = s.max_rate_down = kInf;
+  GraspController c(can(), s);
+  c.reset(1.0);
+  GraspControllerOutput out;
+  double last = 1.0;
+  int raises = 0;
+  for (int k = 0; k < 500; ++k) {
+    c.step(one(1.0), out);
+    if (out.command_issued && k > 0) {
+      EXPECT_GE(out.force, std::min(s.reflex_factor * last, s.f_max) - 1e-9) << k;
+      EXPECT_LE(out.force, s.f_max);
+      raises += out.reflex;
+      last = out.force;
+    }
+  }
+  EXPECT_EQ(out.force, s.f_max);
+  EXPECT_GT(raises, 10);
 }

@@ -30,6 +30,7 @@ TEST(NoAllocation, GraspControllerStep) {
       f.slippage = u(rng);
       f.c_tilde = 2.0 * u(rng);
       f.f_t = u(rng);
+      f.tau = 2e-3 * (u(rng) - 0.5);  // feed-forward and slope of the controller
       f.status = static_cast<Status>(rng() % 7);
     }
     if (n % 5000 == 100) c.request_pivoting();

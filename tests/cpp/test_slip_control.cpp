@@ -85,6 +85,7 @@ TEST(SlipControl, HandWiringWithoutStatusesDropsTheObjectOnContactLoss) {
   // Negative control for the test above: the same loop wired by hand with the status left at
   // its default (Ok) lowers the command to f_min within 0.2 s of contact loss.
   SlipControlSettings s;
+  s.controller.slope_gain = false;  // the paper's gains drain the unloaded command within 0.2 s
   Observer obs0(can(), s.observer), obs1(can(), s.observer);
   GraspController ctrl(can(), s.controller);
   QuasiStaticGrip grip;
@@ -158,7 +159,7 @@ TEST(SlipControl, SameNumbersAsTheHandWiredPathWithStatuses) {
       const FingerWrench& w = in.fingers[i];
       const ObserverInput oin = ObserverInput::from_force_vector(w.f_n, w.f_x, w.f_y, w.tau);
       obs[i].step(oin, o);
-      cin.fingers[i] = FingerInput{o.omega_hat, o.S, o.c_tilde, oin.f_t, o.status, true, o.omega_resolution};
+      cin.fingers[i] = FingerInput{o.omega_hat, o.S, o.c_tilde, oin.f_t, o.status, true, o.omega_resolution, oin.tau};
     }
     ctrl.step(cin, ref);
     sc.step(in, out);
@@ -286,7 +287,7 @@ TEST(SlipControl, ClosedLoopOnThePatchPlantMatchesTheHandWiredLoop) {
       const ObserverInput oin = ObserverInput::from_force_vector(f.f_n, f.f_x, f.f_y, f.tau);
       ObserverOutput o;
       obs[i].step(oin, o);
-      cin.fingers[i] = FingerInput{o.omega_hat, o.S, o.c_tilde, oin.f_t, o.status, true, o.omega_resolution};
+      cin.fingers[i] = FingerInput{o.omega_hat, o.S, o.c_tilde, oin.f_t, o.status, true, o.omega_resolution, oin.tau};
     }
     ctrl.step(cin, ref);
     plant.set_command(ref.force);

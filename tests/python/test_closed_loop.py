@@ -81,14 +81,13 @@ def test_deterministic_for_a_seed_and_noise_changes_with_it():
     [
         ("big_resin_block", 0.5, (0.0, -0.03)),  # translational load, c~ at the clip
         ("small_resin_block", 0.25, (0.003, 0.0)),  # force plus gravitational torque
-        ("aluminium_can", 0.05, (0.0, -0.02)),  # light: 0.3 N, gain scheduling below
+        ("aluminium_can", 0.05, (0.0, -0.02)),  # light: 0.3 N (the paper's gains limit-cycle)
     ],
 )
 def test_steady_force_matches_static_grasp_force(contact, mass, cog):
     """After the lift the PI holds S = 0.8, where the command equals static_grasp_force of the
     measured-true per-finger load within a few percent (MODEL.md 9.4)."""
-    ctrl = {"gain_schedule_force": 3.0} if mass < 0.1 else {}
-    r = run_closed_loop(plant(mass, cog, contact), ctrl, OBS, None, 10.0)
+    r = run_closed_loop(plant(mass, cog, contact), {}, OBS, None, 10.0)
     w = r.window(7.0, 10.0)
     ft = 0.5 * (r.f_t_true_0[w] + r.f_t_true_1[w]).mean()
     tau = 0.5 * (np.abs(r.tau_true_0[w]) + np.abs(r.tau_true_1[w])).mean()
@@ -202,7 +201,7 @@ def test_property_command_finite_in_limits(
         ],
         drop={"rotation_limit": math.inf},
     )
-    ctrl = {"f_min": f_min, "f_max": 15.0, "gain_schedule_force": gs}
+    ctrl = {"f_min": f_min, "f_max": 15.0, "gain_schedule_force": gs, "slope_gain": gs == 0.0}
     r = run_closed_loop(d, ctrl, OBS, [(2.0, "pivot")] if pivot else None, 3.0, kind=kind)
     assert np.all(r.finite.astype(bool))
     for v in r.values():

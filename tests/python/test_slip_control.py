@@ -76,7 +76,8 @@ def test_hand_wiring_without_statuses_drops_the_command():
     """Negative control: the pre-SlipControl wiring with the status left out lowers the
     command to f_min within 0.2 s of contact loss."""
     obs = [lugrip.Observer(CAN), lugrip.Observer(CAN)]
-    ctrl = lugrip.GraspController(CAN)
+    # the paper's constant gains drain the unloaded command within 0.2 s (the slope gain more slowly)
+    ctrl = lugrip.GraspController(CAN, slope_gain=False)
     grip = QuasiStaticGrip()
 
     def cycle(w):
@@ -131,7 +132,8 @@ def test_same_numbers_as_the_hand_wired_path_with_statuses():
         o = [obs[i].step_vector(*w[k, i]) for i in range(2)]
         r = ref.step(omega_hat=[x.omega_hat for x in o], S=[x.S for x in o],
                      c_tilde=[x.c_tilde for x in o], f_t=[x for x in np.hypot(w[k, :, 1], w[k, :, 2])],
-                     status=[int(x.status) for x in o], omega_resolution=[x.omega_resolution for x in o])
+                     status=[int(x.status) for x in o], omega_resolution=[x.omega_resolution for x in o],
+                     tau=list(w[k, :, 3]))
         out = ctrl.step(w[k])
         # f_t: the C++ core uses its own planar norm, within an ulp of numpy's hypot
         assert out.force == pytest.approx(r.force, rel=1e-12, abs=1e-12), k

@@ -231,7 +231,7 @@ def _observations(results: Sequence[ScenarioResult]) -> list[str]:
         "onset at once (the scenarios give it the simulated pad's own σ_z; with Table 1's σ_z = 2 the "
         "σ_z ż term dominates σ_1 ≈ 1e-3 and ω̂ comes ~100× too slow), the dynamic part answers with a "
         f"force peak (largest {top[1]:.1f} N in {top[0]}, steady {_f(top[2])} N) and the static part "
-        "takes over as it decays (static_equivalent_slippage)."
+        "takes over as it decays (from the feed-forward of the measured load)."
     )
     if "exp3_plastic_bottle_pivot" in by:
         m = by["exp3_plastic_bottle_pivot"].metrics["lugrip"]

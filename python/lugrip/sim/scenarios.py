@@ -42,7 +42,7 @@ from typing import Any
 import numpy as np
 
 from .. import __version__
-from .._controller import static_grasp_force
+from .._controller import controller_settings, static_grasp_force
 from .._params import ContactParams
 from .._yaml import load_yaml, to_number
 from ._closed_loop import ClosedLoopRun, run_closed_loop
@@ -65,6 +65,9 @@ __all__ = [
     "scenario_dir",
     "simulate",
 ]
+
+#: Controller settings every scenario states: the gripper's force range [N] and rate limits [N/s].
+GRIPPER_RANGE = ("f_min", "f_max", "max_rate_up", "max_rate_down")
 
 #: Criteria a scenario may list, with their meaning (value compared with the YAML limit).
 CRITERIA = {
@@ -232,6 +235,13 @@ class Scenario:
         for key in ("name", "title", "duration", "plant"):
             if key not in data:
                 raise ValueError(f"{where}: missing key {key!r}")
+        # The gripper's range is the user's, never a library default (a silent cap).
+        missing = [k for k in GRIPPER_RANGE if k not in (data.get("controller") or {})]
+        if missing:
+            raise ValueError(
+                f"{where}: controller: the gripper's range must be given ({', '.join(missing)} "
+                "missing)"
+            )
         by_plant = dict(data.get("criteria_by_plant") or {})
         for crit in [data.get("criteria") or {}, *by_plant.values()]:
             unknown = sorted(set(crit) - set(CRITERIA))
@@ -457,9 +467,10 @@ def compute_metrics(
     references), pivoting, drop, finiteness. Forces per finger [N]."""
     cfg = cfg or scenario.plant_config()
     ctrl = dict(controller if controller is not None else scenario.controller)
-    f_min = float(ctrl.get("f_min", 0.1))
-    f_max = float(ctrl.get("f_max", 20.0))
-    s_ref = float(ctrl.get("s_ref", 0.8))
+    defaults = controller_settings()
+    f_min = float(ctrl.get("f_min", defaults["f_min"]))
+    f_max = float(ctrl.get("f_max", defaults["f_max"]))
+    s_ref = float(ctrl.get("s_ref", defaults["s_ref"]))
     t = run["t"]
     end = float(t[-1]) + (t[1] - t[0] if len(t) > 1 else 0.0)
     hold = scenario.hold_time
@@ -671,7 +682,9 @@ def constant_force_search(
     Returns {force, run, metrics, history: [[force, survived], ...], found}. ``force`` is the
     smallest surviving force tried (None when even f_max fails).
     """
-    f_max = float(f_max if f_max is not None else scenario.controller.get("f_max", 20.0))
+    if f_max is None:
+        f_max = scenario.controller.get("f_max", controller_settings()["f_max"])
+    f_max = float(f_max)
     history: list[list[Any]] = []
     cache: dict[float, tuple[bool, ClosedLoopRun, dict]] = {}
 
