@@ -57,6 +57,7 @@ bool validate(const GraspControllerSettings& s, std::string* message) {
   constexpr double kPoleMin = 1.0e-9, kCornerMax = 1.0e12;  // [rad/s] p_cd, z_cd
   constexpr double kForceMin = 1.0e-6, kForceMax = 1.0e6;   // [N] f_min, f_max, gain_schedule_force
   constexpr double kPivotMax = 1.0e3;                    // s_pivot (slippage inputs are <= 1e3)
+  constexpr double kSlippageMin = 1.0e-3;                // s_ref, feedforward_slippage, reflex_slippage
   std::string msg;
   auto bad = [&](const char* name, double v, const std::string& rule) {
     msg += std::string(name) + " = " + fmt(v) + ": " + rule + "\n";
@@ -81,7 +82,7 @@ bool validate(const GraspControllerSettings& s, std::string* message) {
   within("p_cd", s.p_cd, kPoleMin, false, kCornerMax, " [rad/s]");
   if (!(std::isfinite(s.z_cd) && s.z_cd > s.p_cd && s.z_cd <= kCornerMax))
     bad("z_cd", s.z_cd, "must be finite, > p_cd (lag network) and <= 1e+12 [rad/s]");
-  if (!(s.s_ref > 0.0 && s.s_ref < 1.0)) bad("s_ref", s.s_ref, "must satisfy 0 < s_ref < 1");
+  if (!(s.s_ref >= kSlippageMin && s.s_ref < 1.0)) bad("s_ref", s.s_ref, "must satisfy 1e-03 <= s_ref < 1");
   within("k_p", s.k_p, 0.0, true, kGainMax, " [N]");
   within("k_i", s.k_i, 0.0, true, kGainMax, " [N/s]");
   within("f_min", s.f_min, kForceMin, false, kForceMax, " [N]");
@@ -102,17 +103,17 @@ bool validate(const GraspControllerSettings& s, std::string* message) {
   positive("pivot_end_c_tilde", s.pivot_end_c_tilde);
   if (!(s.pivot_end_samples >= 1)) bad("pivot_end_samples", s.pivot_end_samples, "must be >= 1");
   positive_or_inf("pivot_timeout", s.pivot_timeout);
-  positive("loop_gain_p", s.loop_gain_p);
-  positive("loop_gain_i", s.loop_gain_i);
+  within("loop_gain_p", s.loop_gain_p, 0.0, true, kGainMax, " [-]");
+  within("loop_gain_i", s.loop_gain_i, 0.0, true, kGainMax, " [1/s]");
   if (s.slope_gain && s.gain_schedule_force > 0.0)
     bad("gain_schedule_force", s.gain_schedule_force, "must be 0 when slope_gain is on (one gain law)");
-  if (!(s.feedforward_slippage > 0.0 && s.feedforward_slippage <= 1.0))
-    bad("feedforward_slippage", s.feedforward_slippage, "must satisfy 0 < feedforward_slippage <= 1");
-  if (!(s.reflex_slippage > 0.0 && s.reflex_slippage <= 1.0))
-    bad("reflex_slippage", s.reflex_slippage, "must satisfy 0 < reflex_slippage <= 1");
+  if (!(s.feedforward_slippage >= kSlippageMin && s.feedforward_slippage <= 1.0))
+    bad("feedforward_slippage", s.feedforward_slippage, "must satisfy 1e-03 <= feedforward_slippage <= 1");
+  if (!(s.reflex_slippage >= kSlippageMin && s.reflex_slippage <= 1.0))
+    bad("reflex_slippage", s.reflex_slippage, "must satisfy 1e-03 <= reflex_slippage <= 1");
   if (!(s.reflex_samples >= 1)) bad("reflex_samples", s.reflex_samples, "must be >= 1");
-  if (!(std::isfinite(s.reflex_factor) && s.reflex_factor > 1.0))
-    bad("reflex_factor", s.reflex_factor, "must be finite and > 1");
+  if (!(std::isfinite(s.reflex_factor) && s.reflex_factor > 1.0 && s.reflex_factor <= kPivotMax))
+    bad("reflex_factor", s.reflex_factor, "must be finite, > 1 and <= 1000");
   if (message) *message = msg;
   return msg.empty();
 }
@@ -297,7 +298,11 @@ Status GraspController::step(const GraspControllerInput& in, GraspControllerOutp
     any_present = true;
     if (!finger_valid(f)) {
       valid = false;
-      const Status s = is_valid(f.status) ? Status::InvalidSample : f.status;
+      // NoContact and SensorFault are forwarded; a usable status with bad numbers, an
+      // InvalidSample or a code outside the enum is an invalid sample.
+      const Status s = (f.status == Status::NoContact || f.status == Status::SensorFault)
+                           ? f.status
+                           : Status::InvalidSample;
       if (severity(s) > severity(worst)) worst = s;
       out.dynamic_sample[i] = cd_[i].output();  // state held, sample not filtered
       continue;

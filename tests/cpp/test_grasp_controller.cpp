@@ -540,11 +540,14 @@ TEST(ControllerBadInput, InvalidStatusesAndValuesHoldTheCommand) {
       {0, kNaN, 0.5, 0.5, Status::Ok, true},           {0, 0.0, kInf, 0.5, Status::Ok, true},
       {0, 0.0, 0.5, -kInf, Status::Ok, true},          {0, -0.5, 0.5, 0.5, Status::Ok, true},
       {1e9, 0.0, 0.5, 0.5, Status::Ok, true},
+      {0, 0.0, 0.5, 0.5, static_cast<Status>(7), true},  // a code outside the enum
+      {0, 0.0, 0.5, 0.5, static_cast<Status>(-1), true},
   };
   const Status expected[] = {Status::InvalidSample, Status::SensorFault, Status::NoContact,
                              Status::InvalidSample, Status::InvalidSample, Status::InvalidSample,
-                             Status::InvalidSample, Status::InvalidSample, Status::InvalidSample};
-  for (int k = 0; k < 9; ++k) {
+                             Status::InvalidSample, Status::InvalidSample, Status::InvalidSample,
+                             Status::InvalidSample, Status::InvalidSample};
+  for (int k = 0; k < 11; ++k) {
     GraspController c(can(), paper_law());
     c.reset(3.0);
     GraspControllerInput in = one(0.8);

@@ -257,13 +257,14 @@ struct Stats {
   long out_of_range = 0;        // command outside [f_min, f_max], |c~| > c_max, S outside [0, 1]
   long twin_mismatch = 0;       // twin that never saw the rejected samples disagrees
   long not_held = 0;            // command lowered while a present finger was invalid
-  long unknown_status_ok = 0;   // out-of-enum finger status reported as Ok (reported, see README)
+  long unknown_status_ok = 0;   // out-of-enum finger status reported as Ok (a failure)
   long allocations = 0;         // operator new calls inside step() (seeded driver only)
   long rejected_samples = 0;    // samples the component rejected (InvalidSample, SensorFault, ...)
   std::array<long, 4> per_component{};
   std::string first_failure;    // description of the first failing case
 
-  long failures() const { return ctor_mismatch + non_finite + out_of_range + twin_mismatch + not_held + allocations; }
+  long failures() const { return ctor_mismatch + non_finite + out_of_range + twin_mismatch + not_held + allocations +
+                               unknown_status_ok; }
 };
 
 // Hook for the seeded driver's allocation counter (returns the running count; null: not counted).
@@ -562,7 +563,7 @@ class Campaign {
         if (o.command_issued && o.force < std::min(before, s.f_max)) fail(st, st.not_held, "GraspController: command lowered on invalid input");
         if (status == Status::Ok) {
           if (unknown)
-            ++st.unknown_status_ok;
+            fail(st, st.unknown_status_ok, "GraspController: out-of-enum finger status reported as Ok");
           else
             fail(st, st.out_of_range, "GraspController: invalid input reported as Ok");
         }
