@@ -81,6 +81,8 @@ PARAMETERS: dict[str, _Param] = {
     "sigma0": _Param("N m/rad", 0.0, True, "micro-asperity stiffness (plant)"),
     "sigma_z": _Param("N m s/rad", 0.0, False, "micro-asperity damping (plant)"),
     "delta": _Param("m", 0.0, True, "contact radius law rho = delta f_n^gamma (plant)"),
+    "pad_k_slide": _Param("N/m", 0.0, True, "MuJoCo plant: in-plane stiffness of each pad"),
+    "pad_k_twist": _Param("N m/rad", 0.0, True, "MuJoCo plant: twist stiffness of each pad"),
     "push_force": _Param("N", 0.0, False, "magnitude of the disturbance push"),
     "push_angle": _Param("deg", None, False, "direction of the push from +x (-90: down)"),
     "push_torque": _Param("N m", None, False, "pure torque of the push"),
@@ -350,6 +352,9 @@ class Campaign:
         if not isinstance(params, Mapping):
             raise CampaignError("parameters: expected a mapping name -> distribution")
         parameters = {str(k): Distribution.from_dict(str(k), v) for k, v in params.items()}
+        pads = sorted(k for k in parameters if k.startswith("pad_"))
+        if pads and plant != "mujoco":
+            raise CampaignError(f"parameters.{pads[0]}: only for plant mujoco (MuJoCo's pads)")
         crit = dict(_DEFAULT_CRITERIA)
         given = data.get("criteria") or {}
         if not isinstance(given, Mapping):
@@ -502,6 +507,11 @@ class Campaign:
                 "torque": p.get("push_torque", 0.0),
             }
             plant["disturbances"] = [*list(plant.get("disturbances") or []), push]
+        pad = {k[len("pad_"):]: p[k] for k in ("pad_k_slide", "pad_k_twist") if k in p}
+        if pad:
+            mj = dict(d.get("mujoco") or {})
+            mj["pad"] = dict(mj.get("pad") or {}) | pad
+            d["mujoco"] = mj
         plant["seed"] = p["plant_seed"]
         d["plant"] = plant
         mism = {k[len("mismatch_"):]: v for k, v in p.items() if k.startswith("mismatch_")}
