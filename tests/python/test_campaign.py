@@ -25,7 +25,6 @@ import pytest
 import yaml
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
-
 from lugrip import cli
 from lugrip.campaign import (
     Campaign,

@@ -46,10 +46,10 @@ import yaml
 __all__ = [
     "CONTROLLERS",
     "CRITERIA",
-    "CampaignError",
     "DISTRIBUTIONS",
     "PARAMETERS",
     "Campaign",
+    "CampaignError",
     "Distribution",
     "load_campaign",
 ]

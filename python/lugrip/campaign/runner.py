@@ -110,9 +110,9 @@ def run_one(campaign: Campaign, index: int) -> list[dict[str, Any]]:
     rows = []
     t0 = time.perf_counter()
     try:
-        scn, params, runs = simulate_run(campaign, index)
+        _, params, runs = simulate_run(campaign, index)
         error = None
-    except Exception as err:  # a drawn grasp the simulator rejects is a failed run, recorded
+    except Exception as err:  # noqa: BLE001 (a grasp the simulator rejects is a recorded failed run)
         params = campaign.draw(index)
         runs = {}
         error = f"{type(err).__name__}: {str(err).splitlines()[0] if str(err) else ''}"
