@@ -349,3 +349,21 @@ def test_cli_report_and_replay(tmp_path, capsys):
     assert "pid" in capsys.readouterr().err
     assert _cli("campaign", "replay", tmp_path, "--run", 0) == 2
     assert "campaign.json" in capsys.readouterr().err
+
+
+def test_mujoco_campaign_one_run():
+    """One grasp of the shipped MuJoCo campaign (MuJoCo's own contact solver and pads: an
+    independent plant), lugrip only: the drawn box size and pad springs reach the scene, the
+    scene works, the row is complete and the run is repeatable."""
+    pytest.importorskip("mujoco")
+    with open(ROOT / "campaigns" / "mujoco_blocks.yaml") as f:
+        d = yaml.safe_load(f)
+    d["controllers"] = {"lugrip": {}}
+    c = Campaign.from_dict(d, ROOT / "campaigns" / "mujoco_blocks.yaml")
+    scn, p = c.run_scenario(0)
+    assert scn.mujoco["size"][1:] == [0.5 * p["length"], 0.5 * p["height"]]
+    assert scn.mujoco["pad"] == {"k_slide": p["pad_k_slide"], "k_twist": p["pad_k_twist"]}
+    (row,) = run_one(c, 0)
+    assert row["error"] is None and row["m_scene_status"] == "ok" and row["pass_scene_ok"]
+    assert row["m_finite"] and row["m_mean_force"] > 0.0
+    assert _strip([row]) == _strip(run_one(c, 0))
