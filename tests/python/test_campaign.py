@@ -345,6 +345,12 @@ def test_cli_report_and_replay(tmp_path, capsys):
     text = capsys.readouterr().out
     assert "same as stored" in text
     assert (out / "replay_1_lugrip.png").is_file() and (out / "replay_1.json").is_file()
+    assert _cli("simulate", "--campaign", out, "--run", 0, "--out", tmp_path / "sim") == 0
+    text = capsys.readouterr().out
+    assert text.count("same as stored") == 2  # both controllers of the tiny campaign
+    assert (tmp_path / "sim" / "replay_0_baselines.png").is_file()
+    assert _cli("simulate", "--campaign", out) == 2
+    assert "--run" in capsys.readouterr().err
     assert _cli("campaign", "replay", out, "--run", 1, "--controller", "pid") == 2
     assert "pid" in capsys.readouterr().err
     assert _cli("campaign", "replay", tmp_path, "--run", 0) == 2

@@ -11,7 +11,7 @@ from typing import Any
 from .definition import Campaign, CampaignError
 from .runner import campaign_from_doc, simulate_run
 
-__all__ = ["load_results_campaign", "replay"]
+__all__ = ["load_results_campaign", "replay", "replay_command"]
 
 
 def load_results_campaign(directory: str | Path) -> Campaign:
@@ -85,3 +85,22 @@ def replay(directory: str | Path, index: int, *, controllers=None, out: str | Pa
     path.write_text(json.dumps(doc, indent=1, default=str))
     doc["json"] = str(path)
     return doc
+
+
+def replay_command(directory, index: int, *, controllers=None, out=None, figures=True) -> int:
+    """:func:`replay` with a summary on stdout (``lugrip campaign replay`` and ``lugrip
+    simulate --campaign``); returns the exit code 0."""
+    doc = replay(directory, index, controllers=controllers, out=out, figures=figures)
+    nan = float("nan")
+    for c, d in doc["controllers"].items():
+        m = d["metrics"]
+        same = {True: "same as stored", False: "DIFFERS from stored", None: "not stored"}[
+            d["matches_stored_row"]]
+        print(f"run {index} {c}: {'held' if d['success'] else 'FAILED'}; hold slip "
+              f"{m.get('hold_slip_mm', nan):.3f} mm, rotation "
+              f"{m.get('hold_rotation_deg', nan):.3f} deg, mean force "
+              f"{m.get('mean_force', nan):.2f} N, dropped {m.get('dropped')} ({same})")
+    for name, path in doc["figures"].items():
+        print(f"figure ({name}): {path}")
+    print(f"metrics: {doc['json']}")
+    return 0

@@ -134,7 +134,8 @@ def run(args) -> int:
         if len(args.target) != 2:
             raise CliError(f"usage: lugrip campaign {head} DIR" + (" --run ID" if head == "replay" else ""))
         directory = Path(args.target[1])
-        from ..campaign import load_results_campaign, replay, write_report
+        from ..campaign import load_results_campaign, write_report
+        from ..campaign.replay import replay_command
 
         if head == "report":
             campaign = load_results_campaign(directory)
@@ -143,19 +144,7 @@ def run(args) -> int:
             return 0
         if args.run_id is None:
             raise CliError("replay needs --run ID")
-        doc = replay(directory, args.run_id, controllers=args.controller, out=args.out,
-                     figures=not args.no_figures)
-        for c, d in doc["controllers"].items():
-            m = d["metrics"]
-            same = {True: "same as stored", False: "DIFFERS from stored", None: "not stored"}[
-                d["matches_stored_row"]]
-            print(f"run {args.run_id} {c}: {'held' if d['success'] else 'FAILED'}; hold slip "
-                  f"{m.get('hold_slip_mm', float('nan')):.3f} mm, rotation "
-                  f"{m.get('hold_rotation_deg', float('nan')):.3f} deg, mean force "
-                  f"{m.get('mean_force', float('nan')):.2f} N, dropped {m.get('dropped')} ({same})")
-        for name, path in doc["figures"].items():
-            print(f"figure ({name}): {path}")
-        print(f"metrics: {doc['json']}")
-        return 0
+        return replay_command(directory, args.run_id, controllers=args.controller, out=args.out,
+                              figures=not args.no_figures)
     return _run_campaign(args)
 
