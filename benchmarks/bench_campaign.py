@@ -40,24 +40,77 @@ def _one(campaign, runs: int, workers: int, backend: str, work: Path) -> dict:
     shutil.rmtree(out, ignore_errors=True)
     load0 = os.getloadavg()[0]
     cpu0 = time.process_time()
+    stamps: list[float] = []
     t0 = time.perf_counter()
-    run_campaign(campaign, runs, out, workers=workers, backend=backend, progress=False)
+    run_campaign(campaign, runs, out, workers=workers, backend=backend, progress=False,
+                 on_run=lambda i, rows: stamps.append(time.perf_counter()))
     wall = time.perf_counter() - t0
+    # throughput once every worker has delivered its first run (start-up excluded)
+    k = min(workers, runs - 1)
+    steady = (runs - k) / (stamps[-1] - stamps[k - 1]) if runs > k and stamps[-1] > stamps[k - 1] else float("nan")
     rows = ResultStore(out, campaign).rows()
     busy = sum(r["elapsed_s"] for r in rows)  # worker-side simulation time, all controllers
     return {
         "plant": campaign.plant, "backend": backend, "workers": workers, "runs": runs,
-        "wall_s": wall, "runs_per_s": runs / wall, "sim_s_per_run": busy / runs,
+        "wall_s": wall, "runs_per_s": runs / wall, "steady_runs_per_s": steady,
+        "startup_s": stamps[0] - t0 if stamps else float("nan"), "sim_s_per_run": busy / runs,
         "load_before": load0, "load_after": os.getloadavg()[0],
         "driver_cpu_s": time.process_time() - cpu0, "rows": rows,
     }
 
 
+def _results(dirs: list[Path]) -> list[str]:
+    """Summary lines of finished campaigns (their report.json)."""
+    import json
+
+    out: list[str] = []
+    for d in dirs:
+        data = json.loads((d / "report.json").read_text())
+        meta = json.loads((d / "campaign.json").read_text())
+        out += [
+            "",
+            f"### Campaign `{data['campaign']}` ({data['plant']} plant, {data['runs']} runs)",
+            "",
+            (
+                f"`lugrip campaign campaigns/{data['campaign']}.yaml --runs {data['runs']} "
+                f"--workers 2 --out {d}` (fingerprint {meta['fingerprint']}); success = every "
+                "criterion of the campaign file; 95 % Wilson intervals."
+            ),
+            "",
+            (
+                "| controller | held | rate | 95 % interval | mean force [N] | lugrip holds, it "
+                "fails | it holds, lugrip fails |"
+            ),
+            "|---|---:|---:|---|---:|---:|---:|",
+        ]
+        for c, s in data["summary"].items():
+            p = data["paired_with_lugrip"].get(c, {})
+            lo, hi = s["wilson95"]
+            out.append(
+                f"| {c} | {s['successes']}/{s['runs']} | {s['success_rate']:.2f} | "
+                f"[{lo:.2f}, {hi:.2f}] | {s['mean_force']:.2f} | "
+                f"{p.get('lugrip_holds_other_fails', '-')} | {p.get('other_holds_lugrip_fails', '-')} |"
+            )
+        deciding = {n: [c for c, v in e["controllers"].items() if v["effect"]]
+                    for n, e in data["failure_map"].items()}
+        shown = [f"{n} ({', '.join(cs)})" for n, cs in deciding.items() if cs]
+        out += ["", "Parameters whose bins differ beyond the 95 % intervals: "
+                + (", ".join(shown) if shown else "none at this size") + "; the others are not "
+                "resolved at this number of runs."]
+        worst = data["worst_runs"].get("lugrip") or []
+        if worst:
+            w = worst[0]
+            out.append(f"lugrip's worst run: {w['run']} (`{w['replay']}`).")
+    return out
+
+
 def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("--out", type=Path, default=ROOT / "BENCHMARKS.md")
-    ap.add_argument("--patch-runs", type=int, default=16)
-    ap.add_argument("--mujoco-runs", type=int, default=4)
+    ap.add_argument("--patch-runs", type=int, default=64)
+    ap.add_argument("--mujoco-runs", type=int, default=10)
+    ap.add_argument("--results", type=Path, action="append", default=[], metavar="DIR",
+                    help="campaign results directories whose report.json is summarised too")
     ap.add_argument("--no-ray", action="store_true")
     ap.add_argument("--no-mujoco", action="store_true")
     args = ap.parse_args(argv)
@@ -104,18 +157,21 @@ def main(argv=None) -> int:
         ),
         "",
         (
-            "| plant | backend | workers | runs | wall [s] | runs/s | speed-up vs 1 worker | "
-            "simulation per run [s] | load before |"
+            "| plant | backend | workers | runs | wall [s] | runs/s | speed-up | start-up [s] | "
+            "runs/s after start-up | speed-up after start-up | simulation per run [s] | "
+            "load before |"
         ),
-        "|---|---|---:|---:|---:|---:|---:|---:|---:|",
+        "|---|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|",
     ]
     for r in results:
         base = next(x for x in results if x["plant"] == r["plant"]
                     and x["backend"] == r["backend"] and x["workers"] == 1)
         sp = r["runs_per_s"] / base["runs_per_s"]
+        sp2 = r["steady_runs_per_s"] / base["steady_runs_per_s"]
         lines.append(
             f"| {r['plant']} | {r['backend']} | {r['workers']} | {r['runs']} | {r['wall_s']:.1f} | "
-            f"{r['runs_per_s']:.3f} | {sp:.2f} | {r['sim_s_per_run']:.2f} | "
+            f"{r['runs_per_s']:.3f} | {sp:.2f} | {r['startup_s']:.1f} | "
+            f"{r['steady_runs_per_s']:.3f} | {sp2:.2f} | {r['sim_s_per_run']:.2f} | "
             f"{r['load_before']:.1f} |"
         )
     lines += ["", ("Projected cost of 10^4 runs (four controllers each), from the worker-side "
@@ -137,9 +193,9 @@ def main(argv=None) -> int:
             "the two cores, so the measured speed-up depends on their demand as much as on the "
             "runner, and the simulation time per run is inflated the same way."
         ),
-        markers(SECTION)[1],
-        "",
     ]
+    lines += _results(args.results)
+    lines += [markers(SECTION)[1], ""]
     text = "\n".join(lines)
     write_section(args.out, text, SECTION)
     print(text)
