@@ -50,10 +50,12 @@ def _one(campaign, runs: int, workers: int, backend: str, work: Path) -> dict:
     steady = (runs - k) / (stamps[-1] - stamps[k - 1]) if runs > k and stamps[-1] > stamps[k - 1] else float("nan")
     rows = ResultStore(out, campaign).rows()
     busy = sum(r["elapsed_s"] for r in rows)  # worker-side simulation time, all controllers
+    cpu = sum(r["cpu_s"] for r in rows)  # worker-side CPU time (what a core-hour buys)
     return {
         "plant": campaign.plant, "backend": backend, "workers": workers, "runs": runs,
         "wall_s": wall, "runs_per_s": runs / wall, "steady_runs_per_s": steady,
         "startup_s": stamps[0] - t0 if stamps else float("nan"), "sim_s_per_run": busy / runs,
+        "cpu_s_per_run": cpu / runs,
         "load_before": load0, "load_after": os.getloadavg()[0],
         "driver_cpu_s": time.process_time() - cpu0, "rows": rows,
     }
@@ -107,8 +109,10 @@ def _results(dirs: list[Path]) -> list[str]:
 def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("--out", type=Path, default=ROOT / "BENCHMARKS.md")
-    ap.add_argument("--patch-runs", type=int, default=64)
-    ap.add_argument("--mujoco-runs", type=int, default=10)
+    ap.add_argument("--patch-runs", type=int, default=48)
+    ap.add_argument("--mujoco-runs", type=int, default=6)
+    ap.add_argument("--repeat", type=int, default=2,
+                    help="passes over 1 and 2 workers, interleaved; the fastest pass is kept")
     ap.add_argument("--results", type=Path, action="append", default=[], metavar="DIR",
                     help="campaign results directories whose report.json is summarised too")
     ap.add_argument("--no-ray", action="store_true")
@@ -131,15 +135,22 @@ def main(argv=None) -> int:
     for fname, runs in plants:
         c = load_campaign(ROOT / "campaigns" / fname)
         for backend in backends:
-            for workers in (1, 2):
-                r = _one(c, runs, workers, backend, work)
-                print(f"{c.plant:6s} {backend:7s} {workers} worker(s): {r['runs_per_s']:.3f} "
-                      f"runs/s ({r['wall_s']:.1f} s, load {r['load_before']:.1f})", flush=True)
-                results.append(r)
+            best: dict[int, dict] = {}
+            for _ in range(max(args.repeat, 1)):
+                for workers in (1, 2):
+                    r = _one(c, runs, workers, backend, work)
+                    r["passes"] = max(args.repeat, 1)
+                    print(f"{c.plant:6s} {backend:7s} {workers} worker(s): "
+                          f"{r['runs_per_s']:.3f} runs/s ({r['wall_s']:.1f} s, load "
+                          f"{r['load_before']:.1f})", flush=True)
+                    if workers not in best or r["wall_s"] < best[workers]["wall_s"]:
+                        best[workers] = r
+            results += [best[1], best[2]]
     # identical rows on every backend and worker count (per plant)
     same = {}
     for plant in {r["plant"] for r in results}:
-        tabs = [[{k: v for k, v in row.items() if k != "elapsed_s"} for row in r["rows"]]
+        tabs = [[{k: v for k, v in row.items() if k not in ("elapsed_s", "cpu_s")}
+                 for row in r["rows"]]
                 for r in results if r["plant"] == plant]
         same[plant] = all(t == tabs[0] for t in tabs)
     lines = [
@@ -151,7 +162,8 @@ def main(argv=None) -> int:
             f"{args.patch_runs} --mujoco-runs {args.mujoco_runs}`): the shipped campaigns, four "
             "controllers per run (lugrip, the paper's law, constant force, friction cone), each "
             "configuration into a fresh results directory; wall time includes starting the pool "
-            f"or Ray. Machine: {platform.machine()}, {os.cpu_count()} CPUs, Python "
+            f"or Ray; {max(args.repeat, 1)} interleaved passes over 1 and 2 workers, the fastest "
+            "of each kept. Machine: {platform.machine()}, {os.cpu_count()} CPUs, Python "
             f"{platform.python_version()}; load average (1 min) before each configuration in "
             "the table."
         ),
@@ -171,16 +183,18 @@ def main(argv=None) -> int:
         lines.append(
             f"| {r['plant']} | {r['backend']} | {r['workers']} | {r['runs']} | {r['wall_s']:.1f} | "
             f"{r['runs_per_s']:.3f} | {sp:.2f} | {r['startup_s']:.1f} | "
-            f"{r['steady_runs_per_s']:.3f} | {sp2:.2f} | {r['sim_s_per_run']:.2f} | "
+            f"{r['steady_runs_per_s']:.3f} | {sp2:.2f} | {r['sim_s_per_run']:.2f} / "
+            f"{r['cpu_s_per_run']:.2f} | "
             f"{r['load_before']:.1f} |"
         )
-    lines += ["", ("Projected cost of 10^4 runs (four controllers each), from the worker-side "
-                   "simulation time per run measured on 1 worker:"), ""]
+    lines += ["", ("Projected cost of 10^4 runs (four controllers each), from the CPU time per "
+                   "run in the workers (all configurations; CPU time, unlike wall time, does not "
+                   "grow with the other users' load):"), ""]
     for plant in dict.fromkeys(r["plant"] for r in results):
-        one = next(x for x in results if x["plant"] == plant and x["workers"] == 1)
-        lines.append(f"- {plant}: {one['sim_s_per_run'] * 1e4 / 3600:.1f} core-hours "
-                     f"({one['sim_s_per_run']:.2f} s per run on this machine under load "
-                     f"{one['load_before']:.1f})")
+        mine = [x for x in results if x["plant"] == plant]
+        cpu = sum(x["cpu_s_per_run"] * x["runs"] for x in mine) / sum(x["runs"] for x in mine)
+        lines.append(f"- {plant}: {cpu * 1e4 / 3600:.1f} core-hours ({cpu:.2f} CPU s per run), "
+                     f"{cpu * 1e4 / 3600 / 2:.1f} h on two idle cores")
     lines += [
         "",
         (

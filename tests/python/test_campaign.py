@@ -71,7 +71,7 @@ def _cli(*args) -> int:
 
 def _strip(rows):
     """Rows without the wall time, sorted by (run, controller)."""
-    out = [{k: v for k, v in r.items() if k != "elapsed_s"} for r in rows]
+    out = [{k: v for k, v in r.items() if k not in ("elapsed_s", "cpu_s")} for r in rows]
     return sorted(out, key=lambda r: (r["run"], r["controller"]))
 
 
