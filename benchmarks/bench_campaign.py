@@ -163,7 +163,7 @@ def main(argv=None) -> int:
             "controllers per run (lugrip, the paper's law, constant force, friction cone), each "
             "configuration into a fresh results directory; wall time includes starting the pool "
             f"or Ray; {max(args.repeat, 1)} interleaved passes over 1 and 2 workers, the fastest "
-            "of each kept. Machine: {platform.machine()}, {os.cpu_count()} CPUs, Python "
+            f"of each kept. Machine: {platform.machine()}, {os.cpu_count()} CPUs, Python "
             f"{platform.python_version()}; load average (1 min) before each configuration in "
             "the table."
         ),
@@ -173,7 +173,7 @@ def main(argv=None) -> int:
             "runs/s after start-up | speed-up after start-up | simulation per run [s] | "
             "load before |"
         ),
-        "|---|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|",
+        "|---|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|",
     ]
     for r in results:
         base = next(x for x in results if x["plant"] == r["plant"]
@@ -184,7 +184,7 @@ def main(argv=None) -> int:
             f"| {r['plant']} | {r['backend']} | {r['workers']} | {r['runs']} | {r['wall_s']:.1f} | "
             f"{r['runs_per_s']:.3f} | {sp:.2f} | {r['startup_s']:.1f} | "
             f"{r['steady_runs_per_s']:.3f} | {sp2:.2f} | {r['sim_s_per_run']:.2f} / "
-            f"{r['cpu_s_per_run']:.2f} | "
+            f"{r['cpu_s_per_run']:.2f} | {r['cpu_s_per_run'] * r['runs'] / r['wall_s']:.2f} | "
             f"{r['load_before']:.1f} |"
         )
     lines += ["", ("Projected cost of 10^4 runs (four controllers each), from the CPU time per "
@@ -205,7 +205,8 @@ def main(argv=None) -> int:
             f"Target: >= {TARGET_SPEEDUP}x for 2 workers on an idle 2-core machine. With a load "
             "average above the core count both workers compete with other users' processes for "
             "the two cores, so the measured speed-up depends on their demand as much as on the "
-            "runner, and the simulation time per run is inflated the same way."
+            "runner, and the simulation time per run is inflated the same way. 'cores obtained' "
+            "= runs x CPU per run / wall: what the workers got of the machine (2.0 at best)."
         ),
     ]
     lines += _results(args.results)

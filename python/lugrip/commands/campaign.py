@@ -100,7 +100,8 @@ def _run_campaign(args) -> int:
     if args.ray_address and args.backend != "ray":
         raise CliError("--ray-address needs --backend ray")
     campaign = load_campaign(args.target[0])
-    workers = args.workers or max(len(os.sched_getaffinity(0)), 1)
+    affinity = getattr(os, "sched_getaffinity", None)  # Linux; elsewhere every CPU
+    workers = args.workers or max(len(affinity(0)) if affinity else (os.cpu_count() or 1), 1)
     info = run_campaign(
         campaign,
         args.runs,
