@@ -40,6 +40,7 @@ COMMANDS: list[str] = [
     "identify",
     "simulate",
     "demo",
+    "campaign",
 ]
 """Module names (in this package) of the subcommands, in --help order."""
 

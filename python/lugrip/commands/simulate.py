@@ -105,10 +105,22 @@ def register(subparsers) -> None:
     p.add_argument("--no-baselines", action="store_true", help="only lugrip's controller")
     p.add_argument("--no-plots", action="store_true", help="skip the figures")
     p.add_argument("--list", action="store_true", help="list the available scenarios and exit")
+    p.add_argument("--campaign", type=Path, default=None, metavar="DIR",
+                   help="replay one run of the campaign results in DIR (with --run ID; figures "
+                   "to --out), as 'lugrip campaign replay DIR --run ID'")
+    p.add_argument("--run", dest="campaign_run", type=int, default=None, metavar="ID",
+                   help="with --campaign: the run index")
     p.set_defaults(run=run)
 
 
 def run(args: argparse.Namespace) -> int:
+    if args.campaign is not None or args.campaign_run is not None:
+        if args.campaign is None or args.campaign_run is None or args.campaign_run < 0:
+            raise CliError("--campaign DIR and --run ID (>= 0) go together")
+        from ..campaign.replay import replay_command
+
+        return replay_command(args.campaign, args.campaign_run, out=args.out,
+                              figures=not args.no_plots)
     from ..sim import report
 
     if args.plant == "mujoco" and (args.video or not args.no_frames):

@@ -1,0 +1,151 @@
+"""``lugrip campaign``: randomized grasp campaigns on a local process pool or Ray, streamed to
+Parquet (a rerun with the same --out resumes), with a report; ``lugrip campaign replay DIR
+--run ID`` reruns one grasp alone with its figures; ``lugrip campaign report DIR`` rewrites
+the report of what DIR holds.
+
+Exit code 0 when the runs are done (failed grasps are results, not errors), 2 on a user error
+(bad campaign file: one line naming the field).
+"""
+
+from __future__ import annotations
+
+import argparse
+import os
+from pathlib import Path
+
+from . import CliError
+
+__all__ = ["register", "run"]
+
+_EPILOG = """\
+examples:
+  lugrip campaign campaigns/patch_blocks.yaml --runs 100 --workers 2 --out out/patch_blocks
+  lugrip campaign campaigns/patch_blocks.yaml --runs 1000 --workers 2 --out out/patch_blocks
+      (the same --out: the 100 runs above are kept, runs 100..999 are added)
+  lugrip campaign campaigns/mujoco_blocks.yaml --runs 200 --backend ray --ray-address auto \\
+      --out out/mujoco_blocks
+  lugrip campaign replay out/patch_blocks --run 17 --controller lugrip
+  lugrip campaign report out/patch_blocks
+Ray: pip install 'lugrip[cluster]'; without --ray-address a local Ray instance with --workers
+CPUs is started. The same campaign and run index give the same results on either backend and
+any number of workers. Results: DIR/results.parquet (one row per run and controller: p_* drawn
+parameters, m_* metrics, pass_* criteria, success, seeds), DIR/report.md, report.json,
+failure_map.png.
+"""
+
+
+def _positive_int(text: str) -> int:
+    try:
+        v = int(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"invalid value {text!r}: expected an integer") from None
+    if v < 1:
+        raise argparse.ArgumentTypeError(f"invalid value {text!r}: must be >= 1")
+    return v
+
+
+def _index(text: str) -> int:
+    try:
+        v = int(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"invalid value {text!r}: expected an integer") from None
+    if v < 0:
+        raise argparse.ArgumentTypeError(f"invalid value {text!r}: must be >= 0")
+    return v
+
+
+def register(subparsers) -> None:
+    p = subparsers.add_parser(
+        "campaign",
+        help="randomized grasp campaigns (process pool or Ray), resumable, with a report",
+        description=(
+            "Run runs 0..N-1 of a campaign file (distributions over object, contact, pushes, "
+            "sensors and controller-plant mismatch; controllers to compare; master seed), "
+            "stream the results to DIR and write the report. 'replay DIR --run ID' reruns one "
+            "grasp with its figures; 'report DIR' rewrites the report."
+        ),
+        epilog=_EPILOG,
+        formatter_class=argparse.RawDescriptionHelpFormatter,
+    )
+    p.add_argument("target", nargs="+", metavar="CONFIG",
+                   help="campaign YAML file, or 'replay DIR', or 'report DIR'")
+    p.add_argument("--runs", type=_positive_int, metavar="N", help="number of runs (0..N-1)")
+    p.add_argument("--workers", type=_positive_int, default=None, metavar="W",
+                   help="parallel workers (default: the CPUs this process may use)")
+    p.add_argument("--backend", choices=("process", "ray"), default="process",
+                   help="local process pool (default) or Ray")
+    p.add_argument("--ray-address", default=None, metavar="ADDR",
+                   help="Ray cluster address ('auto' or host:port); default: a local instance")
+    p.add_argument("--out", type=Path, metavar="DIR", help="results directory")
+    p.add_argument("--run", dest="run_id", type=_index, metavar="ID", help="replay: the run index")
+    p.add_argument("--controller", action="append", default=None, metavar="NAME",
+                   help="replay: only this controller (repeatable; default: all)")
+    p.add_argument("--no-report", action="store_true", help="do not write the report")
+    p.add_argument("--no-figures", action="store_true", help="report/replay without figures")
+    p.add_argument("--quiet", action="store_true", help="no progress line")
+    p.set_defaults(run=run)
+
+
+def _run_campaign(args) -> int:
+    from ..campaign import load_campaign, run_campaign, write_report
+
+    if len(args.target) != 1:
+        raise CliError(f"expected one campaign file, got {' '.join(args.target)}")
+    if args.runs is None:
+        raise CliError("--runs N is required")
+    if args.out is None:
+        raise CliError("--out DIR is required")
+    if args.run_id is not None or args.controller:
+        raise CliError("--run and --controller belong to 'lugrip campaign replay DIR'")
+    if args.ray_address and args.backend != "ray":
+        raise CliError("--ray-address needs --backend ray")
+    campaign = load_campaign(args.target[0])
+    affinity = getattr(os, "sched_getaffinity", None)  # Linux; elsewhere every CPU
+    workers = args.workers or max(len(affinity(0)) if affinity else (os.cpu_count() or 1), 1)
+    info = run_campaign(
+        campaign,
+        args.runs,
+        args.out,
+        workers=workers,
+        backend=args.backend,
+        ray_address=args.ray_address,
+        progress=not args.quiet,
+    )
+    rate = info["runs_per_s"]
+    print(
+        f"{campaign.name}: {info['ran']} runs done, {info['skipped']} already in {args.out}"
+        + (f" ({rate:.2f} runs/s on {workers} {args.backend} worker(s))" if info["ran"] else "")
+    )
+    if not args.no_report:
+        paths = write_report(args.out, campaign, figures=not args.no_figures)
+        import json
+
+        data = json.loads(paths["json"].read_text())
+        for c, s in data["summary"].items():
+            lo, hi = s["wilson95"]
+            print(f"  {c}: {s['successes']}/{s['runs']} held ({100 * s['success_rate']:.1f} %, "
+                  f"95 % interval {100 * lo:.1f}-{100 * hi:.1f} %)")
+        print(f"report: {paths['markdown']}")
+    return 0
+
+
+def run(args) -> int:
+    head = args.target[0]
+    if head in ("replay", "report") and not Path(head).is_file():
+        if len(args.target) != 2:
+            raise CliError(f"usage: lugrip campaign {head} DIR" + (" --run ID" if head == "replay" else ""))
+        directory = Path(args.target[1])
+        from ..campaign import load_results_campaign, write_report
+        from ..campaign.replay import replay_command
+
+        if head == "report":
+            campaign = load_results_campaign(directory)
+            paths = write_report(directory, campaign, figures=not args.no_figures)
+            print(f"report: {paths['markdown']}")
+            return 0
+        if args.run_id is None:
+            raise CliError("replay needs --run ID")
+        return replay_command(directory, args.run_id, controllers=args.controller, out=args.out,
+                              figures=not args.no_figures)
+    return _run_campaign(args)
+
