@@ -355,18 +355,19 @@ def test_slip_reflex_reacts_within_one_command_period_without_speed():
     name=st.sampled_from(["loop_gain_p", "loop_gain_i", "feedforward_slippage", "reflex_slippage",
                           "reflex_factor", "reflex_samples"]),
     value=st.one_of(st.floats(max_value=0.0), st.just(math.nan), st.just(math.inf),
-                    st.floats(min_value=1.0001, max_value=1e9)),
+                    st.floats(min_value=1.0001, max_value=1e9),
+                    st.sampled_from([1e-3, 9.99e-4, 0.5, 1e3, 1000.5, 1e9, 1.01e9])),
 )
 @settings(max_examples=60, deadline=None)
 def test_new_settings_are_validated(name, value):
     """Out-of-range values of the new settings are refused, naming the field; values inside
     their range are accepted."""
     valid = {
-        "loop_gain_p": lambda v: math.isfinite(v) and v > 0,
-        "loop_gain_i": lambda v: math.isfinite(v) and v > 0,
-        "feedforward_slippage": lambda v: 0 < v <= 1,
-        "reflex_slippage": lambda v: 0 < v <= 1,
-        "reflex_factor": lambda v: math.isfinite(v) and v > 1,
+        "loop_gain_p": lambda v: 0 < v <= 1e9,
+        "loop_gain_i": lambda v: 0 < v <= 1e9,
+        "feedforward_slippage": lambda v: 1e-3 <= v <= 1,
+        "reflex_slippage": lambda v: 1e-3 <= v <= 1,
+        "reflex_factor": lambda v: 1 < v <= 1e3,
         "reflex_samples": lambda v: math.isfinite(v) and v >= 1 and v == int(v) and v < 2**31,
     }[name]
     if name == "reflex_samples" and not (math.isfinite(value) and value == int(value)):

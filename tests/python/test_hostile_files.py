@@ -139,16 +139,36 @@ def test_good_file_still_passes(tmp_path, capsys):
 
 # --- the expensive files, in a child process with measured CPU time and memory ---------------
 
+_HWM_MARK = "lugrip-test-peak-rss-kB "
+
+# The child reports its own peak resident set (VmHWM of the process image after exec): the
+# ru_maxrss that wait4 returns also counts the pages of the forking parent (pytest, which holds
+# hundreds of MB late in a full run), and would measure the test runner instead of lugrip.
+_CHILD = (
+    "import atexit, runpy, sys\n"
+    "def _peak():\n"
+    "    for line in open('/proc/self/status'):\n"
+    "        if line.startswith('VmHWM:'):\n"
+    f"            sys.stderr.write('\\n{_HWM_MARK}' + line.split()[1] + '\\n')\n"
+    "atexit.register(_peak)\n"
+    "sys.argv = ['lugrip'] + sys.argv[1:]\n"
+    "runpy.run_module('lugrip', run_name='__main__')\n"
+)
+
+
 def _run_measured(args: list[str]) -> tuple[int, str, float, float]:
     """Runs `python -m lugrip ARGS`; returns (exit code, stderr, CPU seconds, peak RSS MB)."""
-    proc = subprocess.Popen([sys.executable, "-m", "lugrip", *args], stdout=subprocess.DEVNULL,
+    proc = subprocess.Popen([sys.executable, "-c", _CHILD, *args], stdout=subprocess.DEVNULL,
                             stderr=subprocess.PIPE, env={**os.environ, "LUGRIP_DEBUG": ""})
     start = time.monotonic()
     err = proc.stderr.read().decode(errors="replace")
     _, status, usage = os.wait4(proc.pid, 0)
     proc.returncode = os.waitstatus_to_exitcode(status)
     assert time.monotonic() - start < 60
-    return proc.returncode, err, usage.ru_utime + usage.ru_stime, usage.ru_maxrss / 1024.0
+    body, mark, peak = err.rpartition(_HWM_MARK)
+    assert mark, err
+    return (proc.returncode, body.rstrip("\n") + "\n", usage.ru_utime + usage.ru_stime,
+            float(peak) / 1024.0)
 
 
 @pytest.mark.parametrize("name", ["alias_bomb", "nesting_100000", "oversized"])

@@ -66,7 +66,7 @@ def replay(directory: str | Path, index: int, *, controllers=None, out: str | Pa
     paths = {}
     if figures:
         from .. import plot
-        from ..plot_experiments import _force_s_omega, figure_baselines
+        from ..plot.experiments import _force_s_omega, figure_baselines
 
         res = types.SimpleNamespace(
             scenario=scn, runs={k: v[0] for k, v in runs.items()},
