@@ -24,6 +24,20 @@ void bind_closed_loop(nb::module_& m) {
       .value("SlippingAvoidance", ModeAction::SlippingAvoidance)
       .value("DynamicOn", ModeAction::DynamicOn)
       .value("DynamicOff", ModeAction::DynamicOff);
+  nb::enum_<FaultKind>(m, "FaultKind", "Injected sensor or actuator fault.")
+      .value("Dropout", FaultKind::Dropout)
+      .value("NanBurst", FaultKind::NanBurst)
+      .value("Spike", FaultKind::Spike)
+      .value("BiasDrift", FaultKind::BiasDrift)
+      .value("Saturation", FaultKind::Saturation)
+      .value("Stuck", FaultKind::Stuck)
+      .value("Dead", FaultKind::Dead)
+      .value("ContactLoss", FaultKind::ContactLoss)
+      .value("ActuatorLag", FaultKind::ActuatorLag)
+      .value("ActuatorSaturation", FaultKind::ActuatorSaturation);
+  nb::class_<FaultSpec> fault(m, "FaultSpec");
+  fault.def(nb::init<>());
+  def_fields_rw(fault);
   nb::class_<ModeEvent> event(m, "ModeEvent");
   event.def(nb::init<>());
   def_fields_rw(event);
@@ -32,6 +46,9 @@ void bind_closed_loop(nb::module_& m) {
       .def("clear_schedule", [](ClosedLoopConfig& c) { c.schedule.clear(); })
       .def("add_event", [](ClosedLoopConfig& c, double t, ModeAction a) { c.schedule.push_back(ModeEvent{t, a}); },
            "time"_a, "action"_a)
+      .def("add_fault", [](ClosedLoopConfig& c, const FaultSpec& f) { c.faults.push_back(f); }, "fault"_a)
+      .def("clear_faults", [](ClosedLoopConfig& c) { c.faults.clear(); })
+      .def_prop_ro("n_faults", [](const ClosedLoopConfig& c) { return c.faults.size(); })
       .def_prop_ro("n_events", [](const ClosedLoopConfig& c) { return c.schedule.size(); });
   def_fields_rw(config);
   nb::class_<ClosedLoopSample> sample(m, "ClosedLoopSample");

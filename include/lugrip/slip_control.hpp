@@ -20,6 +20,9 @@ struct SlipControlSettings {
   ObserverSettings observer;            //!< settings of each finger's Observer
   GraspControllerSettings controller;   //!< settings of the GraspController
   int fingers = 2;                      //!< fingertips measured: 1 or 2
+  //! A finger whose four channels repeat bit for bit for this many consecutive samples is
+  //! reported SensorFault (a frozen sensor; a noisy sensor never repeats exactly). 0: off.
+  int stuck_samples = 0;                //!< [samples], >= 0
 };
 
 //! Checks both nested settings, the finger count and the rate consistency; one line per problem
@@ -57,7 +60,9 @@ struct SlipControlOutput {
 //! speed resolution and the observer status to the GraspController and returns its command.
 //! The statuses travel inside: when a finger's observer reports anything but a valid estimate
 //! (NoContact on contact loss, InvalidSample, SensorFault, an unknown code) the command due in
-//! that cycle is held at the last command (plus invalid_raise_step), never lowered.
+//! that cycle is held at the last command (plus invalid_raise_step), never lowered. With
+//! stuck_samples > 0 a finger whose wrench repeats exactly that many times in a row is reported
+//! SensorFault (its observer keeps running) until the wrench changes.
 //!
 //! Lifecycle: construct (validates, allocates the contact tables) -> step() / the run-time
 //! calls (noexcept, no allocation) -> reset(). set_mu() rebuilds the tables: not real-time.
@@ -115,6 +120,8 @@ class SlipControl {
   std::array<Observer, kMaxFingers> obs_;
   GraspController ctrl_;
   GraspControllerInput cin_{};
+  std::array<FingerWrench, kMaxFingers> prev_{};  // previous wrench per finger (stuck check)
+  std::array<int, kMaxFingers> repeats_{};        // consecutive exact repeats per finger
 };
 
 }  // namespace lugrip
