@@ -69,6 +69,8 @@ class SlipControl:
             parameters were identified with (its ``observer:`` block): that is the observer used,
             with ``observer`` overriding it key by key.
         fingers: 1 or 2 fingertips measured.
+        stuck_samples: a finger whose four channels repeat bit for bit this many samples in a
+            row is reported SensorFault (a frozen sensor) and the command is held; 0: off.
         observer: keywords of :class:`lugrip.Observer` (integrator, bandwidth, torque_noise, ...).
             Its ``dt`` defaults to 1 / ``sensor_rate`` when neither the file nor this mapping
             gives one.
@@ -98,6 +100,7 @@ class SlipControl:
         *,
         fingers: int = 2,
         observer: Mapping[str, Any] | None = None,
+        stuck_samples: int = 0,
         **controller: Any,
     ):
         path = _params_path(params)
@@ -113,6 +116,9 @@ class SlipControl:
         if isinstance(fingers, bool) or fingers not in (1, 2):
             raise ValueError(f"fingers = {fingers!r}: must be 1 or 2")
         s.fingers = int(fingers)
+        if isinstance(stuck_samples, bool) or not isinstance(stuck_samples, int) or stuck_samples < 0:
+            raise ValueError(f"stuck_samples = {stuck_samples!r}: must be an integer >= 0 (0: off)")
+        s.stuck_samples = int(stuck_samples)
         try:
             self._sc = _core.SlipControl(_model(self._params), s)
         except ValueError as err:
