@@ -129,6 +129,7 @@ def test_report_has_a_row_per_fault(results):
     ("block", "field"),
     [
         ({"inject": []}, "faults.inject"),
+        ({"stuck_samples": 3}, "faults.inject"),
         ({"inject": [{"kind": "melt"}]}, "faults[0].kind"),
         ({"inject": [{"kind": "spike", "size": 1}]}, "unknown field"),
         ({"inject": [{"kind": "spike", "burst": 1.5}]}, "faults[0].burst"),

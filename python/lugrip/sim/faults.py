@@ -68,8 +68,8 @@ _BLOCK_KEYS = {"inject", "stuck_samples", "expect_status", "onset"}
 
 
 def fault_block(value: Any, where: str) -> dict:
-    """The validated ``faults:`` block (empty dict when absent)."""
-    if value is None:
+    """The validated ``faults:`` block (empty dict when absent or empty)."""
+    if value is None or (isinstance(value, Mapping) and not value):
         return {}
     if not isinstance(value, Mapping):
         raise ValueError(f"{where}: faults: expected a mapping with 'inject'")
