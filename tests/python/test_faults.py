@@ -137,6 +137,7 @@ def test_report_has_a_row_per_fault(results):
         ({"inject": [{"kind": "stuck"}], "stuck_samples": -1}, "stuck_samples"),
         ({"inject": [{"kind": "stuck"}], "expect_status": ["ok"]}, "expect_status"),
         ({"inject": [{"kind": "stuck"}], "when": 1}, "unknown key"),
+        ({"inject": [{"kind": "spike", "every": -3}]}, "faults[0].every"),
     ],
 )
 def test_bad_fault_blocks_name_the_field(block, field):

@@ -31,6 +31,7 @@ from typing import Any
 
 import numpy as np
 
+from .. import _core
 from .._controller import static_grasp_force
 from ._closed_loop import ClosedLoopRun, fault_specs
 
@@ -81,9 +82,16 @@ def fault_block(value: Any, where: str) -> dict:
     if not isinstance(inject, Sequence) or isinstance(inject, (str, bytes)) or not inject:
         raise ValueError(f"{where}: faults.inject: expected a non-empty list of faults")
     try:
-        fault_specs(inject)
+        specs = fault_specs(inject)
     except ValueError as err:
         raise ValueError(f"{where}: faults.{err}") from None
+    # the C++ checks of the fault fields, now (a default config: only its fault lines count)
+    probe = _core.ClosedLoopConfig()
+    for f in specs:
+        probe.add_fault(f)
+    bad = [x for x in _core.validate_closed_loop_config(probe).splitlines() if x.startswith("faults")]
+    if bad:
+        raise ValueError(f"{where}: {bad[0]}")
     stuck = d.get("stuck_samples", 0)
     if isinstance(stuck, bool) or not isinstance(stuck, int) or stuck < 0:
         raise ValueError(f"{where}: faults.stuck_samples = {stuck!r}: must be an integer >= 0")
