@@ -101,9 +101,7 @@ def test_actuator_saturation_caps_what_the_gripper_gets():
     s.duration = 7.5
     run = sc.simulate(s, s.plant_config(), "patch", [])
     sl = run.window(5.0, 7.5)
-    np.testing.assert_array_equal(
-        run["actuator_command"][sl], np.minimum(run["command"][sl], 5.0)
-    )
+    np.testing.assert_array_equal(run["actuator_command"][sl], np.minimum(run["command"][sl], 5.0))
     # the controller does not know: its command winds up above the cap during the push
     assert np.max(run["command"][sl]) > 5.5
 

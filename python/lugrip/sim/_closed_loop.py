@@ -74,7 +74,7 @@ def fault_specs(items: Iterable[Mapping[str, Any]] | None) -> list[_core.FaultSp
     out = []
     for k, item in enumerate(items or []):
         if not isinstance(item, Mapping):
-            raise ValueError(f"faults[{k}]: expected a mapping with a 'kind', got {item!r}")
+            raise ValueError(f"faults[{k}]: expected a mapping with a 'kind', got {item!r}")  # noqa: TRY004 (file content)
         d = dict(item)
         kind = str(d.pop("kind", "")).lower().replace("-", "_")
         if kind not in FAULT_KINDS:

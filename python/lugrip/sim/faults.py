@@ -73,7 +73,7 @@ def fault_block(value: Any, where: str) -> dict:
     if value is None or (isinstance(value, Mapping) and not value):
         return {}
     if not isinstance(value, Mapping):
-        raise ValueError(f"{where}: faults: expected a mapping with 'inject'")
+        raise ValueError(f"{where}: faults: expected a mapping with 'inject'")  # noqa: TRY004 (file content)
     unknown = sorted(set(value) - _BLOCK_KEYS)
     if unknown:
         raise ValueError(f"{where}: faults: unknown key(s) {', '.join(map(str, unknown))}")
@@ -89,7 +89,9 @@ def fault_block(value: Any, where: str) -> dict:
     probe = _core.ClosedLoopConfig()
     for f in specs:
         probe.add_fault(f)
-    bad = [x for x in _core.validate_closed_loop_config(probe).splitlines() if x.startswith("faults")]
+    bad = [
+        x for x in _core.validate_closed_loop_config(probe).splitlines() if x.startswith("faults")
+    ]
     if bad:
         raise ValueError(f"{where}: {bad[0]}")
     stuck = d.get("stuck_samples", 0)
@@ -134,7 +136,9 @@ def fault_metrics(block: Mapping[str, Any], run: ClosedLoopRun, cfg) -> dict[str
     min_force = None
     if pre.stop > pre.start:
         ft = float(np.mean(0.5 * (run["f_t_true_0"][pre] + run["f_t_true_1"][pre])))
-        tau = float(np.mean(0.5 * (np.abs(run["tau_true_0"][pre]) + np.abs(run["tau_true_1"][pre]))))
+        tau = float(
+            np.mean(0.5 * (np.abs(run["tau_true_0"][pre]) + np.abs(run["tau_true_1"][pre])))
+        )
         min_force = float(static_grasp_force(cfg.contact, ft, tau, 1.0))
     cmd = np.asarray(run["command"], dtype=float)
     after = cmd[i0:]
@@ -180,9 +184,11 @@ def evaluate(name: str, limit: Any, m: Mapping[str, Any]) -> dict[str, Any] | No
 def fault_table(results) -> str:
     """Markdown table, one row per fault scenario (results whose metrics carry fault metrics)."""
     rows = [
-        "| scenario | faults | expected status | status latency [samples] | statuses raised "
-        "| dropped | hold slip [mm] | hold rotation [°] | min command [N] | slip force [N] "
-        "| min command / slip force | pass |",
+        (
+            "| scenario | faults | expected status | status latency [samples] | statuses raised "
+            "| dropped | hold slip [mm] | hold rotation [°] | min command [N] | slip force [N] "
+            "| min command / slip force | pass |"
+        ),
         "|" + "---|" * 12,
     ]
     for r in results:

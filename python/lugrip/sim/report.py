@@ -199,9 +199,11 @@ def markdown_section(
         lines += [
             "### Sensor and actuator faults (one row per fault scenario)",
             "",
-            "Status latency: samples (500 Hz) from the fault onset to the first cycle whose "
-            "status is the expected one; slip force: `static_grasp_force(..., s_ref=1)` of the "
-            "true loads in the second before the onset.",
+            (
+                "Status latency: samples (500 Hz) from the fault onset to the first cycle whose "
+                "status is the expected one; slip force: `static_grasp_force(..., s_ref=1)` of "
+                "the true loads in the second before the onset."
+            ),
             "",
             faults,
             "",
