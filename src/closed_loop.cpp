@@ -98,6 +98,15 @@ void validate_fault(const FaultSpec& f, const std::string& p, std::string& msg) 
 }
 }  // namespace
 
+bool validate(const std::vector<FaultSpec>& faults, std::string* message) {
+  std::string msg;
+  if (faults.size() > static_cast<size_t>(kMaxFaults))
+    msg += "faults: " + std::to_string(faults.size()) + " faults, at most " + std::to_string(kMaxFaults) + "\n";
+  for (size_t i = 0; i < faults.size(); ++i) validate_fault(faults[i], "faults[" + std::to_string(i) + "].", msg);
+  if (message) *message = msg;
+  return msg.empty();
+}
+
 bool validate(const ClosedLoopConfig& c, std::string* message) {
   std::string msg, sub;
   if (!validate(c.plant, &sub)) append_prefixed(msg, sub, "plant.");
@@ -133,9 +142,7 @@ bool validate(const ClosedLoopConfig& c, std::string* message) {
     const int a = static_cast<int>(e.action);
     if (a < 0 || a > 3) msg += f + "action = " + std::to_string(a) + ": unknown action\n";
   }
-  if (c.faults.size() > static_cast<size_t>(kMaxFaults))
-    msg += "faults: " + std::to_string(c.faults.size()) + " faults, at most " + std::to_string(kMaxFaults) + "\n";
-  for (size_t i = 0; i < c.faults.size(); ++i) validate_fault(c.faults[i], "faults[" + std::to_string(i) + "].", msg);
+  if (!validate(c.faults, &sub)) msg += sub;
   if (c.stuck_samples < 0)
     msg += "stuck_samples = " + std::to_string(c.stuck_samples) + ": must be >= 0 (0: off) [samples]\n";
   if (message) *message = msg;
@@ -221,7 +228,10 @@ SlipControl make_slip_control(const ClosedLoopConfig& c, const GraspPlant& plant
 }  // namespace
 
 ClosedLoop::ClosedLoop(const ClosedLoopConfig& config)
-    : cfg_(sorted(checked(config))), plant_(cfg_.plant), sc_(make_slip_control(cfg_, plant_)) {
+    : cfg_(sorted(checked(config))),
+      plant_(cfg_.plant),
+      sc_(make_slip_control(cfg_, plant_)),
+      faults_(cfg_.faults, 1.0 / cfg_.plant.sensor.rate) {
   dt_ = 1.0 / cfg_.plant.sensor.rate;
   ratio_ = cfg_.controller.command_ratio;
   reset();
@@ -241,16 +251,28 @@ void ClosedLoop::reset() noexcept {
   cone_fn_sum_ = {0.0, 0.0};
   cone_ft_sum_ = {0.0, 0.0};
   cone_count_ = 0;
+  faults_.reset(command_);
+}
+
+FaultInjector::FaultInjector(const std::vector<FaultSpec>& faults, double sample_period) : faults_(faults) {
+  std::string msg;
+  if (!validate(faults, &msg)) throw std::invalid_argument("invalid faults:\n" + msg);
+  if (!(std::isfinite(sample_period) && sample_period > 0.0))
+    throw std::invalid_argument("FaultInjector: sample_period = " + num(sample_period) + ": must be finite and > 0 [s]");
+  dt_ = sample_period;
+  reset();
+}
+
+void FaultInjector::reset(double command) noexcept {
   last_ = {};
   frozen_ = {};
   was_active_ = {};
-  lag_state_ = command_;
-  last_actuator_ = command_;
+  lag_state_ = command;
+  last_actuator_ = command;
   lag_init_ = false;
 }
 
-bool ClosedLoop::fault_on(const FaultSpec& f, int k, int64_t n) const noexcept {
-  (void)k;
+bool FaultInjector::on(const FaultSpec& f, int64_t n) const noexcept {
   const double t = static_cast<double>(n) * dt_;
   if (t < f.t_start - 0.5 * dt_ || t >= f.t_start + f.duration - 0.5 * dt_) return false;
   if (f.every <= 0) return true;
@@ -258,24 +280,24 @@ bool ClosedLoop::fault_on(const FaultSpec& f, int k, int64_t n) const noexcept {
   return (n - k0) % f.every < f.burst;
 }
 
-bool ClosedLoop::apply_sensor_faults(int64_t n, SlipControlInput& in) noexcept {
+bool FaultInjector::sensors(int64_t n, std::array<FingerWrench, kMaxFingers>& fingers) noexcept {
   const double nan = std::numeric_limits<double>::quiet_NaN();
   bool any = false;
-  const int count = static_cast<int>(std::min(cfg_.faults.size(), static_cast<size_t>(kMaxFaults)));
+  const int count = static_cast<int>(std::min(faults_.size(), static_cast<size_t>(kMaxFaults)));
   for (int k = 0; k < count; ++k) {
-    const FaultSpec& f = cfg_.faults[k];
+    const FaultSpec& f = faults_[k];
     if (f.kind == FaultKind::ActuatorLag || f.kind == FaultKind::ActuatorSaturation) continue;
-    const bool on = fault_on(f, k, n);
-    const bool onset = on && !was_active_[k];
-    was_active_[k] = on;
-    if (!on) continue;
+    const bool active = on(f, n);
+    const bool onset = active && !was_active_[k];
+    was_active_[k] = active;
+    if (!active) continue;
     any = true;
     const double t_rel = static_cast<double>(n) * dt_ - f.t_start;
     const int64_t k0 = static_cast<int64_t>(std::llround(f.t_start / dt_));
     const int64_t burst_index = f.every > 0 ? (n - k0) / f.every : 0;
     for (int i = 0; i < 2; ++i) {
       if (f.finger >= 0 && f.finger != i) continue;
-      FingerWrench& w = in.fingers[i];
+      FingerWrench& w = fingers[i];
       switch (f.kind) {
         case FaultKind::Dropout: w = last_[i]; break;
         case FaultKind::NanBurst: w = FingerWrench{nan, nan, nan, nan}; break;
@@ -308,20 +330,20 @@ bool ClosedLoop::apply_sensor_faults(int64_t n, SlipControlInput& in) noexcept {
   }
   // Dropout repeats what was delivered (a NaN burst leaves the last finite sample in place).
   for (int i = 0; i < 2; ++i) {
-    const FingerWrench& w = in.fingers[i];
+    const FingerWrench& w = fingers[i];
     if (std::isfinite(w.f_n) && std::isfinite(w.f_x) && std::isfinite(w.f_y) && std::isfinite(w.tau)) last_[i] = w;
   }
   return any;
 }
 
-double ClosedLoop::apply_actuator_faults(int64_t n, double command, bool& active) noexcept {
+double FaultInjector::actuator(int64_t n, double command, bool& active) noexcept {
   double f = command;
-  const int count = static_cast<int>(std::min(cfg_.faults.size(), static_cast<size_t>(kMaxFaults)));
+  const int count = static_cast<int>(std::min(faults_.size(), static_cast<size_t>(kMaxFaults)));
   bool lagged = false;
   for (int k = 0; k < count; ++k) {
-    const FaultSpec& fs = cfg_.faults[k];
+    const FaultSpec& fs = faults_[k];
     if (fs.kind != FaultKind::ActuatorLag && fs.kind != FaultKind::ActuatorSaturation) continue;
-    if (!fault_on(fs, k, n)) continue;
+    if (!on(fs, n)) continue;
     active = true;
     if (fs.kind == FaultKind::ActuatorSaturation) {
       f = std::min(f, fs.force);
@@ -392,7 +414,7 @@ Status ClosedLoop::step(ClosedLoopSample& out) noexcept {
     const FingerSample& s = plant_.sensor_sample(i);
     sin.fingers[i] = FingerWrench{s.f_n, s.f_x, s.f_y, s.tau};
   }
-  bool fault = cfg_.faults.empty() ? false : apply_sensor_faults(n_, sin);
+  bool fault = faults_.empty() ? false : faults_.sensors(n_, sin.fingers);
   const bool lugrip_active = started_ && cfg_.kind == ControllerKind::Lugrip;
   const Status status = lugrip_active ? sc_.step(sin, sout_) : sc_.observe(sin, sout_);
   for (int i = 0; i < 2; ++i) {
@@ -442,7 +464,7 @@ Status ClosedLoop::step(ClosedLoopSample& out) noexcept {
         break;
     }
   }
-  const double actuator = cfg_.faults.empty() ? command_ : apply_actuator_faults(n_, command_, fault);
+  const double actuator = faults_.empty() ? command_ : faults_.actuator(n_, command_, fault);
   plant_.set_command(actuator);
 
   const PlantState& st = plant_.state();

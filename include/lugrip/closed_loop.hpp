@@ -93,6 +93,45 @@ struct FaultSpec {
   double time_constant = 0.0;  //!< [s]
 };
 
+//! Most faults one closed loop injects.
+constexpr int kMaxFaults = 16;
+
+//! Checks every fault (one line per problem, prefixed "faults[i]."). Returns true when valid.
+bool validate(const std::vector<FaultSpec>& faults, std::string* message);
+
+//! Applies a list of faults to the wrenches of each sensor sample and to the command sent to the
+//! gripper (ClosedLoop uses one; a simulator of its own, e.g. the MuJoCo loop, can too).
+//! Lifecycle: construct (validates, copies the list) -> sensors()/actuator() once per sample,
+//! in sample order (noexcept, no allocation) -> reset().
+class FaultInjector {
+ public:
+  FaultInjector() = default;
+  //! sample_period [s] > 0. Throws std::invalid_argument for an invalid fault list.
+  FaultInjector(const std::vector<FaultSpec>& faults, double sample_period);
+  //! Back to before the first sample; `command` [N] is the gripper's command before it.
+  void reset(double command = 0.0) noexcept;
+  //! Sensor faults of sample n (t = n * sample_period) applied to the fingers' wrenches in
+  //! place. Returns true when a fault acted.
+  bool sensors(int64_t n, std::array<FingerWrench, kMaxFingers>& fingers) noexcept;
+  //! Actuator faults of sample n: the command [N] that reaches the gripper; sets `active`
+  //! when a fault acted (leaves it unchanged otherwise).
+  double actuator(int64_t n, double command, bool& active) noexcept;
+  bool empty() const noexcept { return faults_.empty(); }
+  const std::vector<FaultSpec>& faults() const noexcept { return faults_; }
+
+ private:
+  std::vector<FaultSpec> faults_;
+  double dt_ = 0.002;
+  std::array<FingerWrench, kMaxFingers> last_{};   // last wrench delivered per finger
+  std::array<FingerWrench, kMaxFingers> frozen_{}; // Stuck: wrench at the onset per finger
+  std::array<bool, kMaxFaults> was_active_{};
+  double lag_state_ = 0.0;      // ActuatorLag filter output [N]
+  double last_actuator_ = 0.0;  // command that reached the gripper at the last sample [N]
+  bool lag_init_ = false;
+
+  bool on(const FaultSpec& f, int64_t n) const noexcept;
+};
+
 //! One scheduled action, applied before the first sensor sample with t >= time.
 struct ModeEvent {
   double time = 0.0;  //!< [s]
@@ -134,9 +173,6 @@ struct ClosedLoopConfig {
   std::vector<FaultSpec> faults;
   int stuck_samples = 0;
 };
-
-//! Most faults one closed loop injects.
-constexpr int kMaxFaults = 16;
 
 //! Checks the plant config, the observer and controller settings, the rate consistency and the
 //! baseline fields; one line per problem in *message. Returns true when valid.
@@ -234,18 +270,9 @@ class ClosedLoop {
   std::array<double, 2> cone_fn_sum_{}, cone_ft_sum_{};  // friction cone: sums this period
   int cone_count_ = 0;
   SlipControlOutput sout_;
-  // fault injection
-  std::array<FingerWrench, 2> last_{};  // last wrench delivered per finger
-  std::array<FingerWrench, 2> frozen_{}; // Stuck: wrench at the onset per finger
-  std::array<bool, kMaxFaults> was_active_{};
-  double lag_state_ = 0.0;              // ActuatorLag filter output [N]
-  double last_actuator_ = 0.0;          // command that reached the gripper last sample [N]
-  bool lag_init_ = false;
+  FaultInjector faults_;
 
   void apply_events(double t) noexcept;
-  bool fault_on(const FaultSpec& f, int k, int64_t n) const noexcept;
-  bool apply_sensor_faults(int64_t n, SlipControlInput& in) noexcept;
-  double apply_actuator_faults(int64_t n, double command, bool& active) noexcept;
   void cone_command() noexcept;
 };
 
