@@ -122,7 +122,8 @@ struct Table<SlipControlSettings> {
       field("observer", &S::observer, "settings of each finger's observer (ObserverSettings)"),
       field("controller", &S::controller, "controller settings (GraspControllerSettings)"),
       field("fingers", &S::fingers, "fingertips measured: 1 or 2"),
-      field("stuck_samples", &S::stuck_samples, "exact repeats of a wrench reported SensorFault [samples] (0: off)"));
+      field("stuck_samples", &S::stuck_samples, "exact repeats of a wrench reported SensorFault [samples] (0: off)"),
+      field("healthy_finger_fallback", &S::healthy_finger_fallback, "one faulty finger: the other drives the command"));
 };
 
 template <>
@@ -386,7 +387,8 @@ struct Table<ClosedLoopConfig> {
       field("controller_start", &S::controller_start, "[s]"),
       field("constant_force", &S::constant_force, "[N]"), field("cone_margin", &S::cone_margin, "[-]"),
       field("cone_release_rate", &S::cone_release_rate, "[N/s]"),
-      field("stuck_samples", &S::stuck_samples, "exact wrench repeats reported SensorFault [samples] (0: off)"));
+      field("stuck_samples", &S::stuck_samples, "exact wrench repeats reported SensorFault [samples] (0: off)"),
+      field("healthy_finger_fallback", &S::healthy_finger_fallback, "SlipControlSettings::healthy_finger_fallback"));
 };
 
 template <>

@@ -219,6 +219,7 @@ SlipControlSettings slip_settings(const ClosedLoopConfig& c) {
   s.controller = c.controller;
   s.fingers = 2;
   s.stuck_samples = c.stuck_samples;
+  s.healthy_finger_fallback = c.healthy_finger_fallback;
   return s;
 }
 // The plant's contact model (tables shared by copy) or one built from the estimator parameters.

@@ -86,10 +86,20 @@ Status SlipControl::observe(const SlipControlInput& in, SlipControlOutput& out) 
 }
 
 Status SlipControl::step(const SlipControlInput& in, SlipControlOutput& out) noexcept {
-  observe(in, out);
+  const Status worst = observe(in, out);
+  int faulty = -1, n_faulty = 0;
+  if (s_.healthy_finger_fallback && s_.fingers == 2)
+    for (int i = 0; i < 2; ++i)
+      if (!is_valid(cin_.fingers[i].status)) {
+        faulty = i;
+        ++n_faulty;
+      }
+  if (n_faulty == 1) cin_.fingers[faulty].present = false;  // this cycle only
   ctrl_.step(cin_, out.controller);
+  if (n_faulty == 1) cin_.fingers[faulty].present = true;
   out.force = out.controller.force;
   out.status = out.controller.status;
+  if (n_faulty == 1 && out.status == Status::Ok) out.status = worst;
   return out.status;
 }
 

@@ -156,6 +156,7 @@ struct ModeEvent {
 //! | schedule | mode actions (sorted by time at construction) | | {} |
 //! | faults | injected sensor/actuator faults (at most kMaxFaults) | | {} |
 //! | stuck_samples | SlipControlSettings::stuck_samples of the lugrip law (0: off) | samples | 0 |
+//! | healthy_finger_fallback | SlipControlSettings::healthy_finger_fallback | | false |
 struct ClosedLoopConfig {
   PlantConfig plant;
   ObserverSettings observer;
@@ -172,6 +173,7 @@ struct ClosedLoopConfig {
   std::vector<ModeEvent> schedule;
   std::vector<FaultSpec> faults;
   int stuck_samples = 0;
+  bool healthy_finger_fallback = false;
 };
 
 //! Checks the plant config, the observer and controller settings, the rate consistency and the

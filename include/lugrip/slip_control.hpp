@@ -23,6 +23,10 @@ struct SlipControlSettings {
   //! A finger whose four channels repeat bit for bit for this many consecutive samples is
   //! reported SensorFault (a frozen sensor; a noisy sensor never repeats exactly). 0: off.
   int stuck_samples = 0;                //!< [samples], >= 0
+  //! Two fingers, one without a valid estimate (dead, frozen, no contact, invalid samples):
+  //! the other finger alone drives the controller instead of holding the command. The cycle
+  //! status still reports the faulty finger. false: hold (the default).
+  bool healthy_finger_fallback = false;
 };
 
 //! Checks both nested settings, the finger count and the rate consistency; one line per problem
@@ -48,7 +52,9 @@ struct SlipControlInput {
 struct SlipControlOutput {
   double force = 0.0;  //!< grasp-force command to send [N], in [f_min, f_max], finite
   //! Ok, or the worst status of this cycle (the controller's combination of the finger
-  //! statuses); any status but Ok means the command was held at the last command due.
+  //! statuses); any status but Ok means the command was held at the last command due, except
+  //! under healthy_finger_fallback, where one faulty finger is reported while the other
+  //! finger's estimate computes the command.
   Status status = Status::Ok;
   GraspControllerOutput controller;                   //!< full controller output
   std::array<ObserverOutput, kMaxFingers> fingers{};  //!< each finger's observer output

@@ -71,6 +71,9 @@ class SlipControl:
         fingers: 1 or 2 fingertips measured.
         stuck_samples: a finger whose four channels repeat bit for bit this many samples in a
             row is reported SensorFault (a frozen sensor) and the command is held; 0: off.
+        healthy_finger_fallback: two fingers, one without a valid estimate: the other finger
+            alone computes the command (the status still reports the faulty finger) instead of
+            the command being held.
         observer: keywords of :class:`lugrip.Observer` (integrator, bandwidth, torque_noise, ...).
             Its ``dt`` defaults to 1 / ``sensor_rate`` when neither the file nor this mapping
             gives one.
@@ -101,6 +104,7 @@ class SlipControl:
         fingers: int = 2,
         observer: Mapping[str, Any] | None = None,
         stuck_samples: int = 0,
+        healthy_finger_fallback: bool = False,
         **controller: Any,
     ):
         path = _params_path(params)
@@ -119,6 +123,7 @@ class SlipControl:
         if isinstance(stuck_samples, bool) or not isinstance(stuck_samples, int) or stuck_samples < 0:
             raise ValueError(f"stuck_samples = {stuck_samples!r}: must be an integer >= 0 (0: off)")
         s.stuck_samples = int(stuck_samples)
+        s.healthy_finger_fallback = bool(healthy_finger_fallback)
         try:
             self._sc = _core.SlipControl(_model(self._params), s)
         except ValueError as err:

@@ -235,6 +235,7 @@ def closed_loop_config(
     estimator: ContactParams | Mapping[str, Any] | str | None = None,
     faults: Iterable[Mapping[str, Any]] | None = None,
     stuck_samples: int = 0,
+    healthy_finger_fallback: bool = False,
 ) -> _core.ClosedLoopConfig:
     """The validated C++ ClosedLoopConfig (see :func:`run_closed_loop` for the arguments)."""
     plant = config if isinstance(config, PlantConfig) else PlantConfig.from_dict(config)
@@ -268,6 +269,7 @@ def closed_loop_config(
     if isinstance(stuck_samples, bool) or not isinstance(stuck_samples, int) or stuck_samples < 0:
         raise ValueError(f"stuck_samples = {stuck_samples!r}: must be an integer >= 0 (0: off)")
     c.stuck_samples = int(stuck_samples)
+    c.healthy_finger_fallback = bool(healthy_finger_fallback)
     msg = _core.validate_closed_loop_config(c)
     if msg:
         raise ValueError("invalid closed-loop configuration:\n" + msg.rstrip())
@@ -289,6 +291,7 @@ def run_closed_loop(
     estimator: ContactParams | Mapping[str, Any] | str | None = None,
     faults: Iterable[Mapping[str, Any]] | None = None,
     stuck_samples: int = 0,
+    healthy_finger_fallback: bool = False,
 ) -> ClosedLoopRun:
     """Simulate the grasp in closed loop for `duration` seconds (one C++ call).
 
@@ -319,6 +322,8 @@ def run_closed_loop(
             never altered, only what the observers read and what the gripper receives.
         stuck_samples: the lugrip law reports SensorFault (and holds the command) when a
             finger's wrench repeats bit for bit this many samples in a row; 0: off.
+        healthy_finger_fallback: the lugrip law: with one finger faulty the other computes
+            the command (instead of holding it).
 
     Returns:
         :class:`ClosedLoopRun` (dict of numpy arrays).
@@ -339,6 +344,7 @@ def run_closed_loop(
         estimator=estimator,
         faults=faults,
         stuck_samples=stuck_samples,
+        healthy_finger_fallback=healthy_finger_fallback,
     )
     duration = float(duration)
     if not (math.isfinite(duration) and duration >= 0.0):

@@ -7,6 +7,7 @@ A scenario's ``faults:`` block::
       inject:                        # lugrip._core.FaultSpec fields (sim._closed_loop.fault_specs)
         - {kind: nan_burst, finger: -1, t_start: 6.0, duration: 2.0, burst: 20, every: 200}
       stuck_samples: 25              # SlipControl's frozen-sensor check (0: off)
+      healthy_finger_fallback: false # one faulty finger: the other computes the command
       expect_status: [invalid_sample, sensor_fault]  # statuses that count as "fault raised"
       onset: 6.0                     # [s] default: the earliest t_start of `inject`
 
@@ -19,7 +20,8 @@ The faults act on what the observers read (sensor faults) or on what the gripper
   force at which the object starts to slip under the true loads just before the onset
   (``static_grasp_force`` with S = 1);
 * ``fault_command_lowered``: the largest decrease of the command between consecutive samples
-  whose cycle status is not valid (0 when every flagged cycle held the command).
+  whose cycle status is not valid (0 when every flagged cycle held the command); with
+  ``healthy_finger_fallback`` only samples where neither finger has a valid estimate count.
 """
 
 from __future__ import annotations
@@ -60,12 +62,12 @@ FAULT_CRITERIA = {
         "(true loads before the onset, S = 1) >= limit"
     ),
     "fault_command_held": (
-        "while the cycle status is not valid the command is never lowered (largest decrease "
-        "between such samples <= 1e-9 N)"
+        "while the cycle status is not valid (with healthy_finger_fallback: while neither finger "
+        "is valid) the command is never lowered (largest decrease between such samples <= 1e-9 N)"
     ),
 }
 
-_BLOCK_KEYS = {"inject", "stuck_samples", "expect_status", "onset"}
+_BLOCK_KEYS = {"inject", "stuck_samples", "expect_status", "onset", "healthy_finger_fallback"}
 
 
 def fault_block(value: Any, where: str) -> dict:
@@ -114,6 +116,10 @@ def fault_block(value: Any, where: str) -> dict:
         raise ValueError(f"{where}: faults.onset = {onset!r}: must be a finite number [s]")
     d["onset"] = float(onset)
     d["stuck_samples"] = int(stuck)
+    fallback = d.get("healthy_finger_fallback", False)
+    if not isinstance(fallback, bool):
+        raise ValueError(f"{where}: faults.healthy_finger_fallback = {fallback!r}: must be true or false")
+    d["healthy_finger_fallback"] = fallback
     d["inject"] = [dict(f) for f in inject]
     return d
 
@@ -143,6 +149,10 @@ def fault_metrics(block: Mapping[str, Any], run: ClosedLoopRun, cfg) -> dict[str
     cmd = np.asarray(run["command"], dtype=float)
     after = cmd[i0:]
     flagged = ~np.isin(status, _VALID)
+    if block.get("healthy_finger_fallback"):
+        # one faulty finger: the other one drives the command; held only when neither is valid
+        for k in (0, 1):
+            flagged &= ~np.isin(np.asarray(run[f"observer_status_{k}"], dtype=int), _VALID)
     drops = np.diff(cmd)
     lowered = drops[flagged[1:] & flagged[:-1]]
     counts = {

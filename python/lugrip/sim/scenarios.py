@@ -640,14 +640,11 @@ def simulate(
     mujoco: :func:`lugrip.sim.mujoco.loop.run_mujoco_loop`) with controller `kind`."""
     est = scenario.estimator_for(model)
     if scenario.faults:
-        if model == "mujoco":
-            raise ValueError(
-                f"scenario {scenario.name}: fault injection runs on the patch and lumped plants"
-            )
         options = dict(
             options,
             faults=scenario.faults["inject"],
             stuck_samples=scenario.faults.get("stuck_samples", 0),
+            healthy_finger_fallback=scenario.faults.get("healthy_finger_fallback", False),
         )
     if model == "mujoco":
         from .mujoco.loop import run_mujoco_loop
