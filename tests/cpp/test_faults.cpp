@@ -220,3 +220,24 @@ TEST(Faults, SlipControlStuckSamplesValidated) {
   EXPECT_FALSE(validate(s, &msg));
   EXPECT_NE(msg.find("stuck_samples"), std::string::npos);
 }
+
+TEST(Faults, HealthyFingerFallbackLetsTheOtherFingerCommand) {
+  // Finger 1 dead from t = 2 s, then a downward push: holding the command cannot answer the
+  // push; with the fallback finger 0's estimate raises the force while finger 1 stays flagged.
+  ClosedLoopConfig c = hold_config();
+  c.plant.disturbances.push_back(Disturbance{2.5, 0.5, PulseShape::HalfSine, 0.0, -3.0, 0.0, 0.0, 0.0});
+  c.faults.push_back(fault(FaultKind::Dead, 2.0, 1e300, 1));
+  double peak[2] = {0.0, 0.0};
+  for (int fallback = 0; fallback < 2; ++fallback) {
+    c.healthy_finger_fallback = fallback == 1;
+    const auto log = run(c, 3.5);
+    for (int k = kOnset; k < static_cast<int>(log.size()); ++k) {
+      EXPECT_EQ(log[k].observer_status[1], static_cast<int>(Status::NoContact)) << k;
+      EXPECT_NE(log[k].status, static_cast<int>(Status::Ok)) << k;  // the fault stays reported
+      peak[fallback] = std::max(peak[fallback], log[k].command);
+    }
+    if (fallback == 0)  // held: at most the command at the onset (invalid_raise_step = 0)
+      EXPECT_NEAR(peak[0], log[kOnset - 1].command, 1e-9);
+  }
+  EXPECT_GT(peak[1], peak[0] + 0.5);  // the push is answered
+}

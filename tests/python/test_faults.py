@@ -190,3 +190,20 @@ def test_scenario_files_parse_as_written():
         block = fl.fault_block(data["faults"], str(p))
         assert math.isfinite(block["onset"])
         assert fault_specs(block["inject"])
+
+
+def test_mujoco_dead_finger_hold_drops_fallback_holds():
+    """MuJoCo's gripper (its own contact solver, not lugrip's model): with finger 1's sensor
+    dead, holding the command cannot answer the push at t = 6.5 s and the block slides out
+    of the fingers; with healthy_finger_fallback finger 0's estimate answers it."""
+    pytest.importorskip("mujoco")
+    out = {}
+    for fb in (False, True):
+        s = sc.load_scenario(FAULT_DIR / "fault_dead_finger.yaml")
+        s.duration = 7.5
+        s.faults = dict(s.faults, healthy_finger_fallback=fb)
+        r = sc.run_scenario(s, plant_model="mujoco", baselines=False)
+        out[fb] = r.metrics["lugrip"]
+    assert out[False]["dropped"] and out[False]["hold_slip_mm"] > 5.0
+    assert not out[True]["dropped"] and out[True]["hold_slip_mm"] < 1.0
+    assert out[True]["fault_status_latency"] == 0
