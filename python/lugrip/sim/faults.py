@@ -118,7 +118,7 @@ def fault_block(value: Any, where: str) -> dict:
     d["stuck_samples"] = int(stuck)
     fallback = d.get("healthy_finger_fallback", False)
     if not isinstance(fallback, bool):
-        raise ValueError(
+        raise ValueError(  # noqa: TRY004 (file content)
             f"{where}: faults.healthy_finger_fallback = {fallback!r}: must be true or false"
         )
     d["healthy_finger_fallback"] = fallback
