@@ -18,7 +18,7 @@ __all__ = ["register", "run"]
 _EPILOG = """\
 scenarios: names in ./scenarios (or $LUGRIP_SCENARIOS) or its unseen/ and faults/ folders, or
 YAML paths; 'all' runs the paper's experiments, 'unseen' the objects the controller was not
-tuned on, 'faults' the injected sensor/actuator faults (patch and lumped plants).
+tuned on, 'faults' the injected sensor/actuator faults.
 examples:
   lugrip simulate all --out out/                        # the four experiments + baselines
   lugrip simulate exp2_small_resin_block --json m.json  # one scenario
