@@ -81,7 +81,7 @@ void validate_fault(const FaultSpec& f, const std::string& p, std::string& msg) 
   const int kind = static_cast<int>(f.kind);
   if (kind < 0 || kind > 9) msg += p + "kind = " + std::to_string(kind) + ": unknown fault kind\n";
   if (f.finger < -1 || f.finger > 1) msg += p + "finger = " + std::to_string(f.finger) + ": must be 0, 1 or -1 (both)\n";
-  if (!finite_ge0(f.t_start)) msg += p + "t_start = " + num(f.t_start) + ": must be finite and >= 0 [s]\n";
+  if (!(finite_ge0(f.t_start) && f.t_start <= 1e9)) msg += p + "t_start = " + num(f.t_start) + ": must be in [0, 1e9] [s]\n";
   if (!(f.duration > 0.0) || std::isnan(f.duration)) msg += p + "duration = " + num(f.duration) + ": must be > 0 [s]\n";
   if (f.burst < 1) msg += p + "burst = " + std::to_string(f.burst) + ": must be >= 1 [samples]\n";
   if (f.every != 0 && f.every < f.burst)
@@ -258,8 +258,8 @@ void ClosedLoop::reset() noexcept {
 FaultInjector::FaultInjector(const std::vector<FaultSpec>& faults, double sample_period) : faults_(faults) {
   std::string msg;
   if (!validate(faults, &msg)) throw std::invalid_argument("invalid faults:\n" + msg);
-  if (!(std::isfinite(sample_period) && sample_period > 0.0))
-    throw std::invalid_argument("FaultInjector: sample_period = " + num(sample_period) + ": must be finite and > 0 [s]");
+  if (!(sample_period >= 1e-9 && sample_period <= 1e3))
+    throw std::invalid_argument("FaultInjector: sample_period = " + num(sample_period) + ": must be in [1e-9, 1e3] [s]");
   dt_ = sample_period;
   reset();
 }
@@ -273,11 +273,17 @@ void FaultInjector::reset(double command) noexcept {
   lag_init_ = false;
 }
 
+// First sample of a fault's window: the smallest n with n dt >= t_start - dt / 2.
+int64_t FaultInjector::first_sample(const FaultSpec& f) const noexcept {
+  return static_cast<int64_t>(std::ceil(f.t_start / dt_ - 0.5));
+}
+
 bool FaultInjector::on(const FaultSpec& f, int64_t n) const noexcept {
+  const int64_t k0 = first_sample(f);
+  if (n < k0) return false;
   const double t = static_cast<double>(n) * dt_;
-  if (t < f.t_start - 0.5 * dt_ || t >= f.t_start + f.duration - 0.5 * dt_) return false;
+  if (t >= f.t_start + f.duration - 0.5 * dt_) return false;
   if (f.every <= 0) return true;
-  const int64_t k0 = static_cast<int64_t>(std::llround(f.t_start / dt_));
   return (n - k0) % f.every < f.burst;
 }
 
@@ -294,8 +300,7 @@ bool FaultInjector::sensors(int64_t n, std::array<FingerWrench, kMaxFingers>& fi
     if (!active) continue;
     any = true;
     const double t_rel = static_cast<double>(n) * dt_ - f.t_start;
-    const int64_t k0 = static_cast<int64_t>(std::llround(f.t_start / dt_));
-    const int64_t burst_index = f.every > 0 ? (n - k0) / f.every : 0;
+    const int64_t burst_index = f.every > 0 ? (n - first_sample(f)) / f.every : 0;
     for (int i = 0; i < 2; ++i) {
       if (f.finger >= 0 && f.finger != i) continue;
       FingerWrench& w = fingers[i];

@@ -73,7 +73,7 @@ const char* to_string(FaultKind k) noexcept;
 //! |---|---|---|---|
 //! | kind | FaultKind | | Dropout |
 //! | finger | sensor faults: 0, 1 or -1 (both) | | -1 |
-//! | t_start, duration | active window | s | 0, inf |
+//! | t_start, duration | active window (t_start <= 1e9) | s | 0, inf |
 //! | burst, every | burst length and burst period | samples | 1, 0 |
 //! | force | Spike height, Saturation limit, ActuatorSaturation limit | N | 0 |
 //! | torque | Spike height, Saturation limit | N m | 0 |
@@ -106,7 +106,7 @@ bool validate(const std::vector<FaultSpec>& faults, std::string* message);
 class FaultInjector {
  public:
   FaultInjector() = default;
-  //! sample_period [s] > 0. Throws std::invalid_argument for an invalid fault list.
+  //! sample_period [s] in [1e-9, 1e3]. Throws std::invalid_argument for an invalid fault list.
   FaultInjector(const std::vector<FaultSpec>& faults, double sample_period);
   //! Back to before the first sample; `command` [N] is the gripper's command before it.
   void reset(double command = 0.0) noexcept;
@@ -130,6 +130,7 @@ class FaultInjector {
   bool lag_init_ = false;
 
   bool on(const FaultSpec& f, int64_t n) const noexcept;
+  int64_t first_sample(const FaultSpec& f) const noexcept;
 };
 
 //! One scheduled action, applied before the first sensor sample with t >= time.
