@@ -49,6 +49,7 @@ TEST(NoAllocation, ClosedLoopStep) {
         c.faults.push_back(spec);
       }
       c.stuck_samples = 20;
+      c.healthy_finger_fallback = model == PlantModel::Patch;  // both SlipControl paths
       ClosedLoop loop(c);  // allocates (construction)
       ClosedLoopSample s;
       const long before = lugrip_support::g_allocations.load();
