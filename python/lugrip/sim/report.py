@@ -579,6 +579,11 @@ def mujoco_markdown(data: dict[str, Any], base: Path) -> str:
         )
     if fails:
         lines += ["Seeds failing on MuJoCo:", "", *fails, ""]
+    from .faults import fault_table
+
+    faults = fault_table(list(res.values()))
+    if faults:
+        lines += ["Sensor and actuator faults on MuJoCo (one row per fault scenario):", "", faults, ""]
     lines += [
         "ω̂ against MuJoCo's true slip rate (pad 0 and 1, from the lift start): "
         + "; ".join(
