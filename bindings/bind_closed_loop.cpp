@@ -3,6 +3,8 @@
 #include <nanobind/nanobind.h>
 #include <nanobind/stl/optional.h>
 #include <nanobind/stl/string.h>
+#include <nanobind/stl/tuple.h>
+#include <nanobind/stl/vector.h>
 
 #include <stdexcept>
 #include <string>
@@ -24,6 +26,51 @@ void bind_closed_loop(nb::module_& m) {
       .value("SlippingAvoidance", ModeAction::SlippingAvoidance)
       .value("DynamicOn", ModeAction::DynamicOn)
       .value("DynamicOff", ModeAction::DynamicOff);
+  nb::enum_<FaultKind>(m, "FaultKind", "Injected sensor or actuator fault.")
+      .value("Dropout", FaultKind::Dropout)
+      .value("NanBurst", FaultKind::NanBurst)
+      .value("Spike", FaultKind::Spike)
+      .value("BiasDrift", FaultKind::BiasDrift)
+      .value("Saturation", FaultKind::Saturation)
+      .value("Stuck", FaultKind::Stuck)
+      .value("Dead", FaultKind::Dead)
+      .value("ContactLoss", FaultKind::ContactLoss)
+      .value("ActuatorLag", FaultKind::ActuatorLag)
+      .value("ActuatorSaturation", FaultKind::ActuatorSaturation);
+  nb::class_<FaultSpec> fault(m, "FaultSpec");
+  fault.def(nb::init<>());
+  def_fields_rw(fault);
+  nb::class_<FaultInjector>(m, "FaultInjector",
+                             "Applies a fault list to each sensor sample's wrenches and to the gripper command.")
+      .def(nb::init<const std::vector<FaultSpec>&, double>(), "faults"_a, "sample_period"_a)
+      .def("reset", &FaultInjector::reset, "command"_a = 0.0)
+      .def(
+          "sensors",
+          [](FaultInjector& f, int64_t n, const std::vector<double>& w) {
+            if (w.size() != 8) throw nb::value_error("wrenches: expected 8 values (f_n, f_x, f_y, tau of finger 0, then 1)");
+            std::array<FingerWrench, kMaxFingers> fw{};
+            for (int i = 0; i < 2; ++i) fw[i] = FingerWrench{w[4 * i], w[4 * i + 1], w[4 * i + 2], w[4 * i + 3]};
+            const bool active = f.sensors(n, fw);
+            std::vector<double> out(8);
+            for (int i = 0; i < 2; ++i) {
+              out[4 * i] = fw[i].f_n;
+              out[4 * i + 1] = fw[i].f_x;
+              out[4 * i + 2] = fw[i].f_y;
+              out[4 * i + 3] = fw[i].tau;
+            }
+            return std::make_tuple(active, out);
+          },
+          "n"_a, "wrenches"_a,
+          "Sample n's wrenches (8 values: f_n, f_x, f_y, tau per finger) -> (fault acted, wrenches received).")
+      .def(
+          "actuator",
+          [](FaultInjector& f, int64_t n, double command) {
+            bool active = false;
+            const double out = f.actuator(n, command, active);
+            return std::make_tuple(out, active);
+          },
+          "n"_a, "command"_a, "Sample n's command [N] -> (command reaching the gripper [N], fault acted).")
+      .def_prop_ro("empty", &FaultInjector::empty);
   nb::class_<ModeEvent> event(m, "ModeEvent");
   event.def(nb::init<>());
   def_fields_rw(event);
@@ -32,6 +79,9 @@ void bind_closed_loop(nb::module_& m) {
       .def("clear_schedule", [](ClosedLoopConfig& c) { c.schedule.clear(); })
       .def("add_event", [](ClosedLoopConfig& c, double t, ModeAction a) { c.schedule.push_back(ModeEvent{t, a}); },
            "time"_a, "action"_a)
+      .def("add_fault", [](ClosedLoopConfig& c, const FaultSpec& f) { c.faults.push_back(f); }, "fault"_a)
+      .def("clear_faults", [](ClosedLoopConfig& c) { c.faults.clear(); })
+      .def_prop_ro("n_faults", [](const ClosedLoopConfig& c) { return c.faults.size(); })
       .def_prop_ro("n_events", [](const ClosedLoopConfig& c) { return c.schedule.size(); });
   def_fields_rw(config);
   nb::class_<ClosedLoopSample> sample(m, "ClosedLoopSample");

@@ -131,7 +131,9 @@ struct Table<SlipControlSettings> {
   static constexpr auto fields = std::make_tuple(
       field("observer", &S::observer, "settings of each finger's observer (ObserverSettings)"),
       field("controller", &S::controller, "controller settings (GraspControllerSettings)"),
-      field("fingers", &S::fingers, "fingertips measured: 1 or 2"));
+      field("fingers", &S::fingers, "fingertips measured: 1 or 2"),
+      field("stuck_samples", &S::stuck_samples, "exact repeats of a wrench reported SensorFault [samples] (0: off)"),
+      field("healthy_finger_fallback", &S::healthy_finger_fallback, "one faulty finger: the other drives the command"));
 };
 
 template <>
@@ -378,6 +380,18 @@ struct Table<ModeEvent> {
 };
 
 template <>
+struct Table<FaultSpec> {
+  using S = FaultSpec;
+  static constexpr auto fields = std::make_tuple(
+      field("kind", &S::kind, "FaultKind"), field("finger", &S::finger, "0, 1 or -1 (both)"),
+      field("t_start", &S::t_start, "[s]"), field("duration", &S::duration, "[s]"),
+      field("burst", &S::burst, "[samples]"), field("every", &S::every, "[samples] (0: continuous)"),
+      field("force", &S::force, "[N]"), field("torque", &S::torque, "[N m]"),
+      field("force_rate", &S::force_rate, "[N/s]"), field("torque_rate", &S::torque_rate, "[N m/s]"),
+      field("time_constant", &S::time_constant, "[s]"));
+};
+
+template <>
 struct Table<ClosedLoopConfig> {
   using S = ClosedLoopConfig;
   static constexpr auto fields = std::make_tuple(
@@ -387,7 +401,9 @@ struct Table<ClosedLoopConfig> {
       field("kind", &S::kind, "ControllerKind"),
       field("controller_start", &S::controller_start, "[s]"),
       field("constant_force", &S::constant_force, "[N]"), field("cone_margin", &S::cone_margin, "[-]"),
-      field("cone_release_rate", &S::cone_release_rate, "[N/s]"));
+      field("cone_release_rate", &S::cone_release_rate, "[N/s]"),
+      field("stuck_samples", &S::stuck_samples, "exact wrench repeats reported SensorFault [samples] (0: off)"),
+      field("healthy_finger_fallback", &S::healthy_finger_fallback, "SlipControlSettings::healthy_finger_fallback"));
 };
 
 template <>
@@ -422,7 +438,10 @@ struct Table<ClosedLoopSample> {
       field("pivot_end", &S::pivot_end, "PivotEnd code"),
       field("supported", &S::supported, "object resting on the support"),
       field("dropped", &S::dropped, "a drop criterion has been met (latched)"),
-      field("finite", &S::finite, "every value of this sample is finite"));
+      field("finite", &S::finite, "every value of this sample is finite"),
+      field("status", &S::status, "Status code of the cycle"),
+      field("fault_active", &S::fault_active, "an injected fault acted on this sample"),
+      field("actuator_command", &S::actuator_command, "command reaching the gripper after actuator faults [N]"));
 };
 
 }  // namespace lugrip_bind

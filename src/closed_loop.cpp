@@ -3,6 +3,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <sstream>
 #include <stdexcept>
 
@@ -58,6 +59,54 @@ const char* to_string(ModeAction a) noexcept {
   return "unknown";
 }
 
+const char* to_string(FaultKind k) noexcept {
+  switch (k) {
+    case FaultKind::Dropout: return "dropout";
+    case FaultKind::NanBurst: return "nan_burst";
+    case FaultKind::Spike: return "spike";
+    case FaultKind::BiasDrift: return "bias_drift";
+    case FaultKind::Saturation: return "saturation";
+    case FaultKind::Stuck: return "stuck";
+    case FaultKind::Dead: return "dead";
+    case FaultKind::ContactLoss: return "contact_loss";
+    case FaultKind::ActuatorLag: return "actuator_lag";
+    case FaultKind::ActuatorSaturation: return "actuator_saturation";
+  }
+  return "unknown";
+}
+
+namespace {
+bool finite_ge0(double v) { return std::isfinite(v) && v >= 0.0; }
+void validate_fault(const FaultSpec& f, const std::string& p, std::string& msg) {
+  const int kind = static_cast<int>(f.kind);
+  if (kind < 0 || kind > 9) msg += p + "kind = " + std::to_string(kind) + ": unknown fault kind\n";
+  if (f.finger < -1 || f.finger > 1) msg += p + "finger = " + std::to_string(f.finger) + ": must be 0, 1 or -1 (both)\n";
+  if (!(finite_ge0(f.t_start) && f.t_start <= 1e9)) msg += p + "t_start = " + num(f.t_start) + ": must be in [0, 1e9] [s]\n";
+  if (!(f.duration > 0.0) || std::isnan(f.duration)) msg += p + "duration = " + num(f.duration) + ": must be > 0 [s]\n";
+  if (f.burst < 1) msg += p + "burst = " + std::to_string(f.burst) + ": must be >= 1 [samples]\n";
+  if (f.every != 0 && f.every < f.burst)
+    msg += p + "every = " + std::to_string(f.every) + ": must be 0 (continuous) or >= burst [samples]\n";
+  if (!(std::isfinite(f.force) && std::fabs(f.force) <= 1e6)) msg += p + "force = " + num(f.force) + ": must be finite, |force| <= 1e6 [N]\n";
+  if (!(std::isfinite(f.torque) && std::fabs(f.torque) <= 1e4)) msg += p + "torque = " + num(f.torque) + ": must be finite, |torque| <= 1e4 [N m]\n";
+  if (!(std::isfinite(f.force_rate) && std::fabs(f.force_rate) <= 1e6)) msg += p + "force_rate = " + num(f.force_rate) + ": must be finite, |force_rate| <= 1e6 [N/s]\n";
+  if (!(std::isfinite(f.torque_rate) && std::fabs(f.torque_rate) <= 1e4)) msg += p + "torque_rate = " + num(f.torque_rate) + ": must be finite, |torque_rate| <= 1e4 [N m/s]\n";
+  if (!(finite_ge0(f.time_constant) && f.time_constant <= 1e3)) msg += p + "time_constant = " + num(f.time_constant) + ": must be in [0, 1000] [s]\n";
+  if ((f.kind == FaultKind::Saturation || f.kind == FaultKind::ActuatorSaturation) && !(f.force >= 0.0))
+    msg += p + "force = " + num(f.force) + ": a saturation limit must be >= 0 [N]\n";
+  if (f.kind == FaultKind::Saturation && !(f.torque >= 0.0))
+    msg += p + "torque = " + num(f.torque) + ": a saturation limit must be >= 0 [N m]\n";
+}
+}  // namespace
+
+bool validate(const std::vector<FaultSpec>& faults, std::string* message) {
+  std::string msg;
+  if (faults.size() > static_cast<size_t>(kMaxFaults))
+    msg += "faults: " + std::to_string(faults.size()) + " faults, at most " + std::to_string(kMaxFaults) + "\n";
+  for (size_t i = 0; i < faults.size(); ++i) validate_fault(faults[i], "faults[" + std::to_string(i) + "].", msg);
+  if (message) *message = msg;
+  return msg.empty();
+}
+
 bool validate(const ClosedLoopConfig& c, std::string* message) {
   std::string msg, sub;
   if (!validate(c.plant, &sub)) append_prefixed(msg, sub, "plant.");
@@ -93,6 +142,9 @@ bool validate(const ClosedLoopConfig& c, std::string* message) {
     const int a = static_cast<int>(e.action);
     if (a < 0 || a > 3) msg += f + "action = " + std::to_string(a) + ": unknown action\n";
   }
+  if (!validate(c.faults, &sub)) msg += sub;
+  if (c.stuck_samples < 0)
+    msg += "stuck_samples = " + std::to_string(c.stuck_samples) + ": must be >= 0 (0: off) [samples]\n";
   if (message) *message = msg;
   return msg.empty();
 }
@@ -111,7 +163,9 @@ void ClosedLoopLog::reserve(size_t n) {
   }
   mode.reserve(n);
   pivot_end.reserve(n);
-  for (auto* v : {&command_issued, &pivot_finished, &supported, &dropped, &finite}) v->reserve(n);
+  for (auto* v : {&command_issued, &pivot_finished, &supported, &dropped, &finite, &fault_active}) v->reserve(n);
+  status.reserve(n);
+  actuator_command.reserve(n);
 }
 
 void ClosedLoopLog::append(const ClosedLoopSample& s) {
@@ -151,6 +205,9 @@ void ClosedLoopLog::append(const ClosedLoopSample& s) {
   supported.push_back(s.supported);
   dropped.push_back(s.dropped);
   finite.push_back(s.finite);
+  status.push_back(s.status);
+  fault_active.push_back(s.fault_active);
+  actuator_command.push_back(s.actuator_command);
 }
 
 // --- loop ------------------------------------------------------------------------------------
@@ -161,6 +218,8 @@ SlipControlSettings slip_settings(const ClosedLoopConfig& c) {
   s.observer = c.observer;
   s.controller = c.controller;
   s.fingers = 2;
+  s.stuck_samples = c.stuck_samples;
+  s.healthy_finger_fallback = c.healthy_finger_fallback;
   return s;
 }
 // The plant's contact model (tables shared by copy) or one built from the estimator parameters.
@@ -170,7 +229,10 @@ SlipControl make_slip_control(const ClosedLoopConfig& c, const GraspPlant& plant
 }  // namespace
 
 ClosedLoop::ClosedLoop(const ClosedLoopConfig& config)
-    : cfg_(sorted(checked(config))), plant_(cfg_.plant), sc_(make_slip_control(cfg_, plant_)) {
+    : cfg_(sorted(checked(config))),
+      plant_(cfg_.plant),
+      sc_(make_slip_control(cfg_, plant_)),
+      faults_(cfg_.faults, 1.0 / cfg_.plant.sensor.rate) {
   dt_ = 1.0 / cfg_.plant.sensor.rate;
   ratio_ = cfg_.controller.command_ratio;
   reset();
@@ -190,6 +252,120 @@ void ClosedLoop::reset() noexcept {
   cone_fn_sum_ = {0.0, 0.0};
   cone_ft_sum_ = {0.0, 0.0};
   cone_count_ = 0;
+  faults_.reset(command_);
+}
+
+FaultInjector::FaultInjector(const std::vector<FaultSpec>& faults, double sample_period) : faults_(faults) {
+  std::string msg;
+  if (!validate(faults, &msg)) throw std::invalid_argument("invalid faults:\n" + msg);
+  if (!(sample_period >= 1e-9 && sample_period <= 1e3))
+    throw std::invalid_argument("FaultInjector: sample_period = " + num(sample_period) + ": must be in [1e-9, 1e3] [s]");
+  dt_ = sample_period;
+  reset();
+}
+
+void FaultInjector::reset(double command) noexcept {
+  last_ = {};
+  frozen_ = {};
+  was_active_ = {};
+  lag_state_ = command;
+  last_actuator_ = command;
+  lag_init_ = false;
+}
+
+// First sample of a fault's window: the smallest n with n dt >= t_start - dt / 2.
+int64_t FaultInjector::first_sample(const FaultSpec& f) const noexcept {
+  return static_cast<int64_t>(std::ceil(f.t_start / dt_ - 0.5));
+}
+
+bool FaultInjector::on(const FaultSpec& f, int64_t n) const noexcept {
+  const int64_t k0 = first_sample(f);
+  if (n < k0) return false;
+  const double t = static_cast<double>(n) * dt_;
+  if (t >= f.t_start + f.duration - 0.5 * dt_) return false;
+  if (f.every <= 0) return true;
+  return (n - k0) % f.every < f.burst;
+}
+
+bool FaultInjector::sensors(int64_t n, std::array<FingerWrench, kMaxFingers>& fingers) noexcept {
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  bool any = false;
+  const int count = static_cast<int>(std::min(faults_.size(), static_cast<size_t>(kMaxFaults)));
+  for (int k = 0; k < count; ++k) {
+    const FaultSpec& f = faults_[k];
+    if (f.kind == FaultKind::ActuatorLag || f.kind == FaultKind::ActuatorSaturation) continue;
+    const bool active = on(f, n);
+    const bool onset = active && !was_active_[k];
+    was_active_[k] = active;
+    if (!active) continue;
+    any = true;
+    const double t_rel = static_cast<double>(n) * dt_ - f.t_start;
+    const int64_t burst_index = f.every > 0 ? (n - first_sample(f)) / f.every : 0;
+    for (int i = 0; i < 2; ++i) {
+      if (f.finger >= 0 && f.finger != i) continue;
+      FingerWrench& w = fingers[i];
+      switch (f.kind) {
+        case FaultKind::Dropout: w = last_[i]; break;
+        case FaultKind::NanBurst: w = FingerWrench{nan, nan, nan, nan}; break;
+        case FaultKind::Spike: {
+          const double sign = burst_index % 2 == 0 ? 1.0 : -1.0;
+          w.f_x += sign * f.force;
+          w.f_y += sign * f.force;
+          w.tau += sign * f.torque;
+          break;
+        }
+        case FaultKind::BiasDrift:
+          w.f_x += f.force_rate * t_rel;
+          w.f_y += f.force_rate * t_rel;
+          w.tau += f.torque_rate * t_rel;
+          break;
+        case FaultKind::Saturation:
+          w.f_x = clampd(w.f_x, -f.force, f.force);
+          w.f_y = clampd(w.f_y, -f.force, f.force);
+          w.tau = clampd(w.tau, -f.torque, f.torque);
+          break;
+        case FaultKind::Stuck:
+          if (onset) frozen_[i] = last_[i];
+          w = frozen_[i];
+          break;
+        case FaultKind::Dead:
+        case FaultKind::ContactLoss: w = FingerWrench{}; break;
+        default: break;
+      }
+    }
+  }
+  // Dropout repeats what was delivered (a NaN burst leaves the last finite sample in place).
+  for (int i = 0; i < 2; ++i) {
+    const FingerWrench& w = fingers[i];
+    if (std::isfinite(w.f_n) && std::isfinite(w.f_x) && std::isfinite(w.f_y) && std::isfinite(w.tau)) last_[i] = w;
+  }
+  return any;
+}
+
+double FaultInjector::actuator(int64_t n, double command, bool& active) noexcept {
+  double f = command;
+  const int count = static_cast<int>(std::min(faults_.size(), static_cast<size_t>(kMaxFaults)));
+  bool lagged = false;
+  for (int k = 0; k < count; ++k) {
+    const FaultSpec& fs = faults_[k];
+    if (fs.kind != FaultKind::ActuatorLag && fs.kind != FaultKind::ActuatorSaturation) continue;
+    if (!on(fs, n)) continue;
+    active = true;
+    if (fs.kind == FaultKind::ActuatorSaturation) {
+      f = std::min(f, fs.force);
+    } else if (fs.time_constant > 0.0) {
+      // exact discretisation of a first-order lag over one sample, started at the last output
+      if (!lag_init_) lag_state_ = last_actuator_;
+      lag_init_ = true;
+      lagged = true;
+      const double a = std::exp(-dt_ / fs.time_constant);
+      lag_state_ = a * lag_state_ + (1.0 - a) * f;
+      f = lag_state_;
+    }
+  }
+  if (!lagged) lag_init_ = false;
+  last_actuator_ = f;
+  return f;
 }
 
 void ClosedLoop::apply_events(double t) noexcept {
@@ -244,14 +420,16 @@ Status ClosedLoop::step(ClosedLoopSample& out) noexcept {
     const FingerSample& s = plant_.sensor_sample(i);
     sin.fingers[i] = FingerWrench{s.f_n, s.f_x, s.f_y, s.tau};
   }
+  bool fault = faults_.empty() ? false : faults_.sensors(n_, sin.fingers);
   const bool lugrip_active = started_ && cfg_.kind == ControllerKind::Lugrip;
   const Status status = lugrip_active ? sc_.step(sin, sout_) : sc_.observe(sin, sout_);
   for (int i = 0; i < 2; ++i) {
     const FingerSample& s = plant_.sensor_sample(i);
     const ObserverOutput& o = sout_.fingers[i];
-    out.f_n_meas[i] = s.f_n;
-    out.f_t_meas[i] = planar_norm(s.f_x, s.f_y);
-    out.tau_meas[i] = s.tau;
+    const FingerWrench& w = sin.fingers[i];  // what the observers received
+    out.f_n_meas[i] = w.f_n;
+    out.f_t_meas[i] = planar_norm(w.f_x, w.f_y);
+    out.tau_meas[i] = w.tau;
     out.f_t_true[i] = planar_norm(s.true_f_x, s.true_f_y);
     out.tau_true[i] = s.true_tau;
     out.omega_hat[i] = o.omega_hat;
@@ -292,12 +470,16 @@ Status ClosedLoop::step(ClosedLoopSample& out) noexcept {
         break;
     }
   }
-  plant_.set_command(command_);
+  const double actuator = faults_.empty() ? command_ : faults_.actuator(n_, command_, fault);
+  plant_.set_command(actuator);
 
   const PlantState& st = plant_.state();
   out.index = n_;
   out.t = t;
   out.command = command_;
+  out.actuator_command = actuator;
+  out.status = static_cast<int>(status);
+  out.fault_active = fault;
   const bool lugrip = cfg_.kind == ControllerKind::Lugrip && started_;
   out.static_force = lugrip ? sout_.controller.static_force : command_;
   out.dynamic_force = lugrip ? sout_.controller.dynamic_force : 0.0;
@@ -318,8 +500,9 @@ Status ClosedLoop::step(ClosedLoopSample& out) noexcept {
   out.dropped = st.dropped;
   bool ok = std::isfinite(out.command) && std::isfinite(out.static_force) && std::isfinite(out.dynamic_force) &&
             std::isfinite(out.f_n) && std::isfinite(out.slip) && std::isfinite(out.theta);
+  ok = ok && std::isfinite(out.actuator_command);
   for (int i = 0; i < 2; ++i)
-    ok = ok && std::isfinite(out.f_n_meas[i]) && std::isfinite(out.f_t_meas[i]) && std::isfinite(out.tau_meas[i]) &&
+    ok = ok && (fault || (std::isfinite(out.f_n_meas[i]) && std::isfinite(out.f_t_meas[i]) && std::isfinite(out.tau_meas[i]))) &&
          std::isfinite(out.omega_hat[i]) && std::isfinite(out.slippage[i]) && std::isfinite(out.c_tilde[i]) &&
          std::isfinite(out.f_t_true[i]) && std::isfinite(out.tau_true[i]);
   out.finite = ok;

@@ -36,6 +36,8 @@ bool validate(const SlipControlSettings& s, std::string* message) {
   if (!validate(s.controller, &sub)) append_prefixed(msg, sub, "controller.");
   if (s.fingers != 1 && s.fingers != 2)
     msg += "fingers = " + std::to_string(s.fingers) + ": must be 1 or 2\n";
+  if (s.stuck_samples < 0)
+    msg += "stuck_samples = " + std::to_string(s.stuck_samples) + ": must be >= 0 (0: off) [samples]\n";
   const double fs = s.controller.sensor_rate, dt = s.observer.dt;
   if (std::isfinite(fs) && fs > 0.0 && std::isfinite(dt) && dt > 0.0 &&
       !(std::fabs(dt * fs - 1.0) <= 1e-9))
@@ -62,6 +64,14 @@ Status SlipControl::observe(const SlipControlInput& in, SlipControlOutput& out) 
     const ObserverInput oin = ObserverInput::from_force_vector(w.f_n, w.f_x, w.f_y, w.tau, in.dt);
     ObserverOutput& o = out.fingers[i];
     obs_[i].step(oin, o);
+    if (s_.stuck_samples > 0) {
+      const FingerWrench& p = prev_[i];
+      // bit-identical repeats only (NaN never compares equal: those are InvalidSample already)
+      const bool same = w.f_n == p.f_n && w.f_x == p.f_x && w.f_y == p.f_y && w.tau == p.tau;
+      repeats_[i] = same ? (repeats_[i] < s_.stuck_samples ? repeats_[i] + 1 : repeats_[i]) : 0;
+      prev_[i] = w;
+      if (repeats_[i] >= s_.stuck_samples) o.status = Status::SensorFault;
+    }
     FingerInput& f = cin_.fingers[i];
     f.omega_hat = o.omega_hat;
     f.omega_resolution = o.omega_resolution;
@@ -77,16 +87,28 @@ Status SlipControl::observe(const SlipControlInput& in, SlipControlOutput& out) 
 }
 
 Status SlipControl::step(const SlipControlInput& in, SlipControlOutput& out) noexcept {
-  observe(in, out);
+  const Status worst = observe(in, out);
+  int faulty = -1, n_faulty = 0;
+  if (s_.healthy_finger_fallback && s_.fingers == 2)
+    for (int i = 0; i < 2; ++i)
+      if (!is_valid(cin_.fingers[i].status)) {
+        faulty = i;
+        ++n_faulty;
+      }
+  if (n_faulty == 1) cin_.fingers[faulty].present = false;  // this cycle only
   ctrl_.step(cin_, out.controller);
+  if (n_faulty == 1) cin_.fingers[faulty].present = true;
   out.force = out.controller.force;
   out.status = out.controller.status;
+  if (n_faulty == 1 && out.status == Status::Ok) out.status = worst;
   return out.status;
 }
 
 void SlipControl::reset(double force) noexcept {
   for (auto& o : obs_) o.reset();
   ctrl_.reset(force);
+  prev_ = {};
+  repeats_ = {};
 }
 
 void SlipControl::set_mu(double mu) {

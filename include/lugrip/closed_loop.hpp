@@ -48,6 +48,91 @@ enum class ModeAction : int {
 const char* to_string(ControllerKind k) noexcept;
 const char* to_string(ModeAction a) noexcept;
 
+//! Injected fault of the simulated sensor or actuator path. Stable integer values. Sensor faults
+//! change the wrench the observers and the controller receive (and the logged *_meas columns),
+//! never the plant; actuator faults change the command between the controller and the gripper.
+enum class FaultKind : int {
+  Dropout = 0,       //!< the sensor repeats its last delivered sample (bursts)
+  NanBurst = 1,      //!< every channel reads NaN (bursts)
+  Spike = 2,         //!< `force` added to f_x and f_y, `torque` to tau, sign alternating per burst
+  BiasDrift = 3,     //!< offset growing from 0 at force_rate on f_x, f_y and torque_rate on tau
+  Saturation = 4,    //!< f_x, f_y clipped to +-force and tau to +-torque (a saturated range)
+  Stuck = 5,         //!< every channel frozen at the last sample delivered before the onset
+  Dead = 6,          //!< every channel reads 0 (a sensor without power or signal)
+  ContactLoss = 7,   //!< the pad reads no contact (f_n, f_x, f_y, tau = 0), then re-contact
+  ActuatorLag = 8,   //!< extra first-order lag `time_constant` between command and gripper
+  ActuatorSaturation = 9,  //!< the gripper's command saturates at `force`
+};
+
+const char* to_string(FaultKind k) noexcept;
+
+//! One fault, active for t_start <= t < t_start + duration. Within that window it is active on
+//! the samples k (counted from the onset) with k mod every < burst (every = 0: every sample).
+//!
+//! | field | meaning | unit | default |
+//! |---|---|---|---|
+//! | kind | FaultKind | | Dropout |
+//! | finger | sensor faults: 0, 1 or -1 (both) | | -1 |
+//! | t_start, duration | active window (t_start <= 1e9) | s | 0, inf |
+//! | burst, every | burst length and burst period | samples | 1, 0 |
+//! | force | Spike height, Saturation limit, ActuatorSaturation limit | N | 0 |
+//! | torque | Spike height, Saturation limit | N m | 0 |
+//! | force_rate, torque_rate | BiasDrift slopes | N/s, N m/s | 0 |
+//! | time_constant | ActuatorLag | s | 0 |
+struct FaultSpec {
+  FaultKind kind = FaultKind::Dropout;
+  int finger = -1;
+  double t_start = 0.0;    //!< [s]
+  double duration = 1e300; //!< [s]
+  int burst = 1;           //!< [samples] >= 1
+  int every = 0;           //!< [samples] 0 or >= burst
+  double force = 0.0;      //!< [N]
+  double torque = 0.0;     //!< [N m]
+  double force_rate = 0.0;   //!< [N/s]
+  double torque_rate = 0.0;  //!< [N m/s]
+  double time_constant = 0.0;  //!< [s]
+};
+
+//! Most faults one closed loop injects.
+constexpr int kMaxFaults = 16;
+
+//! Checks every fault (one line per problem, prefixed "faults[i]."). Returns true when valid.
+bool validate(const std::vector<FaultSpec>& faults, std::string* message);
+
+//! Applies a list of faults to the wrenches of each sensor sample and to the command sent to the
+//! gripper (ClosedLoop uses one; a simulator of its own, e.g. the MuJoCo loop, can too).
+//! Lifecycle: construct (validates, copies the list) -> sensors()/actuator() once per sample,
+//! in sample order (noexcept, no allocation) -> reset().
+class FaultInjector {
+ public:
+  FaultInjector() = default;
+  //! sample_period [s] in [1e-9, 1e3]. Throws std::invalid_argument for an invalid fault list.
+  FaultInjector(const std::vector<FaultSpec>& faults, double sample_period);
+  //! Back to before the first sample; `command` [N] is the gripper's command before it.
+  void reset(double command = 0.0) noexcept;
+  //! Sensor faults of sample n (t = n * sample_period) applied to the fingers' wrenches in
+  //! place. Returns true when a fault acted.
+  bool sensors(int64_t n, std::array<FingerWrench, kMaxFingers>& fingers) noexcept;
+  //! Actuator faults of sample n: the command [N] that reaches the gripper; sets `active`
+  //! when a fault acted (leaves it unchanged otherwise).
+  double actuator(int64_t n, double command, bool& active) noexcept;
+  bool empty() const noexcept { return faults_.empty(); }
+  const std::vector<FaultSpec>& faults() const noexcept { return faults_; }
+
+ private:
+  std::vector<FaultSpec> faults_;
+  double dt_ = 0.002;
+  std::array<FingerWrench, kMaxFingers> last_{};   // last wrench delivered per finger
+  std::array<FingerWrench, kMaxFingers> frozen_{}; // Stuck: wrench at the onset per finger
+  std::array<bool, kMaxFaults> was_active_{};
+  double lag_state_ = 0.0;      // ActuatorLag filter output [N]
+  double last_actuator_ = 0.0;  // command that reached the gripper at the last sample [N]
+  bool lag_init_ = false;
+
+  bool on(const FaultSpec& f, int64_t n) const noexcept;
+  int64_t first_sample(const FaultSpec& f) const noexcept;
+};
+
 //! One scheduled action, applied before the first sensor sample with t >= time.
 struct ModeEvent {
   double time = 0.0;  //!< [s]
@@ -70,6 +155,9 @@ struct ModeEvent {
 //! | cone_margin | FrictionCone target utilisation, in (0, 1] | - | 0.8 |
 //! | cone_release_rate | FrictionCone decrease rate while below the margin (0: ratchet) | N/s | 0 |
 //! | schedule | mode actions (sorted by time at construction) | | {} |
+//! | faults | injected sensor/actuator faults (at most kMaxFaults) | | {} |
+//! | stuck_samples | SlipControlSettings::stuck_samples of the lugrip law (0: off) | samples | 0 |
+//! | healthy_finger_fallback | SlipControlSettings::healthy_finger_fallback | | false |
 struct ClosedLoopConfig {
   PlantConfig plant;
   ObserverSettings observer;
@@ -84,6 +172,9 @@ struct ClosedLoopConfig {
   double cone_margin = 0.8;
   double cone_release_rate = 0.0;
   std::vector<ModeEvent> schedule;
+  std::vector<FaultSpec> faults;
+  int stuck_samples = 0;
+  bool healthy_finger_fallback = false;
 };
 
 //! Checks the plant config, the observer and controller settings, the rate consistency and the
@@ -119,7 +210,11 @@ struct ClosedLoopSample {
   int pivot_end = 0;            //!< PivotEnd code when pivot_finished
   bool supported = false;       //!< object resting on the support
   bool dropped = false;         //!< a drop criterion has been met (latched)
-  bool finite = true;           //!< every value of this sample is finite
+  bool finite = true;           //!< every value of this sample is finite (the measured columns
+                                //!< excepted while an injected fault acts: a NaN burst reads NaN)
+  int status = 0;               //!< Status code of the cycle (what step() returned)
+  bool fault_active = false;    //!< an injected fault acted on this sample
+  double actuator_command = 0.0;  //!< command reaching the gripper after actuator faults [N]
 };
 
 //! Arrays of a batch run, one entry per sample (columns of ClosedLoopSample).
@@ -131,6 +226,9 @@ struct ClosedLoopLog {
   std::vector<double> slip_x, slip_y, slip, rotation, theta, cog_x, cog_y, gripper_y, ext_fx, ext_fy, ext_tau;
   std::vector<int32_t> mode, pivot_end;
   std::vector<uint8_t> command_issued, pivot_finished, supported, dropped, finite;
+  std::vector<int32_t> status;
+  std::vector<uint8_t> fault_active;
+  std::vector<double> actuator_command;
 
   void reserve(size_t n);
   void append(const ClosedLoopSample& s);
@@ -175,6 +273,7 @@ class ClosedLoop {
   std::array<double, 2> cone_fn_sum_{}, cone_ft_sum_{};  // friction cone: sums this period
   int cone_count_ = 0;
   SlipControlOutput sout_;
+  FaultInjector faults_;
 
   void apply_events(double t) noexcept;
   void cone_command() noexcept;

@@ -20,6 +20,13 @@ struct SlipControlSettings {
   ObserverSettings observer;            //!< settings of each finger's Observer
   GraspControllerSettings controller;   //!< settings of the GraspController
   int fingers = 2;                      //!< fingertips measured: 1 or 2
+  //! A finger whose four channels repeat bit for bit for this many consecutive samples is
+  //! reported SensorFault (a frozen sensor; a noisy sensor never repeats exactly). 0: off.
+  int stuck_samples = 0;                //!< [samples], >= 0
+  //! Two fingers, one without a valid estimate (dead, frozen, no contact, invalid samples):
+  //! the other finger alone drives the controller instead of holding the command. The cycle
+  //! status still reports the faulty finger. false: hold (the default).
+  bool healthy_finger_fallback = false;
 };
 
 //! Checks both nested settings, the finger count and the rate consistency; one line per problem
@@ -45,7 +52,9 @@ struct SlipControlInput {
 struct SlipControlOutput {
   double force = 0.0;  //!< grasp-force command to send [N], in [f_min, f_max], finite
   //! Ok, or the worst status of this cycle (the controller's combination of the finger
-  //! statuses); any status but Ok means the command was held at the last command due.
+  //! statuses); any status but Ok means the command was held at the last command due, except
+  //! under healthy_finger_fallback, where one faulty finger is reported while the other
+  //! finger's estimate computes the command.
   Status status = Status::Ok;
   GraspControllerOutput controller;                   //!< full controller output
   std::array<ObserverOutput, kMaxFingers> fingers{};  //!< each finger's observer output
@@ -57,7 +66,9 @@ struct SlipControlOutput {
 //! speed resolution and the observer status to the GraspController and returns its command.
 //! The statuses travel inside: when a finger's observer reports anything but a valid estimate
 //! (NoContact on contact loss, InvalidSample, SensorFault, an unknown code) the command due in
-//! that cycle is held at the last command (plus invalid_raise_step), never lowered.
+//! that cycle is held at the last command (plus invalid_raise_step), never lowered. With
+//! stuck_samples > 0 a finger whose wrench repeats exactly that many times in a row is reported
+//! SensorFault (its observer keeps running) until the wrench changes.
 //!
 //! Lifecycle: construct (validates, allocates the contact tables) -> step() / the run-time
 //! calls (noexcept, no allocation) -> reset(). set_mu() rebuilds the tables: not real-time.
@@ -115,6 +126,8 @@ class SlipControl {
   std::array<Observer, kMaxFingers> obs_;
   GraspController ctrl_;
   GraspControllerInput cin_{};
+  std::array<FingerWrench, kMaxFingers> prev_{};  // previous wrench per finger (stuck check)
+  std::array<int, kMaxFingers> repeats_{};        // consecutive exact repeats per finger
 };
 
 }  // namespace lugrip

@@ -69,6 +69,11 @@ class SlipControl:
             parameters were identified with (its ``observer:`` block): that is the observer used,
             with ``observer`` overriding it key by key.
         fingers: 1 or 2 fingertips measured.
+        stuck_samples: a finger whose four channels repeat bit for bit this many samples in a
+            row is reported SensorFault (a frozen sensor) and the command is held; 0: off.
+        healthy_finger_fallback: two fingers, one without a valid estimate: the other finger
+            alone computes the command (the status still reports the faulty finger) instead of
+            the command being held.
         observer: keywords of :class:`lugrip.Observer` (integrator, bandwidth, torque_noise, ...).
             Its ``dt`` defaults to 1 / ``sensor_rate`` when neither the file nor this mapping
             gives one.
@@ -98,6 +103,8 @@ class SlipControl:
         *,
         fingers: int = 2,
         observer: Mapping[str, Any] | None = None,
+        stuck_samples: int = 0,
+        healthy_finger_fallback: bool = False,
         **controller: Any,
     ):
         path = _params_path(params)
@@ -113,6 +120,10 @@ class SlipControl:
         if isinstance(fingers, bool) or fingers not in (1, 2):
             raise ValueError(f"fingers = {fingers!r}: must be 1 or 2")
         s.fingers = int(fingers)
+        if isinstance(stuck_samples, bool) or not isinstance(stuck_samples, int) or stuck_samples < 0:
+            raise ValueError(f"stuck_samples = {stuck_samples!r}: must be an integer >= 0 (0: off)")
+        s.stuck_samples = int(stuck_samples)
+        s.healthy_finger_fallback = bool(healthy_finger_fallback)
         try:
             self._sc = _core.SlipControl(_model(self._params), s)
         except ValueError as err:

@@ -34,6 +34,22 @@ TEST(NoAllocation, ClosedLoopStep) {
       c.schedule.push_back(ModeEvent{0.15, ModeAction::DynamicOn});
       c.schedule.push_back(ModeEvent{2.0, ModeAction::Pivot});
       c.schedule.push_back(ModeEvent{3.0, ModeAction::SlippingAvoidance});
+      // every fault kind, so that injection is covered too
+      for (int f = 0; f <= 9; ++f) {
+        FaultSpec spec;
+        spec.kind = static_cast<FaultKind>(f);
+        spec.t_start = 0.3 + 0.3 * f;
+        spec.duration = 0.2;
+        spec.burst = 3;
+        spec.every = 10;
+        spec.force = 3.0;
+        spec.torque = 0.01;
+        spec.force_rate = 1.0;
+        spec.time_constant = 0.1;
+        c.faults.push_back(spec);
+      }
+      c.stuck_samples = 20;
+      c.healthy_finger_fallback = model == PlantModel::Patch;  // both SlipControl paths
       ClosedLoop loop(c);  // allocates (construction)
       ClosedLoopSample s;
       const long before = lugrip_support::g_allocations.load();
@@ -42,7 +58,7 @@ TEST(NoAllocation, ClosedLoopStep) {
       for (int n = 0; n < 500; ++n) loop.step(s);
       const long used = lugrip_support::g_allocations.load() - before;
       EXPECT_EQ(used, 0) << to_string(model) << " " << to_string(kind);
-      EXPECT_TRUE(s.finite);
+      EXPECT_TRUE(s.finite);  // outputs finite (NaN readings excepted while a fault acts)
     }
   }
 }

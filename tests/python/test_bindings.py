@@ -31,7 +31,8 @@ STRUCTS = {
     "PlantState": ("grasp_plant.hpp", set()),
     "SensorConfig": ("grasp_plant.hpp", {"bias"}),  # get_bias / set_bias
     "PlantConfig": ("grasp_plant.hpp", {"moves", "disturbances"}),  # add_move / add_disturbance
-    "ClosedLoopConfig": ("closed_loop.hpp", {"schedule"}),  # add_event
+    "ClosedLoopConfig": ("closed_loop.hpp", {"schedule", "faults"}),  # add_event, add_fault
+    "FaultSpec": ("closed_loop.hpp", set()),
     "ClosedLoopSample": ("closed_loop.hpp", set()),
 }
 

@@ -16,14 +16,16 @@ from . import CliError
 __all__ = ["register", "run"]
 
 _EPILOG = """\
-scenarios: names in ./scenarios (or $LUGRIP_SCENARIOS) or its unseen/ folder, or YAML paths;
-'all' runs the paper's experiments, 'unseen' the objects the controller was not tuned on.
+scenarios: names in ./scenarios (or $LUGRIP_SCENARIOS) or its unseen/ and faults/ folders, or
+YAML paths; 'all' runs the paper's experiments, 'unseen' the objects the controller was not
+tuned on, 'faults' the injected sensor/actuator faults.
 examples:
   lugrip simulate all --out out/                        # the four experiments + baselines
   lugrip simulate exp2_small_resin_block --json m.json  # one scenario
   lugrip simulate all --short --plant lumped --no-baselines
   lugrip simulate box_heavy --plant mujoco --video out/box.mp4
   lugrip simulate all unseen --plant mujoco --seeds 8 --compare patch
+  lugrip simulate scenarios/faults/*.yaml --no-plots     # sensor and actuator faults
   lugrip simulate --list
 MuJoCo plant: writes DIR/mujoco.md, DIR/mujoco_<scenario>.png (frames of the lift and the pivot
 when offscreen rendering works: MUJOCO_GL=egl or osmesa) and the metrics JSON (default
@@ -133,13 +135,19 @@ def run(args: argparse.Namespace) -> int:
             raise CliError(
                 "no scenarios found (run from the repository root or set LUGRIP_SCENARIOS)"
             )
-        for name in names + list_scenarios(suite="unseen"):
+        for name in names + list_scenarios(suite="unseen") + list_scenarios(suite="faults"):
             s = load_scenario(name)
             print(f"{name:32s} {s.suite:7s} {s.title}")
         return 0
     names = []
     for n in args.scenarios:
-        names += list_scenarios() if n == "all" else list_scenarios(suite="unseen") if n == "unseen" else [n]
+        names += (
+            list_scenarios()
+            if n == "all"
+            else list_scenarios(suite=n)
+            if n in ("unseen", "faults")
+            else [n]
+        )
     if not names:
         raise CliError("no scenario given (names, YAML files, 'all' or 'unseen'; see --list)")
     try:
@@ -178,6 +186,14 @@ def run(args: argparse.Namespace) -> int:
             f"  dropped {'yes' if m['dropped'] else 'no'}",
             flush=True,
         )
+        if "fault_onset" in m:
+            lat = m["fault_status_latency"]
+            print(
+                f"    fault {', '.join(m['fault_kinds'])}: status latency "
+                f"{'-' if lat is None else lat} samples, min command {m['fault_min_command']:.3f} N"
+                f" (slip force {m['fault_min_force'] or float('nan'):.3f} N)",
+                flush=True,
+            )
         for name, c in r.criteria.items():
             if c["pass"] is False:
                 print(f"    failed: {name} (value {c['value']}, limit {c['limit']})")

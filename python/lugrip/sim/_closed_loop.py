@@ -24,10 +24,12 @@ from ._plant import PlantConfig, _Columns
 
 __all__ = [
     "CONTROLLER_KINDS",
+    "FAULT_KINDS",
     "MODE_ACTIONS",
     "ClosedLoopRun",
     "closed_loop_config",
     "estimator_params",
+    "fault_specs",
     "run_closed_loop",
 ]
 
@@ -46,6 +48,55 @@ MODE_ACTIONS = {
     "dynamic_on": _core.ModeAction.DynamicOn,
     "dynamic_off": _core.ModeAction.DynamicOff,
 }
+
+#: Accepted names of the injected faults (sensor faults change what the observers receive,
+#: actuator faults what the gripper receives; the plant itself is never altered).
+FAULT_KINDS = {
+    "dropout": _core.FaultKind.Dropout,
+    "nan_burst": _core.FaultKind.NanBurst,
+    "spike": _core.FaultKind.Spike,
+    "bias_drift": _core.FaultKind.BiasDrift,
+    "saturation": _core.FaultKind.Saturation,
+    "stuck": _core.FaultKind.Stuck,
+    "dead": _core.FaultKind.Dead,
+    "contact_loss": _core.FaultKind.ContactLoss,
+    "actuator_lag": _core.FaultKind.ActuatorLag,
+    "actuator_saturation": _core.FaultKind.ActuatorSaturation,
+}
+_FAULT_FIELDS = {name for name, _k, _d in _core.FaultSpec.fields} - {"kind"}
+_FAULT_INTS = {"finger", "burst", "every"}
+
+
+def fault_specs(items: Iterable[Mapping[str, Any]] | None) -> list[_core.FaultSpec]:
+    """C++ FaultSpecs from mappings such as ``{kind: nan_burst, finger: 0, t_start: 3.0,
+    burst: 5, every: 50, duration: 1.0}`` (fields of ``lugrip._core.FaultSpec``; times [s],
+    burst lengths and periods [samples], forces [N], torques [N m])."""
+    out = []
+    for k, item in enumerate(items or []):
+        if not isinstance(item, Mapping):
+            raise ValueError(f"faults[{k}]: expected a mapping with a 'kind', got {item!r}")  # noqa: TRY004 (file content)
+        d = dict(item)
+        kind = str(d.pop("kind", "")).lower().replace("-", "_")
+        if kind not in FAULT_KINDS:
+            raise ValueError(
+                f"faults[{k}].kind {item.get('kind')!r}: expected one of {', '.join(FAULT_KINDS)}"
+            )
+        unknown = sorted(set(d) - _FAULT_FIELDS)
+        if unknown:
+            raise ValueError(f"faults[{k}]: unknown field(s) {', '.join(unknown)}")
+        f = _core.FaultSpec()
+        f.kind = FAULT_KINDS[kind]
+        for name, v in d.items():
+            if name in _FAULT_INTS:
+                if isinstance(v, bool) or not isinstance(v, int) or abs(v) > 2**31 - 1:
+                    raise ValueError(f"faults[{k}].{name} = {v!r}: must be an integer")
+                setattr(f, name, int(v))
+            else:
+                if isinstance(v, bool) or not isinstance(v, (int, float)):
+                    raise ValueError(f"faults[{k}].{name} = {v!r}: must be a number")
+                setattr(f, name, float(v))
+        out.append(f)
+    return out
 
 
 class ClosedLoopRun(_Columns):
@@ -67,7 +118,11 @@ class ClosedLoopRun(_Columns):
       lumped plant: slip path length) [m], ``rotation`` (theta - theta0) and ``theta`` [rad],
       ``cog_x``, ``cog_y`` (CoG relative to the grasp point) [m], ``gripper_y`` [m],
       ``ext_fx``, ``ext_fy`` [N], ``ext_tau`` [N m] (disturbance), ``supported``, ``dropped``
-      (latched), ``finite`` (every value of the row finite).
+      (latched), ``finite`` (every value of the row finite; the measured columns excepted
+      while an injected fault acts);
+    * cycle: ``status`` (Status code the cycle returned: SlipControl's while the lugrip law
+      runs, else the worst observer status), ``fault_active`` (an injected fault acted),
+      ``actuator_command`` (what reached the gripper after actuator faults) [N].
 
     Derived: ``S`` = max(S_0, S_1) (what the controller regulates), ``slip_mm``,
     ``rotation_deg``, ``hang_deg`` (angle of grasp point -> CoG from the downward vertical).
@@ -178,6 +233,9 @@ def closed_loop_config(
     cone_margin: float = 0.8,
     cone_release_rate: float = 0.0,
     estimator: ContactParams | Mapping[str, Any] | str | None = None,
+    faults: Iterable[Mapping[str, Any]] | None = None,
+    stuck_samples: int = 0,
+    healthy_finger_fallback: bool = False,
 ) -> _core.ClosedLoopConfig:
     """The validated C++ ClosedLoopConfig (see :func:`run_closed_loop` for the arguments)."""
     plant = config if isinstance(config, PlantConfig) else PlantConfig.from_dict(config)
@@ -206,6 +264,12 @@ def closed_loop_config(
     c.cone_release_rate = float(cone_release_rate)
     for t, action in _schedule(mode_schedule):
         c.add_event(t, action)
+    for f in fault_specs(faults):
+        c.add_fault(f)
+    if isinstance(stuck_samples, bool) or not isinstance(stuck_samples, int) or stuck_samples < 0:
+        raise ValueError(f"stuck_samples = {stuck_samples!r}: must be an integer >= 0 (0: off)")
+    c.stuck_samples = int(stuck_samples)
+    c.healthy_finger_fallback = bool(healthy_finger_fallback)
     msg = _core.validate_closed_loop_config(c)
     if msg:
         raise ValueError("invalid closed-loop configuration:\n" + msg.rstrip())
@@ -225,6 +289,9 @@ def run_closed_loop(
     cone_margin: float = 0.8,
     cone_release_rate: float = 0.0,
     estimator: ContactParams | Mapping[str, Any] | str | None = None,
+    faults: Iterable[Mapping[str, Any]] | None = None,
+    stuck_samples: int = 0,
+    healthy_finger_fallback: bool = False,
 ) -> ClosedLoopRun:
     """Simulate the grasp in closed loop for `duration` seconds (one C++ call).
 
@@ -251,6 +318,12 @@ def run_closed_loop(
             believes about the contact), see :func:`estimator_params`; None: the plant's own.
             A YAML written by ``lugrip identify`` also brings its ``observer:`` block (the
             observer it was identified with) as the base of `observer_settings`.
+        faults: injected sensor/actuator faults (:func:`fault_specs` mappings); the plant is
+            never altered, only what the observers read and what the gripper receives.
+        stuck_samples: the lugrip law reports SensorFault (and holds the command) when a
+            finger's wrench repeats bit for bit this many samples in a row; 0: off.
+        healthy_finger_fallback: the lugrip law: with one finger faulty the other computes
+            the command (instead of holding it).
 
     Returns:
         :class:`ClosedLoopRun` (dict of numpy arrays).
@@ -269,6 +342,9 @@ def run_closed_loop(
         cone_margin=cone_margin,
         cone_release_rate=cone_release_rate,
         estimator=estimator,
+        faults=faults,
+        stuck_samples=stuck_samples,
+        healthy_finger_fallback=healthy_finger_fallback,
     )
     duration = float(duration)
     if not (math.isfinite(duration) and duration >= 0.0):

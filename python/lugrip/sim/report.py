@@ -192,6 +192,22 @@ def markdown_section(
                 "",
             ]
     lines += ["### Metrics (lugrip against the baselines)", "", metrics_table(results), ""]
+    from .faults import fault_table
+
+    faults = fault_table(results)
+    if faults:
+        lines += [
+            "### Sensor and actuator faults (one row per fault scenario)",
+            "",
+            (
+                "Status latency: samples (500 Hz) from the fault onset to the first cycle whose "
+                "status is the expected one; slip force: `static_grasp_force(..., s_ref=1)` of "
+                "the true loads in the second before the onset."
+            ),
+            "",
+            faults,
+            "",
+        ]
     lines += ["### Pass criteria", "", criteria_table(results), ""]
     lines += ["Criteria: " + "; ".join(f"`{k}`: {v}" for k, v in CRITERIA.items()) + ".", ""]
     base_figs = [(k, v) for k, v in figures.items() if k.endswith("_baselines.png")]
@@ -563,6 +579,11 @@ def mujoco_markdown(data: dict[str, Any], base: Path) -> str:
         )
     if fails:
         lines += ["Seeds failing on MuJoCo:", "", *fails, ""]
+    from .faults import fault_table
+
+    faults = fault_table(list(res.values()))
+    if faults:
+        lines += ["Sensor and actuator faults on MuJoCo (one row per fault scenario):", "", faults, ""]
     lines += [
         "ω̂ against MuJoCo's true slip rate (pad 0 and 1, from the lift start): "
         + "; ".join(

@@ -21,6 +21,7 @@ A scenario file (``scenarios/<name>.yaml``) holds::
     criteria: {...}                  # see CRITERIA
     baselines: {constant_force: true, friction_cone: true}
     short: {...}                     # overrides for --short (top-level keys; plant merged)
+    faults: {inject: [...], ...}     # injected sensor/actuator faults (lugrip.sim.faults)
 
 Slip and rotation are measured in the *hold* phases: from ``hold_start`` (by default the start of
 the lift, so the lift-off, where the load arrives, counts) to the end, minus the pivoting
@@ -45,6 +46,7 @@ from .. import __version__
 from .._controller import controller_settings, static_grasp_force
 from .._params import ContactParams
 from .._yaml import load_yaml, to_number
+from . import faults as _faults
 from ._closed_loop import ClosedLoopRun, run_closed_loop
 from ._plant import PlantConfig
 
@@ -105,6 +107,7 @@ CRITERIA = {
         "mean grip force from the lift start on < the smallest constant force that survives "
         "the scenario (bisection)"
     ),
+    **_faults.FAULT_CRITERIA,
 }
 
 
@@ -136,6 +139,8 @@ def list_scenarios(directory: str | Path | None = None, suite: str = "paper") ->
         names += sorted(p.stem for p in d.glob("*.yaml"))
     if suite in ("unseen", "all"):
         names += sorted(p.stem for p in (d / "unseen").glob("*.yaml"))
+    if suite == "faults":
+        names += sorted(p.stem for p in (d / "faults").glob("*.yaml"))
     return names
 
 
@@ -149,7 +154,7 @@ def find_scenario(name: str | Path) -> Path:
         return p
     d = scenario_dir()
     if d is not None:
-        for cand in (d / f"{name}.yaml", d / "unseen" / f"{name}.yaml"):
+        for cand in (d / f"{name}.yaml", d / "unseen" / f"{name}.yaml", d / "faults" / f"{name}.yaml"):
             if cand.is_file():
                 return cand
     known = ", ".join(list_scenarios(suite="all")) or "none found (set LUGRIP_SCENARIOS)"
@@ -189,13 +194,14 @@ _KEYS = {
     "suite",
     "mujoco",
     "criteria_by_plant",
+    "faults",
 }
 
 #: Plant models a scenario runs on: the two of lugrip's own simulator and MuJoCo's gripper.
 PLANT_MODELS = ("patch", "lumped", "mujoco")
 #: Scenario sets: the paper's experiments (scenarios/*.yaml) and objects the controller was not
 #: tuned on (scenarios/unseen/*.yaml).
-SUITES = ("paper", "unseen")
+SUITES = ("paper", "unseen", "faults")
 
 
 @dataclasses.dataclass
@@ -222,6 +228,7 @@ class Scenario:
     suite: str = "paper"
     mujoco: dict = dataclasses.field(default_factory=dict)
     criteria_by_plant: dict = dataclasses.field(default_factory=dict)
+    faults: dict = dataclasses.field(default_factory=dict)
     source: Path | None = None
 
     @classmethod
@@ -283,6 +290,7 @@ class Scenario:
             suite=str(data.get("suite") or "paper"),
             mujoco=dict(data.get("mujoco") or {}),
             criteria_by_plant={str(k): dict(v) for k, v in by_plant.items()},
+            faults=_faults.fault_block(data.get("faults"), where),
             source=source,
         )
         if s.suite not in SUITES:
@@ -517,7 +525,13 @@ def compute_metrics(
         )
     hold_slip, hold_rot = _hold_increment(run, phases, lumped)
     lift_slip, lift_rot = _hold_increment(run, [(scenario.lift_start, scenario.lift_end)], lumped)
-    finite = all(np.all(np.isfinite(np.asarray(v, dtype=float))) for v in run.values())
+    faulty = np.asarray(run["fault_active"], dtype=bool) if "fault_active" in run else None
+    finite = all(
+        np.all(np.isfinite(np.asarray(v, dtype=float))[~faulty])
+        if faulty is not None and k.startswith(("f_n_meas", "f_t_meas", "tau_meas"))
+        else np.all(np.isfinite(np.asarray(v, dtype=float)))
+        for k, v in run.items()
+    )
     cmd = run["command"]
     m.update(
         dropped=bool(run["dropped"][-1]),
@@ -593,6 +607,8 @@ def compute_metrics(
             )
     elif "min_force" in m:
         m["min_force_plant"] = m["min_force"]  # the patch follows lugrip's limit surface
+    if scenario.faults:
+        m.update(_faults.fault_metrics(scenario.faults, run, cfg))
     m["scene_status"] = scene["status"] if scene else "ok"
     if scene:
         m["scene"] = dict(scene)
@@ -637,6 +653,13 @@ def simulate(
     """One closed-loop run of `scenario` on plant `model` (patch, lumped: lugrip's C++ loop;
     mujoco: :func:`lugrip.sim.mujoco.loop.run_mujoco_loop`) with controller `kind`."""
     est = scenario.estimator_for(model)
+    if scenario.faults:
+        options = dict(
+            options,
+            faults=scenario.faults["inject"],
+            stuck_samples=scenario.faults.get("stuck_samples", 0),
+            healthy_finger_fallback=scenario.faults.get("healthy_finger_fallback", False),
+        )
     if model == "mujoco":
         from .mujoco.loop import run_mujoco_loop
 
@@ -777,7 +800,10 @@ def _evaluate(scenario: Scenario, metrics: dict[str, dict[str, Any]], search) ->
     m = metrics["lugrip"]
     out: dict[str, dict] = {}
     for name, limit in c.items():
-        if name == "no_drop":
+        fault = _faults.evaluate(name, limit, m)
+        if fault is not None:
+            out[name] = fault
+        elif name == "no_drop":
             out[name] = _criterion(m["dropped"], False, not m["dropped"])
         elif name == "no_nan":
             ok = all(mm["finite"] for mm in metrics.values())

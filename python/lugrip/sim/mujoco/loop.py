@@ -24,9 +24,10 @@ from typing import Any
 import mujoco
 import numpy as np
 
+from ... import _core
 from ..._params import ContactParams
 from ..._slip_control import SlipControl
-from .._closed_loop import ClosedLoopRun, _schedule, estimator_params
+from .._closed_loop import ClosedLoopRun, _schedule, estimator_params, fault_specs
 from .._plant import Disturbance, PlantConfig
 from .gripper import SceneSpec, build_scene, spin_coefficient
 
@@ -146,6 +147,9 @@ def run_mujoco_loop(
     cone_release_rate: float = 0.0,
     estimator: ContactParams | Mapping[str, Any] | str | None = None,
     frame_callback: Callable[[mujoco.MjModel, mujoco.MjData, float], None] | None = None,
+    faults=None,
+    stuck_samples: int = 0,
+    healthy_finger_fallback: bool = False,
 ) -> MujocoRun:
     """Simulate the scenario's grasp on MuJoCo in closed loop for `duration` seconds.
 
@@ -159,6 +163,10 @@ def run_mujoco_loop(
             The controller starts when both pads first touch the object (bumpless from the
             force then); before that the gripper closes with ``actuator.f_init``.
         frame_callback: called as f(model, data, t) at every sensor sample (rendering).
+        faults, stuck_samples, healthy_finger_fallback: injected sensor/actuator faults, the
+            frozen-sensor check and the one-faulty-finger policy, as
+            :func:`lugrip.sim.run_closed_loop` (the same C++ FaultInjector: sensor faults change
+            the wrenches SlipControl receives, actuator faults the command the gripper gets).
 
     Returns:
         :class:`MujocoRun`, one row per sensor sample.
@@ -183,7 +191,9 @@ def run_mujoco_loop(
     obs_kw = {"torque_noise": float(plant.sensor.torque_noise), "dt": T_s}
     obs_kw.update(dict(observer_settings or {}))
     # the baselines command by their own law; SlipControl's observers still run for the log
-    ctrl = SlipControl(est, fingers=2, observer=obs_kw, **ctrl_s)
+    ctrl = SlipControl(est, fingers=2, observer=obs_kw, stuck_samples=stuck_samples,
+        healthy_finger_fallback=healthy_finger_fallback, **ctrl_s)
+    injector = _core.FaultInjector(fault_specs(faults), T_s) if faults else None
     limits = {
         k: getattr(ctrl.settings.controller, k)
         for k in ("f_min", "f_max", "max_rate_up", "max_rate_down")
@@ -212,7 +222,7 @@ def run_mujoco_loop(
 
     a_cfg = plant.actuator
     decay = math.exp(-h / a_cfg.time_constant) if a_cfg.time_constant > 0 else 0.0
-    f_act = command = float(a_cfg.f_init)
+    f_act = command = gripper_cmd = float(a_cfg.f_init)
     f_cap = min(float(a_cfg.f_max), scene.force_range)
     moves = plant.moves
     wrist = scene.wrist
@@ -236,8 +246,11 @@ def run_mujoco_loop(
         "supported",
         "dropped",
         "finite",
+        "status",
+        "fault_active",
     ):
         col(name, np.int64)
+    col("actuator_command")
     for k in (0, 1):
         for name in (
             "f_n_meas",
@@ -287,7 +300,7 @@ def run_mujoco_loop(
         fx, fy, tz = disturbance_wrench(plant.disturbances, t, theta)
         d.xfrc_applied[body["object"]] = (0.0, fx, fy, tz, 0.0, 0.0)
         # gripper force: first-order lag and rate limit toward the held command
-        target = command + (f_act - command) * decay
+        target = gripper_cmd + (f_act - gripper_cmd) * decay
         step_max = a_cfg.rate_limit * h
         f_act = min(max(target, f_act - step_max), f_act + step_max)
         f_act = min(max(f_act, 0.0), f_cap)
@@ -311,6 +324,10 @@ def run_mujoco_loop(
         true = acc / ratio  # the sensor's average over its sample period (anti-alias)
         acc[:] = 0.0
         meas = true[:, :4] + bias + rng.normal(0.0, 1.0, (2, 4)) * noise
+        fault_on = False
+        if injector is not None:
+            fault_on, w = injector.sensors(i, meas.ravel().tolist())
+            meas = np.asarray(w, dtype=float).reshape(2, 4)
         in_contact = [true[k, 4] > 0 and true[k, 0] > 1e-4 for k in (0, 1)]
         for k in (0, 1):
             touched[k] = touched[k] or in_contact[k]
@@ -421,8 +438,18 @@ def run_mujoco_loop(
                 or status == "lost_contact"
             )
 
+        gripper_cmd = command
+        if injector is not None:
+            gripper_cmd, acted = injector.actuator(i, command)
+            fault_on = fault_on or acted
         cols["t"][i] = ts
         cols["command"][i] = command
+        cols["actuator_command"][i] = gripper_cmd
+        cols["fault_active"][i] = int(fault_on)
+        if out is not None:
+            cols["status"][i] = int(getattr(out.status, "value", out.status))
+        else:
+            cols["status"][i] = 3  # before the first touch: no contact
         lug = kind == "lugrip" and started and out is not None
         cols["static_force"][i] = out.controller.static_force if lug else command
         cols["dynamic_force"][i] = out.controller.dynamic_force if lug else 0.0
@@ -469,7 +496,7 @@ def run_mujoco_loop(
         row_ok = math.isfinite(command) and all(
             math.isfinite(cols[c][i]) for c in ("slip", "theta")
         )
-        row_ok = row_ok and bool(np.all(np.isfinite(meas)))
+        row_ok = row_ok and (fault_on or bool(np.all(np.isfinite(meas))))
         if samples is not None:
             row_ok = row_ok and all(
                 math.isfinite(samples[k].omega_hat) and math.isfinite(samples[k].S) for k in (0, 1)
