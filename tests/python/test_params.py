@@ -28,7 +28,7 @@ BAD = {
     "sigma_z": [-2.0, math.nan, -math.inf],
     "delta": [0.0, -0.0018, 1.0, math.nan, math.inf],
     "gamma": [0.0, -0.1, 1 / 3, 0.5, math.nan],
-    "k": [0.0, 0.4, -4.0, math.nan, -math.inf],
+    "k": [0.3, 0.4, 1e-9, -4.0, math.nan, -math.inf],
     "c_max": [0.0, -1.5, math.nan, math.inf, 1e4],
 }
 
@@ -46,7 +46,7 @@ def valid_rule(name: str, v: float) -> bool:
     if name == "gamma":
         return 0 < v < 1 / 3
     if name == "k":
-        return v >= 0.5
+        return v >= 0.5 or v == 0.0  # 0: the elliptic limit surface
     if name == "c_max":
         return math.isfinite(v) and 0 < v <= 1000
     raise KeyError(name)
@@ -94,7 +94,7 @@ def test_one_bad_field_is_named(field, value):
 
 def test_every_bad_field_reported_at_once():
     with pytest.raises(ValueError) as info:
-        lugrip.ContactParams(mu=-1, beta_a=-1, sigma0=0, sigma_z=-1, delta=0, gamma=0.5, k=0, c_max=0)
+        lugrip.ContactParams(mu=-1, beta_a=-1, sigma0=0, sigma_z=-1, delta=0, gamma=0.5, k=0.2, c_max=0)
     msg = str(info.value)
     for field in BAD:
         assert f"{field} = " in msg

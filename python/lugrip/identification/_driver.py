@@ -69,7 +69,8 @@ def identify(
     Without ``params0`` (``start="data"``) the parameters come from stages, each from what
     the data carry (docs/model.md §8): the phases of every sample from the wrench and the
     motion together, the sensor noise from the still samples, (a) the limit surface (mu,
-    delta, gamma, the pressure exponent k) from the gross-sliding wrench, (c) beta_A from its
+    delta, gamma and the shape: the pressure exponent k, or the elliptic limit surface, k = 0,
+    whichever lies closer to the points) from the gross-sliding wrench, (c) beta_A from its
     speed dependence with a significance test (not significant: "sliding speed not
     observable", beta_A set so that the observer reports speed_observable = False, and kept
     fixed), (b) sigma0 and sigma_z from the loading runs. Then (``refine``) the paper's eq. 32

@@ -293,6 +293,8 @@ def _stage_dict(st) -> dict:
             "stderr": {k: v for k, v in ls.stderr.items()},
             "points": len(ls.points), "at_bound": list(ls.at_bound),
             "rms_distance": ls.residual_rms,
+            "shape": "ellipse" if ls.k == 0.0 else "pressure",
+            "rms_distance_by_shape": dict(ls.shape_rms),
         },
     }
     if st.presliding is not None:
