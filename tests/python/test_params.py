@@ -215,3 +215,25 @@ def test_read_observer_settings_is_exported(tmp_path):
     assert yaml.safe_load(path.read_text())["observer"]["bandwidth"] == 700.0
     lugrip.ContactParams.table1().to_yaml(path)
     assert lugrip.read_observer_settings(path) is None
+
+
+def test_elliptic_limit_surface_round_trips_and_lists(tmp_path, capsys):
+    """k = 0 (the elliptic limit surface) is a valid value: YAML round trip, the k = 4 xi,
+    `lugrip params --check` names the shape, `lugrip identify --k ellipse` parses to 0 and
+    a k between 0 and 0.5 stays an error."""
+    from lugrip.cli import main
+    from lugrip.commands.identify import _exponent
+
+    p = lugrip.ContactParams.table1().replace(k=0.0)
+    assert p.xi == lugrip.shape_factor(4.0)
+    path = tmp_path / "ellipse.yaml"
+    p.to_yaml(path)
+    assert lugrip.ContactParams.from_yaml(path) == p
+    assert main(["params", "--check", str(path)]) == 0
+    assert "limit surface: the ellipse" in capsys.readouterr().out
+    assert _exponent("ellipse") == 0.0 and _exponent("0") == 0.0 and _exponent("inf") == math.inf
+    import argparse
+
+    for bad in ("0.2", "-1", "nan"):
+        with pytest.raises(argparse.ArgumentTypeError):
+            _exponent(bad)

@@ -215,7 +215,8 @@ class IdentificationResult:
                 "k": {
                     "value": self.params.k if math.isfinite(self.params.k) else ".inf",
                     "unit": "-",
-                },
+                }
+                | ({"note": "0: the elliptic limit surface"} if self.params.k == 0.0 else {}),
                 "c_max": {"value": self.params.c_max, "unit": "-"},
             },
             # the observer inside the cost: the parameters are identified FOR it (docs/model.md
