@@ -40,7 +40,7 @@ class ContactParams:
         k: pressure exponent (2 Hertz, 4 the paper's xi = 0.6354, inf uniform); 0 selects
             the elliptic limit surface (f_t/(mu f_n))^2 + (tau/tau_max)^2 = 1 of a point
             contact on an elliptic friction cone, with xi fixed at its k = 4 value
-            (docs/model.md §3).
+            (docs/model.md §3.5).
         c_max: saturation of the normalized CoR |c~| (paper: 1.5).
 
     Raises:
