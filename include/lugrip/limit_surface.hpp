@@ -13,7 +13,7 @@ inline constexpr double kMinPressureExponent = 0.5;
 //! law: (f~_t)^2 + (tau~)^2 = 1 in the normalized plane (f_t/(mu f_n), tau/tau_max), the shape
 //! of a point contact on an elliptic friction cone (MuJoCo condim 4). No pressure of the family
 //! below produces it. Its curves have the closed form f~ = u/sqrt(1+u^2), tau~ = 1/sqrt(1+u^2),
-//! u = |c~|/xi (the maximum-dissipation point for the CoR at c~); docs/model.md section 3.
+//! u = |c~|/xi (the maximum-dissipation point for the CoR at c~); docs/model.md section 3.5.
 inline constexpr double kEllipticLimitSurface = 0.0;
 
 //! Torsional shape factor of the elliptic limit surface, a convention (the ellipse fixes only
