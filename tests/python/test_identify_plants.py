@@ -61,6 +61,9 @@ def test_grid_stribeck_limit_surface_and_unobservable_speed(stribeck):
     [mu_k, mu_s] +- 5 %, tau_max at 2 N and 8 N within 15 %, nothing at a bound, the speed
     reported unobservable (beta_A fixed by the observability rule, not fitted)."""
     truth, r, _ = stribeck
+    # a distributed Hertzian contact: the pressure family lies closer than the ellipse
+    assert r.params.k != 0.0
+    assert r.stages.ls.shape_rms["pressure"] < r.stages.ls.shape_rms["ellipse"]
     assert 0.95 * truth.mu_kinetic <= r.params.mu <= 1.05 * truth.mu_static
     for f in (2.0, 8.0):
         assert abs(_tau_ratio(r, truth, f) - 1.0) <= 0.15, f
@@ -89,6 +92,7 @@ def test_grid_viscous_speed_is_observable_and_tracked(viscous):
     beta_A and delta trade against each other through k) within 30 % and the |omega| error
     where |c~| <= 1.5 well below that of predicting zero."""
     truth, r, test = viscous
+    assert r.params.k != 0.0  # the pressure family, not the ellipse
     assert r.speed_observable is True
     p = r.params
     assert p.beta_a * p.delta**4 == pytest.approx(truth.beta_a * truth.delta**4, rel=0.3)
