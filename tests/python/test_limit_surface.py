@@ -206,3 +206,14 @@ def test_elliptic_limit_surface_closed_form():
     model = lugrip._core.ContactModel(params.to_core())
     tau2 = float(np.asarray(model.tau_max(np.array([2.0])))[0])
     assert tau2 == pytest.approx(params.mu * ls.xi * params.delta * 2.0 ** (1 + params.gamma), rel=1e-12)
+
+
+def test_patch_plant_refuses_the_ellipse():
+    """The pressure patch needs a pressure distribution; k = 0 (no pressure law) is refused
+    with a message naming the reason, while the contact model accepts it."""
+    from lugrip.sim import PatchContact
+
+    p = lugrip.ContactParams.table1().replace(k=0.0)
+    with pytest.raises(ValueError, match="elliptic limit surface"):
+        PatchContact(p)
+    PatchContact(p.replace(k=0.5))

@@ -105,7 +105,8 @@ def identify(
             rotation-only data (warned either way).
         score_saturated: also score sliding samples whose CoR the observer clips at c_max.
         threads: C++ threads (0: all cores). k, c_max: pressure exponent (None: identified
-            by the stages; 4 for a params0-less fit without stages) and CoR clip (1.5).
+            by the stages, the pressure family and the elliptic limit surface compared; 0:
+            the ellipse; 4 for a params0-less fit without stages) and CoR clip (1.5).
         progress: called as progress(iteration, cost, params).
 
     Raises:
@@ -368,8 +369,9 @@ def identify(
         message = "parameter(s) at a bound: " + ", ".join(f"{n} ({where})" for n, where in at_bound)
         if any(n == "k" for n, _ in at_bound):
             message += (
-                " (k at 0.5: the sliding wrench is more elliptic than any pressure "
-                "profile of the limit-surface family; hold it with k=0.5, --k 0.5, to accept it)"
+                " (k at 0.5: the sliding wrench lies outside every pressure profile of the "
+                "limit-surface family, yet the elliptic limit surface fits it worse; hold k "
+                "with k=0.5 / --k 0.5 or k=0 / --k ellipse to accept one of them)"
             )
         warnings.warn(message, IdentificationWarning, stacklevel=2)
     elif status not in ("converged", "stages"):
