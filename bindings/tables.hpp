@@ -33,7 +33,7 @@ struct Table<ContactParams> {
       field("sigma_z", &S::sigma_z, "bristle damping [N m s/rad]"),
       field("delta", &S::delta, "contact-radius law rho = delta f_n^gamma [m/N^gamma]"),
       field("gamma", &S::gamma, "contact-radius exponent [-]"),
-      field("k", &S::k, "pressure exponent [-]"),
+      field("k", &S::k, "pressure exponent [-]; 0 selects the elliptic limit surface"),
       field("c_max", &S::c_max, "saturation of the normalized CoR |c~| [-]"));
 };
 

@@ -36,9 +36,22 @@ inline void hermite(const double* tab, int n, double x, double& v0, double& d0, 
   d1 = (g00 * (a[2] - b[2]) + g10 * a[3] + g11 * b[3]) * dn;
 }
 
+// The elliptic limit surface at a = |c~| >= 0 (finite): u = a / xi_E, F = u / sqrt(1 + u^2),
+// T = 1 / sqrt(1 + u^2); dT/da = -(a / xi_E) dF/da as for every maximum-dissipation LS.
+inline LsPoint ellipse_point(double a) noexcept {
+  const double u = a / kEllipseShapeFactor, s = 1.0 / std::sqrt(1.0 + u * u), s3 = s * s * s;
+  LsPoint r;
+  r.F = u * s;
+  r.T = s;
+  r.dF = s3 / kEllipseShapeFactor;
+  r.dT = -u * s3 / kEllipseShapeFactor;
+  return r;
+}
+
 }  // namespace
 
 double shape_factor(double k) {
+  if (k == kEllipticLimitSurface) return kEllipseShapeFactor;
   if (!(k > 0.0)) throw std::invalid_argument("shape_factor: k must be > 0");
   if (std::isinf(k)) return 2.0 / 3.0;
   // xi = B(3/k, 1+1/k) / B(2/k, 1+1/k)
@@ -46,11 +59,20 @@ double shape_factor(double k) {
 }
 
 LimitSurface::LimitSurface(double k, int intervals) : k_(k), n_(intervals > 0 ? intervals : 256) {
-  if (std::isnan(k) || !(k >= kMinPressureExponent))
+  if (std::isnan(k) || !(k >= kMinPressureExponent || k == kEllipticLimitSurface))
     throw std::invalid_argument("LimitSurface: k = " + std::to_string(k) +
-                                ": the pressure exponent must be >= 0.5 (inf for uniform pressure)");
+                                ": the pressure exponent must be >= 0.5 (inf for uniform pressure, "
+                                "0 for the elliptic limit surface)");
   if (n_ < 16 || n_ > 100000) throw std::invalid_argument("LimitSurface: intervals must be in [16, 1e5]");
   xi_ = shape_factor(k);
+  if (k == kEllipticLimitSurface) {  // F ~ a/xi; F ~ 1 - xi^2/(2 a^2), T ~ xi/a
+    elliptic_ = true;
+    p_k_ = m_k_ = 0.0;
+    s_k_ = 1.0 / xi_;
+    a_f_ = 0.5 * xi_ * xi_;
+    a_tau_ = xi_;
+    return;
+  }
   if (std::isinf(k)) {
     p_k_ = kPi;
     m_k_ = 2.0 * kPi / 3.0;
@@ -121,6 +143,7 @@ LsPoint LimitSurface::integrate(double a) const {
   a = std::fabs(a);
   if (a == 0.0) return LsPoint{0.0, 1.0, s_k_, 0.0};
   if (std::isinf(a)) return LsPoint{1.0, 0.0, 0.0, 0.0};
+  if (elliptic_) return ellipse_point(a);
   std::vector<double> x, w;
   detail::gauss_gegenbauer(400, 0.0, x, w);
   return quad(a, x, w);
@@ -213,6 +236,7 @@ LsPoint LimitSurface::eval(double a) const noexcept {
     const double nan = std::numeric_limits<double>::quiet_NaN();
     return LsPoint{nan, nan, nan, nan};
   }
+  if (elliptic_) return std::isinf(a) ? LsPoint{1.0, 0.0, 0.0, 0.0} : ellipse_point(a);
   if (a <= 1.0) {
     hermite(inner_.data(), n_, a, r.F, r.dF, r.T, r.dT);
     return r;

@@ -27,7 +27,8 @@ bool validate(const ContactParams& p, std::string* message) {
   if (!(std::isfinite(p.sigma_z) && p.sigma_z >= 0.0)) bad("sigma_z", p.sigma_z, "must be finite and >= 0 [N m s/rad]");
   if (!(std::isfinite(p.delta) && p.delta > 0.0 && p.delta < 1.0)) bad("delta", p.delta, "must be finite, > 0 and < 1 [m/N^gamma]");
   if (!(p.gamma > 0.0 && p.gamma < 1.0 / 3.0)) bad("gamma", p.gamma, "must satisfy 0 < gamma < 1/3");
-  if (!(p.k >= kMinPressureExponent)) bad("k", p.k, "must be >= 0.5 (inf for uniform pressure)");
+  if (!(p.k >= kMinPressureExponent || p.k == kEllipticLimitSurface))
+    bad("k", p.k, "must be >= 0.5 (inf for uniform pressure) or 0 (elliptic limit surface)");
   if (!(std::isfinite(p.c_max) && p.c_max > 0.0 && p.c_max <= 1.0e3)) bad("c_max", p.c_max, "must be finite, > 0 and <= 1000");
   if (message) *message = msg;
   return msg.empty();

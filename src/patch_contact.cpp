@@ -6,6 +6,7 @@
 #include <string>
 
 #include "lugrip/grasp_plant.hpp"
+#include "lugrip/limit_surface.hpp"
 #include "quadrature.hpp"
 
 namespace lugrip {
@@ -60,6 +61,9 @@ void ring_integrals(double ra, double rb, double k, double& W, double& Q) {
 PatchContact::PatchContact(const ContactParams& params, const PatchSettings& settings)
     : p_(params), s_(settings) {
   validate_or_throw(p_);
+  if (p_.k == kEllipticLimitSurface)
+    throw std::invalid_argument("PatchContact: k = 0 (the elliptic limit surface) has no pressure "
+                                "distribution; the patch needs a pressure exponent >= 0.5");
   if (!(s_.rings >= 1 && s_.rings <= 200))
     throw std::invalid_argument("PatchSettings.rings = " + std::to_string(s_.rings) + ": must be in [1, 200]");
   if (!(std::isfinite(s_.bristle_stiffness) && s_.bristle_stiffness > 0.0))

@@ -9,9 +9,23 @@ namespace lugrip {
 //! (xi -> 0) that the fixed-size tables cannot resolve to 1e-6.
 inline constexpr double kMinPressureExponent = 0.5;
 
+//! The value of ContactParams::k that selects the elliptic limit surface instead of a pressure
+//! law: (f~_t)^2 + (tau~)^2 = 1 in the normalized plane (f_t/(mu f_n), tau/tau_max), the shape
+//! of a point contact on an elliptic friction cone (MuJoCo condim 4). No pressure of the family
+//! below produces it. Its curves have the closed form f~ = u/sqrt(1+u^2), tau~ = 1/sqrt(1+u^2),
+//! u = |c~|/xi (the maximum-dissipation point for the CoR at c~); docs/model.md section 3.5.
+inline constexpr double kEllipticLimitSurface = 0.0;
+
+//! Torsional shape factor of the elliptic limit surface, a convention (the ellipse fixes only
+//! the product xi rho): the paper's pad value xi(4), so that tau_max = mu xi rho f_n keeps its
+//! meaning and rho = delta f_n^gamma stays the contact radius of a pad whose torsional capacity
+//! was set from the paper's k = 4.
+inline constexpr double kEllipseShapeFactor = 0.6354098135954843;
+
 //! Torsional shape factor xi(k) = (3/4) Gamma(3/k)^2 / (Gamma(2/k) Gamma(4/k)), so that
 //! tau_max = mu xi rho f_n. xi(2) = 3 pi/16, xi(4) = 0.6354098, xi(inf) = 2/3.
-//! k must be > 0 (std::numeric_limits<double>::infinity() for a uniform pressure).
+//! k must be > 0 (std::numeric_limits<double>::infinity() for a uniform pressure), or
+//! kEllipticLimitSurface (returns kEllipseShapeFactor).
 double shape_factor(double k);
 
 //! Magnitudes of the normalized LS at a = |c~| and their derivatives d/da.
@@ -37,11 +51,13 @@ struct LsPoint {
 //! and positive.
 class LimitSurface {
  public:
-  //! k: pressure exponent, >= kMinPressureExponent (0.5), may be +infinity. Throws
+  //! k: pressure exponent, >= kMinPressureExponent (0.5), may be +infinity; or
+  //! kEllipticLimitSurface (0) for the ellipse, evaluated in closed form (no tables). Throws
   //! std::invalid_argument otherwise.
   explicit LimitSurface(double k = 4.0, int intervals = 0);
 
   double k() const noexcept { return k_; }
+  bool elliptic() const noexcept { return elliptic_; }
   double xi() const noexcept { return xi_; }
 
   //! Magnitudes and derivatives at a = |c~| (a < 0 is treated as |a|; NaN gives NaN).
@@ -65,7 +81,8 @@ class LimitSurface {
   double tail_force() const noexcept { return a_f_; }
   double tail_torque() const noexcept { return a_tau_; }
 
-  //! Direct (slow) quadrature at one point, bypassing the tables; for tests.
+  //! Direct (slow) quadrature at one point, bypassing the tables; for tests (the closed form
+  //! for the ellipse).
   LsPoint integrate(double a) const;
 
   int intervals() const noexcept { return n_; }
@@ -73,6 +90,7 @@ class LimitSurface {
  private:
   double k_, xi_, p_k_, m_k_, s_k_, a_f_, a_tau_;
   int n_;
+  bool elliptic_ = false;  // k == kEllipticLimitSurface: closed-form ellipse
   std::vector<double> gj_x_, gj_w_;  // Gauss-Jacobi (alpha = beta = 1/k) on [-1, 1]
   std::vector<double> half_x_, half_w_;  // half-chord rule: y = s^2 and weights (alpha = 1/k)
   bool split_chords_ = false;  // k not an even integer: |r|^k has a cusp at the disc centre

@@ -14,7 +14,8 @@ struct ContactParams {
   double sigma_z = -1.0; //!< micro-asperity damping [N m s/rad], >= 0
   double delta = 0.0;    //!< contact-radius law rho = delta f_n^gamma [m/N^gamma], > 0
   double gamma = 0.0;    //!< contact-radius exponent [-], 0 < gamma < 1/3
-  double k = 4.0;        //!< pressure exponent p ~ (1-(r/rho)^k)^(1/k) [-], [0.5, inf]; 4 gives xi = 0.6354
+  double k = 4.0;        //!< pressure exponent p ~ (1-(r/rho)^k)^(1/k) [-], [0.5, inf]; 4 gives xi = 0.6354;
+                         //!< 0 (kEllipticLimitSurface) selects the elliptic limit surface
   double c_max = 1.5;    //!< saturation of the normalized CoR |c~| [-], > 0 (paper: 1.5)
 };
 

@@ -37,7 +37,10 @@ class ContactParams:
         sigma0: micro-asperity stiffness [N m/rad].
         sigma_z: micro-asperity damping [N m s/rad].
         delta, gamma: contact radius rho = delta * f_n**gamma [m], 0 < gamma < 1/3.
-        k: pressure exponent (2 Hertz, 4 the paper's xi = 0.6354, inf uniform).
+        k: pressure exponent (2 Hertz, 4 the paper's xi = 0.6354, inf uniform); 0 selects
+            the elliptic limit surface (f_t/(mu f_n))^2 + (tau/tau_max)^2 = 1 of a point
+            contact on an elliptic friction cone, with xi fixed at its k = 4 value
+            (docs/model.md §3.5).
         c_max: saturation of the normalized CoR |c~| (paper: 1.5).
 
     Raises:
@@ -76,7 +79,7 @@ class ContactParams:
 
     @property
     def xi(self) -> float:
-        """Torsional shape factor xi(k)."""
+        """Torsional shape factor xi(k) (the k = 4 value for the ellipse, k = 0)."""
         return _core.shape_factor(self.k)
 
     # --- presets -----------------------------------------------------------------------

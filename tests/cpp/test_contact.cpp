@@ -137,7 +137,7 @@ TEST(ContactParamsValidation, OneBadFieldAtATime) {
       {"sigma_z", &ContactParams::sigma_z, {-1e-9, kNaN, kInf}, {0.0, 2.0}},
       {"delta", &ContactParams::delta, {0.0, -0.0018, 1.0, kNaN, kInf}, {1e-6, 0.0018}},
       {"gamma", &ContactParams::gamma, {0.0, -0.1, 1.0 / 3.0, 0.5, kNaN, kInf}, {1e-6, 0.254, 0.333}},
-      {"k", &ContactParams::k, {0.0, 0.4, -4.0, kNaN, -kInf}, {0.5, 2.0, 4.0, kInf}},
+      {"k", &ContactParams::k, {1e-9, 0.4, -4.0, kNaN, -kInf}, {0.0, 0.5, 2.0, 4.0, kInf}},
       {"c_max", &ContactParams::c_max, {0.0, -1.5, kNaN, kInf, 1e4}, {1e-3, 1.5, 1000.0}},
   };
   for (const Case& c : cases) {
@@ -870,4 +870,23 @@ TEST(CorEstimatorProperty, ExtremeButValidParametersAndSettings) {
   std::printf("  [extreme] max iterations %d\n", max_iter);
   EXPECT_LE(max_iter, 200);
   EXPECT_GT(valid, 10000);
+}
+
+// Consistency: the contact model on the elliptic limit surface (k = 0) inverts sigma_LS of the
+// closed form (f~ = u/sqrt(1+u^2), tau~ = 1/sqrt(1+u^2), u = a/xi, written here) back to a,
+// and its capacity about the CoR is mu f_n rho (xi tau~ + a f~) = mu f_n rho xi sqrt(1+u^2).
+TEST(EllipticContactModel, InvertsSigmaAndGivesTheClosedFormCapacity) {
+  ContactParams p = table1_params();
+  p.k = lugrip::kEllipticLimitSurface;
+  const lugrip::ContactModel m(p);
+  const double xi = lugrip::kEllipseShapeFactor;
+  EXPECT_NEAR(m.tau_max(3.0), p.mu * xi * p.delta * std::pow(3.0, 1.0 + p.gamma), 1e-15);
+  for (double a = 1e-3; a < 2e3; a *= 1.9) {
+    const double u = a / xi, F = u / std::sqrt(1.0 + u * u), T = 1.0 / std::sqrt(1.0 + u * u);
+    const double s = std::pow(F, 1.0 + p.gamma) / T;
+    EXPECT_NEAR(m.invert_sigma(s, nullptr), a, 1e-8 * a) << "a = " << a;
+    const double f_n = 2.5;
+    EXPECT_NEAR(m.g(f_n, a), p.mu * f_n * m.rho(f_n) * xi * std::sqrt(1.0 + u * u), 1e-12 * m.g(f_n, a))
+        << "a = " << a;
+  }
 }

@@ -120,11 +120,13 @@ TEST(ShapeFactor, GammaClosedFormAndLimits) {
 }
 
 TEST(ShapeFactor, RejectsInvalidK) {
-  for (double k : {0.0, -1.0, -kInf, std::numeric_limits<double>::quiet_NaN()}) {
+  for (double k : {-1e-300, -1.0, -kInf, std::numeric_limits<double>::quiet_NaN()}) {
     EXPECT_THROW(shape_factor(k), std::invalid_argument) << "k = " << k;
     EXPECT_THROW(LimitSurface{k}, std::invalid_argument) << "k = " << k;
   }
   EXPECT_THROW(LimitSurface{0.4}, std::invalid_argument);  // below kMinPressureExponent
+  EXPECT_THROW(LimitSurface{1e-3}, std::invalid_argument);  // only exactly 0 is the ellipse
+  EXPECT_THROW(shape_factor(-0.0 - 1e-12), std::invalid_argument);
   EXPECT_NO_THROW(LimitSurface{0.5});
   EXPECT_THROW(LimitSurface(4.0, 3), std::invalid_argument);  // too few table intervals
   EXPECT_NO_THROW(LimitSurface{kInf});
@@ -461,5 +463,71 @@ TEST(LimitSurfaceProperties, CustomTableResolutionConverges) {
   for (const SpecRow& r : kSpecTable) {
     EXPECT_NEAR(fine.ft_star(r.c), r.ft, 1e-7) << r.c;
     EXPECT_NEAR(fine.tau_star(r.c), r.tau, 1e-7) << r.c;
+  }
+}
+
+// --- the elliptic limit surface (k = kEllipticLimitSurface) -----------------------------------
+// Consistency of the closed form with the ellipse (f~)^2 + (tau~)^2 = 1 and with the
+// maximum-dissipation rule, written here from the ellipse's geometry: the outward normal of
+// the ellipse at (f~, tau~) is parallel to the twist (c~, 1) / (xi, 1) scaled, i.e.
+// f~ / tau~ = c~ / xi; reference points are the tangent points of that rule solved by hand.
+
+TEST(EllipticLimitSurface, ClosedFormPoints) {
+  const LimitSurface ls(lugrip::kEllipticLimitSurface);
+  EXPECT_TRUE(ls.elliptic());
+  EXPECT_EQ(ls.k(), 0.0);
+  EXPECT_EQ(ls.xi(), lugrip::kEllipseShapeFactor);
+  EXPECT_EQ(shape_factor(lugrip::kEllipticLimitSurface), lugrip::kEllipseShapeFactor);
+  EXPECT_NEAR(lugrip::kEllipseShapeFactor, shape_factor(4.0), 1e-15);
+  const double xi = ls.xi();
+  // c~ = xi: the normal is at 45 degrees, f~ = tau~ = 1/sqrt(2).
+  EXPECT_NEAR(ls.F(xi), std::sqrt(0.5), 1e-15);
+  EXPECT_NEAR(ls.T(xi), std::sqrt(0.5), 1e-15);
+  // c~ = 3 xi / 4: the 3-4-5 triangle, f~ = 3/5, tau~ = 4/5.
+  EXPECT_NEAR(ls.F(0.75 * xi), 0.6, 1e-15);
+  EXPECT_NEAR(ls.T(0.75 * xi), 0.8, 1e-15);
+  EXPECT_EQ(ls.F(0.0), 0.0);
+  EXPECT_EQ(ls.T(0.0), 1.0);
+  EXPECT_EQ(ls.F(kInf), 1.0);
+  EXPECT_EQ(ls.T(kInf), 0.0);
+  EXPECT_TRUE(std::isnan(ls.F(std::numeric_limits<double>::quiet_NaN())));
+  EXPECT_EQ(ls.ft_star(0.75 * xi), -ls.F(0.75 * xi));
+  EXPECT_EQ(ls.ft_star(-0.75 * xi), ls.F(0.75 * xi));
+  EXPECT_NEAR(ls.G(xi), xi * std::sqrt(2.0), 1e-15);  // xi T + a F at a = xi
+  EXPECT_NEAR(ls.sigma_ls(xi, 0.254), std::pow(std::sqrt(0.5), 1.254) / std::sqrt(0.5), 1e-15);
+}
+
+TEST(EllipticLimitSurface, OnTheEllipseWithMaximumDissipationDerivatives) {
+  const LimitSurface ls(lugrip::kEllipticLimitSurface);
+  const double xi = ls.xi();
+  for (double a = 1e-4; a < 1e4; a *= 1.37) {
+    const LsPoint p = ls.eval(a);
+    EXPECT_NEAR(p.F * p.F + p.T * p.T, 1.0, 1e-14) << "a = " << a;
+    EXPECT_NEAR(p.F / p.T, a / xi, 1e-12 * (1.0 + a / xi)) << "a = " << a;
+    EXPECT_NEAR(p.dT, -(a / xi) * p.dF, 1e-15 * (1.0 + a)) << "a = " << a;
+    const double h = 1e-4 * a;  // central differences against the closed-form slopes
+    EXPECT_NEAR(p.dF, (ls.F(a + h) - ls.F(a - h)) / (2 * h), 1e-5 * p.dF + 1e-12) << "a = " << a;
+    EXPECT_NEAR(p.dT, (ls.T(a + h) - ls.T(a - h)) / (2 * h), -1e-5 * p.dT + 1e-12) << "a = " << a;
+    const LsPoint q = ls.integrate(a);
+    EXPECT_EQ(q.F, p.F);
+    EXPECT_EQ(q.T, p.T);
+  }
+  // Asymptotic constants: F ~ a/xi; 1 - F ~ xi^2/(2 a^2), T ~ xi / a.
+  EXPECT_NEAR(ls.F(1e-6) / 1e-6, ls.small_slope(), 1e-9);
+  EXPECT_NEAR(ls.small_slope(), 1.0 / xi, 1e-15);
+  EXPECT_NEAR((1.0 - ls.F(1e4)) * 1e8, ls.tail_force(), 1e-5);
+  EXPECT_NEAR(ls.T(1e5) * 1e5, ls.tail_torque(), 1e-9);
+}
+
+TEST(EllipticLimitSurface, DiffersFromEveryPressureExponent) {
+  // No member of the pressure family reproduces the ellipse: at c~ = xi (where the ellipse has
+  // f~ = tau~ = 0.7071) the pressure curves sit inside it by more than 1 %.
+  const LimitSurface e(lugrip::kEllipticLimitSurface);
+  for (double k : {0.5, 1.0, 2.0, 4.0, 8.0, kInf}) {
+    const LimitSurface ls(k);
+    const double a = ls.xi();  // the pressure LS's own 45-degree point
+    const double r = std::hypot(ls.F(a), ls.T(a));
+    EXPECT_LT(r, 0.99) << "k = " << k;
+    EXPECT_NEAR(std::hypot(e.F(e.xi()), e.T(e.xi())), 1.0, 1e-15);
   }
 }

@@ -254,5 +254,17 @@ def test_module_entry_point_runs_ls_and_reports_errors(tmp_path):
                           str(tmp_path)], capture_output=True, text=True, timeout=60)
     assert bad.returncode == 2
     assert bad.stderr.strip().splitlines() == [
-        "lugrip ls: error: argument --k: invalid value 'four': expected a positive number or "
-        "'inf' (see 'lugrip ls --help')"]
+        "lugrip ls: error: argument --k: invalid value 'four': expected a positive number, "
+        "'inf' or 'ellipse' (see 'lugrip ls --help')"]
+
+
+def test_ls_lists_and_plots_the_ellipse(tmp_path, capsys):
+    """`lugrip ls --k ellipse` prints the elliptic limit surface (k = 0): at c~ = xi the
+    closed form gives f~* = -1/sqrt(2), tau~* = 1/sqrt(2); the figure is written."""
+    xi = lugrip.shape_factor(4.0)
+    assert main(["ls", "--k", "ellipse", "4", "--c", f"{xi!r}", "--out", str(tmp_path)]) == 0
+    out = capsys.readouterr().out
+    assert "k = ellipse" in out
+    row = next(line.split() for line in out.splitlines() if line.split()[:1] == ["0.6354"])
+    np.testing.assert_allclose([float(row[1]), float(row[2])], [-2**-0.5, 2**-0.5], atol=1e-6)
+    assert any(tmp_path.iterdir())

@@ -398,3 +398,46 @@ def test_every_validated_k_builds_a_model(k):
     p = lugrip.ContactParams.table1().replace(k=k)
     est = lugrip.estimate_cor(p, 5.0, 1.0, -1e-3)
     _check_outputs(p, est)
+
+
+# ------------------------------------------------------------- the elliptic limit surface ----
+
+def test_round_trip_on_elliptic_wrenches():
+    """Consistency (plant = the ellipse written here in closed form, not through lugrip's
+    curves): wrenches on the ellipse (f_t/(mu f_n))^2 + (tau/tau_max)^2 = 1 at its
+    maximum-dissipation point for c~ (f~ = u/sqrt(1+u^2), tau~ = 1/sqrt(1+u^2), u = c~/xi),
+    and inside it at a virtual normal force s f_n (f_t scaled by s, tau by s^(gamma+1)), give
+    back c~; on the surface the capacity g is mu f_n rho (xi tau~ + |c~| f~)."""
+    p = lugrip.ContactParams.table1().replace(k=0.0)
+    xi = p.xi
+    assert xi == pytest.approx(0.6354098136, abs=1e-10)
+    c_t = np.array([-1.4, -0.9, -0.3, -0.05, 0.02, 0.2, 0.6, 1.0, 1.45])
+    f_n = np.linspace(1.0, 12.0, c_t.size)
+    u = np.abs(c_t) / xi
+    F, T = u / np.sqrt(1 + u**2), 1 / np.sqrt(1 + u**2)
+    tau_max = p.mu * xi * p.delta * f_n ** (1 + p.gamma)
+    for s in (1.0, 0.6, 0.2):
+        f_t = s * p.mu * f_n * F
+        tau = -np.sign(c_t) * s ** (1 + p.gamma) * tau_max * T
+        est = lugrip.estimate_cor(p, f_n, f_t, tau)
+        np.testing.assert_allclose(np.asarray(est.c_tilde), c_t, atol=1e-7, err_msg=f"s = {s}")
+        if s == 1.0:
+            rho = p.delta * f_n**p.gamma
+            g_closed = p.mu * f_n * rho * (xi * T + np.abs(c_t) * F)
+            np.testing.assert_allclose(np.asarray(est.g), g_closed, rtol=1e-7)
+
+
+def test_elliptic_outside_points_clip_and_stay_finite():
+    """Consistency: wrenches 20 % beyond the ellipse (sliding with a viscous excess) give a
+    finite estimate with |c~| <= c_max and the sign rule sign(c~) = -sign(tau)."""
+    p = lugrip.ContactParams.table1().replace(k=0.0)
+    c_t = np.linspace(-3.0, 3.0, 13)
+    c_t = c_t[c_t != 0]
+    u = np.abs(c_t) / p.xi
+    f_n = np.full(c_t.size, 4.0)
+    f_t = 1.2 * p.mu * f_n * u / np.sqrt(1 + u**2)
+    tau = -np.sign(c_t) * 1.2 * p.mu * p.xi * p.delta * f_n ** (1 + p.gamma) / np.sqrt(1 + u**2)
+    est = lugrip.estimate_cor(p, f_n, f_t, tau)
+    c = np.asarray(est.c_tilde)
+    assert np.all(np.isfinite(c)) and np.all(np.abs(c) <= p.c_max + 1e-12)
+    assert np.all(np.sign(c) == np.sign(c_t))

@@ -3,7 +3,7 @@ generate (lugrip.rigs), and the checks that refuse data which cannot give a fit.
 
 Kinds of test:
 * independent plants: the grid-of-cells LuGre contact (Stribeck, with and without a viscous
-  shear) and the MuJoCo rubbing rig; their physics is written from their own cells / engine,
+  shear) and the MuJoCo rubbing rig (its elliptic limit surface selects k = 0); their physics is written from their own cells / engine,
   not from lugrip's limit surface or observer;
 * consistency: the lumped rig is lugrip's own model under prescribed motion (used only where
   the plant does not matter: the checks of bad input).
@@ -61,6 +61,9 @@ def test_grid_stribeck_limit_surface_and_unobservable_speed(stribeck):
     [mu_k, mu_s] +- 5 %, tau_max at 2 N and 8 N within 15 %, nothing at a bound, the speed
     reported unobservable (beta_A fixed by the observability rule, not fitted)."""
     truth, r, _ = stribeck
+    # a distributed Hertzian contact: the pressure family lies closer than the ellipse
+    assert r.params.k != 0.0
+    assert r.stages.ls.shape_rms["pressure"] < r.stages.ls.shape_rms["ellipse"]
     assert 0.95 * truth.mu_kinetic <= r.params.mu <= 1.05 * truth.mu_static
     for f in (2.0, 8.0):
         assert abs(_tau_ratio(r, truth, f) - 1.0) <= 0.15, f
@@ -89,6 +92,7 @@ def test_grid_viscous_speed_is_observable_and_tracked(viscous):
     beta_A and delta trade against each other through k) within 30 % and the |omega| error
     where |c~| <= 1.5 well below that of predicting zero."""
     truth, r, test = viscous
+    assert r.params.k != 0.0  # the pressure family, not the ellipse
     assert r.speed_observable is True
     p = r.params
     assert p.beta_a * p.delta**4 == pytest.approx(truth.beta_a * truth.delta**4, rel=0.3)
@@ -103,17 +107,61 @@ def test_grid_viscous_speed_is_observable_and_tracked(viscous):
     assert err <= 0.3 * np.sqrt(np.mean(om**2))
 
 
-def test_mujoco_rig_coulomb_contact():
-    """Independent plant (MuJoCo pad, elliptic cone, Coulomb mu 0.7): mu within 10 % on this
-    small set, tau_max within 15 %, speed not observable."""
+@pytest.fixture(scope="module")
+def mujoco_fit():
     pytest.importorskip("mujoco")
-    data = make_rig("mujoco").simulate(n=18, seed=5)
-    r = _fit(data.log)
-    truth = data.truth
-    assert r.params.mu == pytest.approx(truth.mu, rel=0.10)
+    data = make_rig("mujoco").simulate(n=40, seed=7)
+    train, test = _split(data)
+    return data.truth, _fit(train.log), test
+
+
+def test_mujoco_rig_selects_the_elliptic_limit_surface(mujoco_fit):
+    """Independent plant (MuJoCo pad, condim-4 elliptic cone, Coulomb mu 0.7): no pressure
+    exponent reproduces its elliptic limit surface (the free k ran to its bound 0.5), the
+    ellipse lies closer to the sliding points and is kept; then nothing is at a bound, mu is
+    within 5 %, tau_max at 2 N and 8 N within 15 %, the speed is not observable."""
+    truth, r, _ = mujoco_fit
+    ls = r.stages.ls
+    assert r.params.k == 0.0 and ls.elliptic
+    assert set(ls.shape_rms) == {"pressure", "ellipse"}
+    assert ls.shape_rms["ellipse"] < ls.shape_rms["pressure"]
+    assert any("limit-surface shape" in s and "ellipse is kept" in s for s in r.stages.report)
+    assert not ls.at_bound
+    assert not any(e.at_bound for e in r.estimates)
+    assert r.status == "converged"
+    assert r.params.mu == pytest.approx(truth.mu, rel=0.05)
     for f in (2.0, 8.0):
         assert abs(_tau_ratio(r, truth, f) - 1.0) <= 0.15, f
     assert r.speed_observable is False
+
+
+def test_mujoco_rig_observer_flags_slip_on_held_out_maneuvers(mujoco_fit):
+    """Independent plant, held-out maneuvers, observer with the fitted (elliptic) YAML block:
+    S >= 0.9 on >= 95 % of the gross-sliding samples and on <= 5 % of the stick samples below
+    70 % of the friction limit; speed_observable False while sliding (Coulomb contact)."""
+    _, r, test = mujoco_fit
+    run = r.make_observer().run(test.log)
+    S = np.asarray(run.S)
+    assert np.mean(S[test.gross_sliding] >= 0.9) >= 0.95
+    assert np.mean(S[test.stick_below(0.7)] >= 0.9) <= 0.05
+    assert np.mean(np.asarray(run.speed_observable)[test.gross_sliding]) <= 0.05
+
+
+def test_mujoco_rig_cor_estimate_is_closer_with_the_ellipse(mujoco_fit):
+    """Independent plant: with the fitted parameters the CoR estimate from the wrench matches
+    the slider's actual CoR (|c~| <= 1.2, gross sliding) to <= 0.03 RMS on the ellipse; with
+    the same mu, delta, gamma on the k = 4 pressure surface (same xi, so the same tau_max) the
+    error is at least three times larger."""
+    _, r, test = mujoco_fit
+    m = test.gross_sliding & (np.abs(test.c_tilde_true) <= 1.2)
+    assert np.count_nonzero(m) > 200
+    errs = {}
+    for k in (0.0, 4.0):
+        p = r.params.replace(k=k)
+        est = lugrip.estimate_cor(p, test.log.f_n[m], test.log.f_t[m], test.log.tau[m])
+        errs[k] = float(np.sqrt(np.mean((np.asarray(est.c_tilde) - test.c_tilde_true[m]) ** 2)))
+    assert errs[0.0] <= 0.03, errs
+    assert errs[4.0] >= 3.0 * errs[0.0], errs
 
 
 @pytest.fixture(scope="module")

@@ -92,7 +92,7 @@ def test_shape_factor():
     assert lugrip.ContactParams.table1().xi == lugrip.shape_factor(4.0)
 
 
-@pytest.mark.parametrize("k", [0.0, -1.0, -math.inf, math.nan])
+@pytest.mark.parametrize("k", [0.2, 1e-9, -1.0, -math.inf, math.nan])
 def test_invalid_k_raises(k):
     with pytest.raises(ValueError, match="k"):
         lugrip.LimitSurface(k)
@@ -181,3 +181,39 @@ def test_maximum_dissipation_and_torque_capacity(k, lsk):
     dG = (ls.G(a + h) - ls.G(a - h)) / (2 * h)
     np.testing.assert_allclose(dG, -ls.ft_star(a), atol=5e-5, rtol=0)
     assert ls.G(0.0) == pytest.approx(ls.xi, abs=1e-15)
+
+
+def test_elliptic_limit_surface_closed_form():
+    """k = 0 selects the ellipse (f~)^2 + (tau~)^2 = 1: against its closed form, written here
+    from the maximum-dissipation rule (the ellipse's normal at (f~, tau~) is parallel to
+    (c~/xi, 1)), with xi fixed at the k = 4 value; no pressure exponent reproduces it."""
+    ls = lugrip.LimitSurface(0.0)
+    assert ls.xi == lugrip.shape_factor(4.0) == lugrip.shape_factor(0.0)
+    c = np.concatenate([-np.geomspace(1e-3, 50, 40), [0.0], np.geomspace(1e-3, 50, 40)])
+    u = np.abs(c) / ls.xi
+    np.testing.assert_allclose(np.abs(ls.ft_star(c)), u / np.sqrt(1 + u**2), atol=1e-14)
+    np.testing.assert_allclose(ls.tau_star(c), 1 / np.sqrt(1 + u**2), atol=1e-14)
+    assert np.all(np.sign(ls.ft_star(c[c != 0])) == -np.sign(c[c != 0]))
+    np.testing.assert_allclose(ls.G(c), ls.xi * np.sqrt(1 + u**2), rtol=1e-13)  # xi T + a F
+    # the pressure family lies inside the ellipse (>= 1.5 % somewhere) for every k
+    a = np.geomspace(0.05, 5, 200)
+    for k in (0.5, 1.0, 2.0, 4.0, 8.0, math.inf):
+        pk = lugrip.LimitSurface(k)
+        radius = np.hypot(pk.ft_star(a), pk.tau_star(a))
+        assert radius.min() < 0.985, k
+    params = lugrip.ContactParams.table1().replace(k=0.0)
+    assert params.xi == ls.xi
+    model = lugrip._core.ContactModel(params.to_core())
+    tau2 = float(np.asarray(model.tau_max(np.array([2.0])))[0])
+    assert tau2 == pytest.approx(params.mu * ls.xi * params.delta * 2.0 ** (1 + params.gamma), rel=1e-12)
+
+
+def test_patch_plant_refuses_the_ellipse():
+    """The pressure patch needs a pressure distribution; k = 0 (no pressure law) is refused
+    with a message naming the reason, while the contact model accepts it."""
+    from lugrip.sim import PatchContact
+
+    p = lugrip.ContactParams.table1().replace(k=0.0)
+    with pytest.raises(ValueError, match="elliptic limit surface"):
+        PatchContact(p)
+    PatchContact(p.replace(k=0.5))

@@ -28,7 +28,7 @@ BAD = {
     "sigma_z": [-2.0, math.nan, -math.inf],
     "delta": [0.0, -0.0018, 1.0, math.nan, math.inf],
     "gamma": [0.0, -0.1, 1 / 3, 0.5, math.nan],
-    "k": [0.0, 0.4, -4.0, math.nan, -math.inf],
+    "k": [0.3, 0.4, 1e-9, -4.0, math.nan, -math.inf],
     "c_max": [0.0, -1.5, math.nan, math.inf, 1e4],
 }
 
@@ -46,7 +46,7 @@ def valid_rule(name: str, v: float) -> bool:
     if name == "gamma":
         return 0 < v < 1 / 3
     if name == "k":
-        return v >= 0.5
+        return v >= 0.5 or v == 0.0  # 0: the elliptic limit surface
     if name == "c_max":
         return math.isfinite(v) and 0 < v <= 1000
     raise KeyError(name)
@@ -94,7 +94,7 @@ def test_one_bad_field_is_named(field, value):
 
 def test_every_bad_field_reported_at_once():
     with pytest.raises(ValueError) as info:
-        lugrip.ContactParams(mu=-1, beta_a=-1, sigma0=0, sigma_z=-1, delta=0, gamma=0.5, k=0, c_max=0)
+        lugrip.ContactParams(mu=-1, beta_a=-1, sigma0=0, sigma_z=-1, delta=0, gamma=0.5, k=0.2, c_max=0)
     msg = str(info.value)
     for field in BAD:
         assert f"{field} = " in msg
@@ -215,3 +215,25 @@ def test_read_observer_settings_is_exported(tmp_path):
     assert yaml.safe_load(path.read_text())["observer"]["bandwidth"] == 700.0
     lugrip.ContactParams.table1().to_yaml(path)
     assert lugrip.read_observer_settings(path) is None
+
+
+def test_elliptic_limit_surface_round_trips_and_lists(tmp_path, capsys):
+    """k = 0 (the elliptic limit surface) is a valid value: YAML round trip, the k = 4 xi,
+    `lugrip params --check` names the shape, `lugrip identify --k ellipse` parses to 0 and
+    a k between 0 and 0.5 stays an error."""
+    from lugrip.cli import main
+    from lugrip.commands.identify import _exponent
+
+    p = lugrip.ContactParams.table1().replace(k=0.0)
+    assert p.xi == lugrip.shape_factor(4.0)
+    path = tmp_path / "ellipse.yaml"
+    p.to_yaml(path)
+    assert lugrip.ContactParams.from_yaml(path) == p
+    assert main(["params", "--check", str(path)]) == 0
+    assert "limit surface: the ellipse" in capsys.readouterr().out
+    assert _exponent("ellipse") == 0.0 and _exponent("0") == 0.0 and _exponent("inf") == math.inf
+    import argparse
+
+    for bad in ("0.2", "-1", "nan"):
+        with pytest.raises(argparse.ArgumentTypeError):
+            _exponent(bad)

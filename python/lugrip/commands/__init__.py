@@ -68,15 +68,18 @@ class CliError(Exception):
 
 
 def parse_k(text: str) -> float:
-    """argparse type for a pressure exponent k: a positive number or 'inf'."""
+    """argparse type for a pressure exponent k: a positive number, 'inf', or 'ellipse' (the
+    elliptic limit surface, ContactParams.k = 0)."""
     t = text.strip().lower()
     if t in ("inf", "infinity", "+inf", "oo"):
         return math.inf
+    if t == "ellipse":
+        return 0.0
     try:
         value = float(t)
     except ValueError:
         raise argparse.ArgumentTypeError(
-            f"invalid value {text!r}: expected a positive number or 'inf'") from None
+            f"invalid value {text!r}: expected a positive number, 'inf' or 'ellipse'") from None
     if math.isnan(value) or value <= 0.0:
         raise argparse.ArgumentTypeError(
             f"invalid value {text!r}: the pressure exponent k must be > 0 (or 'inf')")
@@ -95,9 +98,11 @@ def positive_float(text: str) -> float:
 
 
 def k_label(k: float) -> str:
-    """'2', '4', '3.5', 'inf' — for file names, CSV cells and legends."""
+    """'2', '4', '3.5', 'inf', 'ellipse' (k = 0) — for file names, CSV cells and legends."""
     if math.isinf(k):
         return "inf"
+    if k == 0.0:
+        return "ellipse"
     return f"{k:g}"
 
 

@@ -38,12 +38,15 @@ maneuvers come from the 'maneuver' column and are never integrated across a gap.
 
 
 def _exponent(text: str) -> float:
+    if text.strip().lower() == "ellipse":
+        return 0.0
     try:
         k = float(text)
     except ValueError:
-        raise argparse.ArgumentTypeError(f"{text!r} is not a number (inf allowed)") from None
-    if not k >= 0.5:
-        raise argparse.ArgumentTypeError(f"{text!r}: the pressure exponent must be >= 0.5")
+        raise argparse.ArgumentTypeError(f"{text!r} is not a number (inf allowed) or 'ellipse'") from None
+    if not (k >= 0.5 or k == 0.0):
+        raise argparse.ArgumentTypeError(
+            f"{text!r}: the pressure exponent must be >= 0.5 (or 0 / 'ellipse')")
     return k
 
 
@@ -162,7 +165,9 @@ def register(subparsers) -> None:
         type=_exponent,
         default=None,
         metavar="K",
-        help="hold the pressure exponent at K (0.5 .. inf; 2 Hertzian); default: identified",
+        help="hold the pressure exponent at K (0.5 .. inf; 2 Hertzian; 0 or 'ellipse' the "
+        "elliptic limit surface); default: identified (the pressure family and the ellipse "
+        "are both fitted, the lower RMS distance is kept)",
     )
     p.add_argument(
         "--bootstrap", type=_bootstrap_count, default=20, metavar="N",
@@ -338,18 +343,21 @@ def limit_surface_figure(result):
     import numpy as np
 
     from .. import plot
-    from ..identification._stages import _A, _curves
+    from ..identification._stages import _A, _curves, _ellipse_curves
 
     ls = result.stages.ls
     pts = ls.points
-    F, T, xi = _curves(0.0 if np.isinf(ls.k) else 1.0 / ls.k)
+    if ls.elliptic:
+        F, T, xi = _ellipse_curves()
+    else:
+        F, T, xi = _curves(0.0 if np.isinf(ls.k) else 1.0 / ls.k)
     ft = pts.f_t / (ls.mu * pts.f_n)
     tt = pts.tau_abs / (ls.mu * xi * ls.delta * pts.f_n ** (1.0 + ls.gamma))
     lam = ls.kappa * pts.f_n ** (3.0 * ls.gamma - 1.0) * pts.omega_abs / (2.0 * xi)
     with plot.style():
         fig, ax = plot.new_figure(1, 1, width=5.5, row_height=4.5)
         keep = _A <= 30.0
-        ax.plot(F[keep], T[keep], color="k", lw=1.2, label=f"fitted LS (k = {ls.k:.3g})")
+        ax.plot(F[keep], T[keep], color="k", lw=1.2, label="fitted LS (ellipse)" if ls.elliptic else f"fitted LS (k = {ls.k:.3g})")
         sc = ax.scatter(ft, tt, c=pts.omega_abs, s=12, cmap="viridis", label="measured")
         if ls.kappa > 0:
             ax.scatter(ft - 2 * xi * ls.c_abs * lam, tt - lam, s=6, marker="x",

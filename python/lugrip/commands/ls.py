@@ -61,7 +61,8 @@ def register(subparsers) -> None:
         formatter_class=argparse.RawDescriptionHelpFormatter,
     )
     p.add_argument("--k", nargs="+", type=parse_k, default=list(DEFAULT_K), metavar="K",
-                   help="pressure exponents: 2 Hertz, 4 the paper's xi = 0.6354, inf uniform "
+                   help="pressure exponents: 2 Hertz, 4 the paper's xi = 0.6354, inf uniform, "
+                        "ellipse the elliptic limit surface "
                         "(default: 2 4 inf)")
     p.add_argument("--out", type=Path, default=Path("out"), metavar="DIR",
                    help="directory for the figures (default: out)")
@@ -160,6 +161,8 @@ _C_SYM = r"\tilde c"
 
 
 def _k_legend(k: float) -> str:
+    if k == 0.0:
+        return "elliptic LS"
     name = {2.0: " (Hertz)", math.inf: " (uniform)"}.get(k, "")
     return (r"$k = \infty$" if math.isinf(k) else f"$k = {k:g}$") + name
 
@@ -254,7 +257,8 @@ def figure3(ks, c_max: float = 5.0):
                     continue
                 ax_df.plot(c, f[i] - f[ref], label=_k_legend(k), **styles[i])
                 ax_dt.plot(c, t[i] - t[ref], label=_k_legend(k), **styles[i])
-            ref_text = "k = ∞" if math.isinf(ks[ref]) else f"k = {ks[ref]:g}"
+            ref_text = ("k = ∞" if math.isinf(ks[ref]) else
+                        "the ellipse" if ks[ref] == 0.0 else f"k = {ks[ref]:g}")
             ax_df.set_ylabel(f"difference to\n{ref_text} [-]")
             ax_dt.set_ylabel(f"difference to\n{ref_text} [-]")
             for ax in (ax_df, ax_dt):

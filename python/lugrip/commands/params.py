@@ -41,7 +41,7 @@ _MEANING = {"mu": "Coulomb friction coefficient",
             "sigma_z": "micro-asperity damping",
             "delta": "contact radius rho = delta f_n^gamma",
             "gamma": "contact radius exponent",
-            "k": "pressure exponent",
+            "k": "pressure exponent (0: elliptic limit surface)",
             "c_max": "saturation of |c~|"}
 
 
@@ -105,6 +105,9 @@ def describe(params, source: str = "") -> str:
     lines = [f"contact parameters{' from ' + source if source else ''} (valid):"]
     for name, value in params.to_dict().items():
         lines.append(f"  {name:<8} = {value:<14.6g} [{_UNITS[name]}]  {_MEANING[name]}")
+    if params.k == 0.0:
+        lines.append("  limit surface: the ellipse (f_t/(mu f_n))^2 + (tau/tau_max)^2 = 1, "
+                     "xi fixed at the k = 4 value")
     model = _core.ContactModel(params.to_core())
     f_n = np.array([1.0, 5.0])
     rho = model.rho(f_n)

@@ -69,7 +69,8 @@ def identify(
     Without ``params0`` (``start="data"``) the parameters come from stages, each from what
     the data carry (docs/model.md §8): the phases of every sample from the wrench and the
     motion together, the sensor noise from the still samples, (a) the limit surface (mu,
-    delta, gamma, the pressure exponent k) from the gross-sliding wrench, (c) beta_A from its
+    delta, gamma and the shape: the pressure exponent k, or the elliptic limit surface, k = 0,
+    whichever lies closer to the points) from the gross-sliding wrench, (c) beta_A from its
     speed dependence with a significance test (not significant: "sliding speed not
     observable", beta_A set so that the observer reports speed_observable = False, and kept
     fixed), (b) sigma0 and sigma_z from the loading runs. Then (``refine``) the paper's eq. 32
@@ -104,7 +105,8 @@ def identify(
             rotation-only data (warned either way).
         score_saturated: also score sliding samples whose CoR the observer clips at c_max.
         threads: C++ threads (0: all cores). k, c_max: pressure exponent (None: identified
-            by the stages; 4 for a params0-less fit without stages) and CoR clip (1.5).
+            by the stages, the pressure family and the elliptic limit surface compared; 0:
+            the ellipse; 4 for a params0-less fit without stages) and CoR clip (1.5).
         progress: called as progress(iteration, cost, params).
 
     Raises:
@@ -367,8 +369,9 @@ def identify(
         message = "parameter(s) at a bound: " + ", ".join(f"{n} ({where})" for n, where in at_bound)
         if any(n == "k" for n, _ in at_bound):
             message += (
-                " (k at 0.5: the sliding wrench is more elliptic than any pressure "
-                "profile of the limit-surface family; hold it with k=0.5, --k 0.5, to accept it)"
+                " (k at 0.5: the sliding wrench lies outside every pressure profile of the "
+                "limit-surface family, yet the elliptic limit surface fits it worse; hold k "
+                "with k=0.5 / --k 0.5 or k=0 / --k ellipse to accept one of them)"
             )
         warnings.warn(message, IdentificationWarning, stacklevel=2)
     elif status not in ("converged", "stages"):

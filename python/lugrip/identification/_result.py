@@ -215,7 +215,8 @@ class IdentificationResult:
                 "k": {
                     "value": self.params.k if math.isfinite(self.params.k) else ".inf",
                     "unit": "-",
-                },
+                }
+                | ({"note": "0: the elliptic limit surface"} if self.params.k == 0.0 else {}),
                 "c_max": {"value": self.params.c_max, "unit": "-"},
             },
             # the observer inside the cost: the parameters are identified FOR it (docs/model.md
@@ -293,6 +294,8 @@ def _stage_dict(st) -> dict:
             "stderr": {k: v for k, v in ls.stderr.items()},
             "points": len(ls.points), "at_bound": list(ls.at_bound),
             "rms_distance": ls.residual_rms,
+            "shape": "ellipse" if ls.k == 0.0 else "pressure",
+            "rms_distance_by_shape": dict(ls.shape_rms),
         },
     }
     if st.presliding is not None:

@@ -8,8 +8,9 @@
     lam = K |omega| / (2 xi), K = pi delta^3 beta_A f_n^(3 gamma - 1) / mu (eqs. 9-10). The
     fit minimises each point's distance to that curve (its CoR a is a nuisance, found per
     point) over mu, delta, gamma, the pressure exponent k (through 1/k in [0, 2]: k in
-    [0.5, inf]) and kappa = pi delta^3 beta_A / mu >= 0. Standard errors: sandwich,
-    clustered by maneuver.
+    [0.5, inf]) and kappa = pi delta^3 beta_A / mu >= 0; or, with k = 0, on the elliptic
+    limit surface (a point contact on an elliptic friction cone), a shape with no free
+    parameter. Standard errors: sandwich, clustered by maneuver.
 (b) sigma0, sigma_z from the loading runs: the bristle state is integrated along the
     prescribed motion (eq. 1 with the ground-truth omega) and sigma0 z + sigma_z dz/dt +
     sigma_1 omega is fitted to y = tau - c f_t from the CoR estimate at the stage (a) values.
@@ -70,7 +71,18 @@ def _curves(inv_k: float):
     )
 
 
+@functools.lru_cache(maxsize=1)
+def _ellipse_curves():
+    ls = _core.LimitSurface(ELLIPSE_K)
+    return np.abs(np.asarray(ls.ft_star(_A))), np.asarray(ls.tau_star(_A)), float(ls.xi)
+
+
+ELLIPSE_K = 0.0  # ContactParams.k of the elliptic limit surface
+
+
 def k_of(inv_k: float) -> float:
+    if math.isnan(inv_k):  # the ellipse (no pressure exponent)
+        return ELLIPSE_K
     return math.inf if inv_k <= 1e-9 else 1.0 / inv_k
 
 
@@ -161,7 +173,8 @@ class LimitSurfaceFit:
     """Stage (a)+(c) result.
 
     Attributes:
-        mu, delta, gamma, k: limit-surface parameters; kappa: pi delta^3 beta_A / mu [s/rad
+        mu, delta, gamma, k: limit-surface parameters (k = 0: the elliptic limit surface,
+            ``elliptic``); kappa: pi delta^3 beta_A / mu [s/rad
             N^(1-3 gamma)]; beta_a: kappa mu / (pi delta^3) [N s/m^3].
         stderr: sandwich standard errors {mu, delta, gamma, inv_k, kappa, beta_a}.
         free: fitted among ("mu", "delta", "gamma", "inv_k", "kappa").
@@ -170,6 +183,8 @@ class LimitSurfaceFit:
         points: the sliding points; c_abs: their fitted |c~|; residual_rms: RMS of the
             normalised distances; rms_zero_viscous: the same refitted with kappa = 0.
         viscous_t: kappa / stderr (NaN without a speed term).
+        shape_rms: RMS distance of every limit-surface shape tried by the selection
+            ({"pressure": ..., "ellipse": ...}; empty when the shape was given).
     """
 
     mu: float
@@ -189,6 +204,11 @@ class LimitSurfaceFit:
     cov: (
         np.ndarray
     )  # sandwich covariance of the fitted variables (ln mu, ln delta, gamma, 1/k, kappa)
+    shape_rms: dict = dataclasses.field(default_factory=dict)
+
+    @property
+    def elliptic(self) -> bool:
+        return self.k == ELLIPSE_K
 
     def tau_max(self, f_n) -> np.ndarray:
         return self.mu * self.xi * self.delta * np.asarray(f_n, float) ** (1.0 + self.gamma)
@@ -208,9 +228,11 @@ def fit_limit_surface(
     pts: SlidingPoints, *, gamma: float | None = None, k: float | None = None, viscous: bool = True
 ) -> LimitSurfaceFit:
     """Fit stage (a) (and (c) with ``viscous``) to the sliding points. ``gamma`` / ``k``
-    given: held at that value."""
+    given: held at that value (k = 0: the elliptic limit surface)."""
     if len(pts) < 3:
         raise ValueError("fewer than 3 gross-sliding points")
+    elliptic = k is not None and k == ELLIPSE_K
+    curves = (lambda _ik: _ellipse_curves()) if elliptic else _curves
     names = (
         ["mu", "delta"]
         + (["gamma"] if gamma is None else [])
@@ -219,7 +241,7 @@ def fit_limit_surface(
     )
     fixed = {
         "gamma": gamma,
-        "inv_k": None if k is None else (0.0 if math.isinf(k) else 1.0 / k),
+        "inv_k": None if k is None else (math.nan if elliptic else (0.0 if math.isinf(k) else 1.0 / k)),
         "kappa": 0.0,
     }
     fn, ft_raw, tau, w = pts.f_n, pts.f_t, pts.tau_abs, pts.omega_abs
@@ -235,7 +257,7 @@ def fit_limit_surface(
 
     def resid(x):
         mu, delta, g_, ik, kap = unpack(x)
-        F, T, xi = _curves(ik)
+        F, T, xi = curves(ik)
         ft = ft_raw / (mu * fn)
         tt = tau / (mu * xi * delta * fn ** (1.0 + g_))
         lam = kap * fn ** (3.0 * g_ - 1.0) * w / (2.0 * xi)
@@ -244,7 +266,7 @@ def fit_limit_surface(
 
     g0 = 0.2 if gamma is None else gamma
     mu0 = float(np.percentile(ft_raw / fn, 90))
-    xi0 = _curves(0.25)[2]
+    xi0 = curves(0.25)[2]
     d0 = float(np.percentile(tau / (mu0 * xi0 * fn ** (1.0 + g0)), 90))
     d0 = min(max(d0, 2e-4), 5e-3)
     best = None
@@ -268,7 +290,7 @@ def fit_limit_surface(
             best = r
     x = best.x
     mu, delta, g_, ik, kap = unpack(x)
-    F, T, xi = _curves(ik)
+    F, T, xi = curves(ik)
     # sandwich covariance clustered by maneuver
     J = best.jac
     res = best.fun

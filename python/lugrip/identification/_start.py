@@ -15,6 +15,7 @@ from ._data import _Maneuver
 from ._optimize import Prior
 from ._phases import LOADING, SLIDING, STILL, Noise, estimate_noise, find_phases
 from ._stages import (
+    ELLIPSE_K,
     LimitSurfaceFit,
     PreslidingFit,
     fit_limit_surface,
@@ -32,6 +33,7 @@ _NO_SLIDING = (
     "identifiable (stick gives only a lower bound on mu); rub beyond the presliding distance, "
     "or fit only sigma0/sigma_z with free=('sigma0', 'sigma_z') and params0"
 )
+SIGMA_Z_TIME = 0.01  # [s] sigma_z / sigma0 where the loading runs show no micro-damping
 _REL_FLOOR = 0.02  # smallest relative prior spread of a stage value in the refinement [-]
 
 
@@ -193,16 +195,22 @@ def staged_estimate(
     else:
         sigma0 = pre.sigma0
         sz_sig = pre.stderr["sigma_z"] > 0 and pre.sigma_z >= 2.0 * pre.stderr["sigma_z"]
-        # without measurable micro-damping keep the observer's stick mode damped: sigma_z at
-        # the upper 2-sigma value of the fit, never below 1 % of sigma0 x 1 s
-        sigma_z = (
-            pre.sigma_z if sz_sig else max(pre.sigma_z + 2.0 * pre.stderr["sigma_z"], 0.01 * sigma0)
-        )
+        # without measurable micro-damping keep the observer's stick mode damped at a bristle
+        # time constant sigma_z / sigma0 of 10 ms (shorter than the loading runs, which show
+        # no damping). Not the fit's upper 2-sigma value: where the loading runs leave sigma_z
+        # undetermined its standard error is huge, and so heavy a damping stops the observer's
+        # bristle from reaching its sliding bound (S stays low in gross sliding).
+        sigma_z = pre.sigma_z if sz_sig else SIGMA_Z_TIME * sigma0
         lines.append(
             f"(b) presliding from {pre.runs} loading runs ({pre.samples} samples): sigma0 "
             f"{sigma0:.4g} +- {pre.stderr['sigma0']:.2g} N m/rad, sigma_z "
             f"{pre.sigma_z:.3g} +- {pre.stderr['sigma_z']:.2g} N m s/rad"
-            + ("" if sz_sig else f" (not significant: set to {sigma_z:.3g})")
+            + (
+                ""
+                if sz_sig
+                else f" (not significant: set to {sigma_z:.3g}, a bristle time constant of "
+                f"{1e3 * SIGMA_Z_TIME:g} ms)"
+            )
             + f"; RMS residual {pre.residual_rms:.3g} of g"
         )
         # the spread includes the misfit of the one-state bristle model to the loading runs
@@ -237,24 +245,42 @@ K_GAIN = 0.95  # a free k must lower the RMS distance to the surface below this 
 
 
 def _fit_ls(pts, fix_gamma, k, lines: list) -> LimitSurfaceFit:
-    """Stage (a)+(c) with k free, kept only when it lowers the RMS distance to the surface by
-    more than 5 % against k = 4 (else k is not determined by the data and held at 4)."""
+    """Stage (a)+(c), choosing the limit-surface shape. In the pressure family k is free and
+    kept only when it lowers the RMS distance to the surface by more than 5 % against k = 4
+    (else k is not determined by the data and held at 4). The elliptic limit surface (no
+    shape parameter) is fitted too; the shape with the lower RMS distance is kept."""
     if k is not None:
         return fit_limit_surface(pts, gamma=fix_gamma, k=k, viscous=True)
     free = fit_limit_surface(pts, gamma=fix_gamma, k=None, viscous=True)
     held = fit_limit_surface(pts, gamma=fix_gamma, k=K_DEFAULT, viscous=True)
-    if free.residual_rms < K_GAIN * held.residual_rms:
-        return free
+    pressure = free
+    if not free.residual_rms < K_GAIN * held.residual_rms:
+        lines.append(
+            f"k not determined by these data (free k = {free.k:.3g} lowers the distance to the "
+            f"surface only to {free.residual_rms / held.residual_rms:.2f} of k = {K_DEFAULT:g}): "
+            f"held at {K_DEFAULT:g}"
+        )
+        pressure = held
+    ellipse = fit_limit_surface(pts, gamma=fix_gamma, k=ELLIPSE_K, viscous=True)
+    keep = ellipse if ellipse.residual_rms < pressure.residual_rms else pressure
+    rms = {"pressure": pressure.residual_rms, "ellipse": ellipse.residual_rms}
+    bound = f" (at its bound: {', '.join(pressure.at_bound)})" if pressure.at_bound else ""
     lines.append(
-        f"k not determined by these data (free k = {free.k:.3g} lowers the distance to the "
-        f"surface only to {free.residual_rms / held.residual_rms:.2f} of k = {K_DEFAULT:g}): "
-        f"held at {K_DEFAULT:g}"
+        f"(a) limit-surface shape: pressure family (k {_k_text(pressure.k)}){bound} RMS "
+        f"distance {rms['pressure']:.3g}, elliptic limit surface {rms['ellipse']:.3g}: "
+        + ("the ellipse is kept" if keep is ellipse else "the pressure family is kept")
     )
-    return held
+    return dataclasses.replace(keep, shape_rms=rms)
+
+
+def _k_text(k: float) -> str:
+    if k == ELLIPSE_K:
+        return "0 (elliptic limit surface)"
+    return "inf" if math.isinf(k) else f"{k:.3g}"
 
 
 def _ls_line(ls: LimitSurfaceFit, pts, fix_gamma) -> str:
-    kk = "inf" if math.isinf(ls.k) else f"{ls.k:.3g}"
+    kk = _k_text(ls.k)
     return (
         f"(a) limit surface from {len(pts)} sliding points ({int(pts.samples.sum())} samples, "
         f"{np.unique(pts.maneuver).size} maneuvers, |c~| {np.min(ls.c_abs):.2g}-"
