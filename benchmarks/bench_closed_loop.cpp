@@ -5,7 +5,7 @@
 //
 // One closed-loop step = one sensor sample (500 Hz): the plant advanced by one sample period
 // (two 1 kHz plant steps, or one with the 500 Hz lumped variant), both fingertip observers and
-// the grasp controller (MODEL.md 9.7). "x real time" = simulated seconds per wall-clock second.
+// the grasp controller (docs/model.md 9.7). "x real time" = simulated seconds per wall-clock second.
 // The scenario is a lift of a 0.3 kg block grasped 3 mm beside its CoG with a push (every branch:
 // support, lift-off transient, hold, disturbance), repeated from reset() until the time budget
 // is spent. Components are timed alone with the same inputs (plant open loop at a constant

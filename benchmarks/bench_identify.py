@@ -16,7 +16,7 @@ Measured in one run on this machine:
   observer), the data-computed start, a Table 2 object (all six, and the per-object refit of
   mu and beta_A from 10 maneuvers), logs from the discretised-patch contact plant (not the
   lumped model, Stribeck of its own), and the rubbing estimate on that plant;
-* the observer bandwidth (MODEL.md 7.4, 8.1): the round trip, the object refit and the issue-3
+* the observer bandwidth (docs/model.md 7.4, 8.1): the round trip, the object refit and the issue-3
   observer figures (Table 1 / Table 2 RMSE, slip detection, false alarms, noise) for B = 100,
   300, 1000 and the default, which is why the default is what it is.
 """
@@ -683,7 +683,7 @@ def section(R: dict) -> str:
             "does not (table above)."
         )
     w(
-        "* The observer's bandwidth matters (MODEL.md 7.4, 8.1): eq. 32 identifies the parameters "
+        "* The observer's bandwidth matters (docs/model.md 7.4, 8.1): eq. 32 identifies the parameters "
         "that make *that* observer best. A slow observer lags the slip ramps (lag ~ "
         "(d omega/dt)/B), and sigma0, sigma_z and beta_A absorb the lag: at 100/s (the default "
         "before this change) sigma0 comes back about 2x too large, and the fitted set tracks "
@@ -853,7 +853,7 @@ def section(R: dict) -> str:
         "* **sigma0 and sigma_z are not identifiable from a Table 2 object's logs.** They act only "
         "in pre-sliding (stick and slip onset), and there the slip speed is not observable: the "
         "speed enters the wrench only through sigma_1 omega, and Table 2's beta_A makes sigma_1 "
-        "~1e-3 N m s/rad (MODEL.md 6, 7.3), so the observer's error at slip onsets is set by the "
+        "~1e-3 N m s/rad (docs/model.md 6, 7.3), so the observer's error at slip onsets is set by the "
         "torque noise / sigma_1, not by sigma0 and sigma_z; they wander to wherever the cost is "
         "flat (even to their bounds). This is why the paper identifies them once per fingertip "
         "(Table 1 data, large sigma_1) and refits only mu and beta_A per object."

@@ -99,7 +99,7 @@ class NumpyObserver:
         return float(np.interp(a, self.a_grid, self.T_grid))
 
     def cor(self, f_n, f_t, tau):
-        """Normalized CoR c~ (eqs. 13-15, MODEL.md 5.7)."""
+        """Normalized CoR c~ (eqs. 13-15, docs/model.md 5.7)."""
         p = self.p
         rho = p.delta * f_n**p.gamma
         f = abs(f_t) / (p.mu * f_n)
@@ -667,7 +667,7 @@ def render(R) -> str:
         "",
         (
             "With β_A 230-400× smaller than Table 1 the same speeds need only a few per cent of load "
-            "above g, and the speed enters the wrench only through σ1 ω (MODEL.md §6-7): the RMSE "
+            "above g, and the speed enters the wrench only through σ1 ω (docs/model.md §6-7): the RMSE "
             "is a large fraction of the RMS speed (Table 1: "
             f"{d1['rmse'] / d1['rms_omega']:.2f}), worst for rotation-dominated slips, where σ1 "
             "(∝ c~² + 1/2) is smallest, while S still flags the slips (negative median delay: S "
@@ -697,7 +697,7 @@ def render(R) -> str:
         (
             "The late detections of the Table 2 objects are translation-dominated CoRs, above all "
             "those beyond the clip, where the estimated capacity and torque refer to the clipped "
-            "CoR (MODEL.md §5.6)."
+            "CoR (docs/model.md §5.6)."
         ),
         "",
     ]
@@ -725,7 +725,7 @@ def render(R) -> str:
         "",
         (
             "The paper's stated accuracy taken as white noise (2 N·mm torque std, about g at 1 N) "
-            "is pessimistic (MODEL.md §10.1): S ≥ 0.9 then fires in stick maneuvers at low force."
+            "is pessimistic (docs/model.md §10.1): S ≥ 0.9 then fires in stick maneuvers at low force."
         ),
         "",
     ]
@@ -754,7 +754,7 @@ def render(R) -> str:
         "",
         (
             "One RK4 step per 2 ms sample is stable only while h l (σz + σ1) ≤ 2.785 and "
-            f"h σ0 |ω̂|/g ≤ 2.785 (MODEL.md §7.4). With the bandwidth gain l = {DEFAULT_B:g}/σ1 the first "
+            f"h σ0 |ω̂|/g ≤ 2.785 (docs/model.md §7.4). With the bandwidth gain l = {DEFAULT_B:g}/σ1 the first "
             "bound fails wherever σ1 is small; with the paper's fixed l = 200 the second fails at "
             "low force and high slip speed. Steady sliding at |c~| = 0.1, Table 1, "
             "default noise:"

@@ -324,7 +324,7 @@ def write_report(path: Path, cpp: dict, py: dict, api: dict, chk: dict, meta: di
             f"{fmt_ns(c['p99_ns'])} | {fmt_ns(c['worst_ns'])} | — |"
         )
         w(
-            f"| scipy nested `quad` (MODEL.md 3.3 method A) | {label} | {fmt_ns(q['median_ns'])} | "
+            f"| scipy nested `quad` (docs/model.md 3.3 method A) | {label} | {fmt_ns(q['median_ns'])} | "
             f"{fmt_ns(q['p99_ns'])} | {fmt_ns(q['worst_ns'])} | {fmt_ratio(q['median_ns'] / c['median_ns'])}; {fmt_ratio(q['p99_ns'] / c['p99_ns'])} |"
         )
         w(
@@ -442,7 +442,7 @@ def write_report(path: Path, cpp: dict, py: dict, api: dict, chk: dict, meta: di
         f"C++ `LimitSurface(4)` vs the scipy table: {fmt_ratio(qs['median_ms'] / c4['median_ms'])} faster "
         f"(the C++ tables have 2 × {cpp['ls_table_nodes']} nodes with exact derivatives and Hermite "
         "interpolation; the scipy "
-        "table is the 641-node grid of MODEL.md 3.3 with a cubic spline, quoted there at 2e-6)."
+        "table is the 641-node grid of docs/model.md 3.3 with a cubic spline, quoted there at 2e-6)."
     )
     w("")
 
@@ -491,12 +491,12 @@ def write_report(path: Path, cpp: dict, py: dict, api: dict, chk: dict, meta: di
         "- **scipy baseline** (`benchmarks/scipy_baseline.py`, no lugrip import): written as a user would,"
     )
     w(
-        "  from MODEL.md. The LS at one c~ by nested `scipy.integrate.quad` (method A of MODEL.md 3.3:"
+        "  from docs/model.md. The LS at one c~ by nested `scipy.integrate.quad` (method A of docs/model.md 3.3:"
     )
     w(
         "  CoR-centred chords, the inner integral with QUADPACK's algebraic end-point weight, default"
     )
-    w("  tolerances, agreeing with the MODEL.md 3.4 table to 1e-10). The CoR per sample with")
+    w("  tolerances, agreeing with the docs/model.md 3.4 table to 1e-10). The CoR per sample with")
     w(
         "  `scipy.optimize.brentq` on F^(γ+1) − σT = 0 and on h(a) = f − F − 2ξa(t − T), with F, T from a"
     )
