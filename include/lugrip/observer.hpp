@@ -25,11 +25,13 @@ const char* to_string(GainMode m) noexcept;
 
 //! Observer settings; every default lives here. The defaults were chosen on synthetic sliding
 //! data (plant = SliderModel, sensor = ContactModel::wrench_at + white noise); the figures are in
-//! the report of issue 3 and the tests in tests/cpp/test_observer.cpp pin the behaviour.
+//! BENCHMARKS.md (section Sliding-velocity observer), and tests/cpp/test_observer.cpp pins the
+//! behaviour.
 //! The bandwidth is also the one identification uses by default (docs/model.md 7.4, 8.1: the
 //! parameters are identified for the observer inside the cost): at 3000/s the Table 1 round
 //! trip and the per-object refit recover the parameters within 5 %, at 100/s the observer's lag
-//! behind slip ramps is absorbed by sigma0 (x2) and beta_A (-14 %); BENCHMARKS.md, issue 4.
+//! behind slip ramps is absorbed by sigma0 (x2) and beta_A (-14 %); BENCHMARKS.md, section
+//! Identification.
 //!
 //! | field | meaning | unit | range | default |
 //! |---|---|---|---|---|

@@ -310,7 +310,7 @@ def test_slip_onset_follows_the_plant():
 
 
 # ---------------------------------------------------------------------------------------------
-# accuracy on synthetic maneuvers (issue 3 acceptance, reduced size)
+# accuracy on synthetic maneuvers (the observer report's figures, reduced size)
 # ---------------------------------------------------------------------------------------------
 
 

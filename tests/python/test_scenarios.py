@@ -1,5 +1,5 @@
 """The paper's experiments as scenarios (scenarios/*.yaml): loading and validation, every
-scenario passing its criteria in the CI (--short) version with the baselines, the issue-5
+scenario passing its criteria in the CI (--short) version with the baselines, the
 acceptance comparisons (friction cone fails the rotational loads, the constant force needs more
 than lugrip's steady force, full can >= 10x empty can, pivot ends near vertical and avoidance
 resumes), metrics.json, figures and the ``lugrip simulate`` command."""

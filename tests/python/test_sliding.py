@@ -1,5 +1,5 @@
 """Synthetic sliding maneuvers (lugrip.sliding): determinism, design coverage, physics of the
-plant and the sensor wrench, the issue-3 RMSE figure on a reduced set, slip-detection scoring on
+plant and the sensor wrench, the observer report's RMSE figure on a reduced set, slip-detection scoring on
 hand-built cases, the sign of omega_hat through files, and the one-step RK4 divergence regime."""
 
 from __future__ import annotations
@@ -27,7 +27,7 @@ DT = 0.002
 
 @pytest.fixture(scope="module")
 def table1_set():
-    """The reduced issue-3 set: 60 maneuvers, Table 1, default noise (~0.1 s to build)."""
+    """The reduced observer-report set: 60 maneuvers, Table 1, default noise (~0.1 s to build)."""
     return simulate_maneuvers(TABLE1, 60, seed=11)
 
 
@@ -161,7 +161,7 @@ def test_bad_arguments_are_named(kwargs, match):
 
 
 # ---------------------------------------------------------------------------------------------
-# issue-3 acceptance on a reduced set
+# the observer report's acceptance figures on a reduced set
 # ---------------------------------------------------------------------------------------------
 
 
