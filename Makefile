@@ -54,7 +54,7 @@ test-cpp: deps-cpp
 test-python: install
 	$(VPY) -m pytest -q tests/python
 
-# `make bench`: every section of BENCHMARKS.md (issues 2-5), ~5 minutes; ratios come from one run.
+# `make bench`: every section of BENCHMARKS.md, ~5 minutes; ratios come from one run.
 
 # Debug build of the C++ tests with AddressSanitizer and UBSan.
 sanitize:

@@ -1,4 +1,4 @@
-// lugrip — per-call timings of the real-time core (issue 2, item 9; STYLE.md section 9).
+// lugrip — per-call timings of the real-time core (BENCHMARKS.md, section Contact-model core).
 //
 //   bench_core [--quick] [--json] [--seed N]
 //

@@ -1,5 +1,5 @@
 // lugrip — per-step timings of the sliding-velocity observer including the CoR estimate
-// (issue 3: "ns per observer step including the CoR estimate (median, p99)").
+// (median and p99 ns per step; BENCHMARKS.md, section Sliding-velocity observer).
 //
 //   bench_observer [--quick] [--json] [--seed N]
 //

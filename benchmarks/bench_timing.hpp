@@ -1,7 +1,7 @@
 // lugrip — timing helpers shared by the C++ benchmarks (bench_core, bench_observer,
 // bench_closed_loop). Header-only, C++17, standard library only.
 //
-// Method (STYLE.md section 9): std::chrono::steady_clock. A per-call figure from time_batched is
+// Method: std::chrono::steady_clock. A per-call figure from time_batched is
 // the time of a batch of kBatch = 16 consecutive calls (two clock reads around the batch) minus
 // the median cost of an empty timed region (timer_overhead_ns), divided by kBatch; time_each
 // times every call alone, with the same overhead subtracted. Median / p99 of per-call figures

@@ -4,14 +4,14 @@
 Written as a user would write it with scipy (it does not import lugrip):
 
 * ``ls_quad(a, k)``: the normalized limit-surface curves at one c~ by nested
-  ``scipy.integrate.quad`` (MODEL.md 3.3, method A: CoR-centred chords, the inner chord integral
+  ``scipy.integrate.quad`` (docs/model.md 3.3, method A: CoR-centred chords, the inner chord integral
   with the algebraic rim weight (QAWS, ``weight='alg'``), the outer angle integral adaptive).
   Baseline for lugrip's LS evaluation and, over a table grid, for its construction.
-* ``LsTable``: F and T by quad on the grid MODEL.md 3.3 recommends (step 0.01 on [0, 3],
+* ``LsTable``: F and T by quad on the grid docs/model.md 3.3 recommends (step 0.01 on [0, 3],
   0.05 on [3, 20]) and one ``scipy.interpolate.CubicSpline`` through both curves, with the
   asymptotics of 3.2 beyond 20. Built once; this is the LS the CoR baseline uses, so the CoR
   baseline is a fair, fast one: no quadrature per sample.
-* ``estimate_cor(...)``: one sample, MODEL.md 5.2-5.7: sigma (14), ``scipy.optimize.brentq``
+* ``estimate_cor(...)``: one sample, docs/model.md 5.2-5.7: sigma (14), ``scipy.optimize.brentq``
   on F^(g+1) - sigma T = 0, the inside test (15), ``brentq`` on the outside equation
   h(a) = f - F - 2 xi a (t - T) on [0, c_max], sign rule, saturation, then c, g, sigma_1, y.
 * ``estimate_cor_numpy(...)``: the same, vectorized over samples with numpy (bisection on the
@@ -50,7 +50,7 @@ OBJECTS = {"table1": TABLE1, "big_resin_block": dict(TABLE1, mu=0.85, beta_a=1.2
 
 # --- limit surface by quadrature -------------------------------------------------------------------
 class Shape:
-    """Normalization constants of the pressure p = (1 - r^k)^(1/k) (MODEL.md 2.2-2.3, 3.2)."""
+    """Normalization constants of the pressure p = (1 - r^k)^(1/k) (docs/model.md 2.2-2.3, 3.2)."""
 
     def __init__(self, k: float):
         self.k = k
@@ -116,7 +116,7 @@ def ls_quad(a: float, k: float = 4.0, shape: Shape | None = None, eps: float = 1
 
 
 def table_grid(coarse: bool = False):
-    """MODEL.md 3.3 grid: step 0.01 on [0, 3] (node 1.0 included), 0.05 on [3, 20]; 641 nodes.
+    """docs/model.md 3.3 grid: step 0.01 on [0, 3] (node 1.0 included), 0.05 on [3, 20]; 641 nodes.
     coarse (for --quick): steps 0.05 and 0.5, 95 nodes."""
     if coarse:
         return np.concatenate([np.linspace(0.0, 3.0, 61), np.linspace(3.5, 20.0, 34)])
@@ -124,7 +124,7 @@ def table_grid(coarse: bool = False):
 
 
 class LsTable:
-    """F, T tabulated by quad on the MODEL.md 3.3 grid, one CubicSpline, asymptotic tails."""
+    """F, T tabulated by quad on the docs/model.md 3.3 grid, one CubicSpline, asymptotic tails."""
 
     def __init__(self, k: float = 4.0, grid=None):
         self.shape = sh = Shape(k)
@@ -149,7 +149,7 @@ class LsTable:
         return F, T
 
 
-# --- CoR estimation, one sample (MODEL.md 5.7) -----------------------------------------------------
+# --- CoR estimation, one sample (docs/model.md 5.7) -----------------------------------------------------
 def estimate_cor(p: dict, ls: LsTable, f_n: float, f_t: float, tau: float, prev: float = 0.0):
     """Returns (c_tilde, inside, c, g, sigma_1, y) for one sample; same thresholds as lugrip."""
     if not (math.isfinite(f_n) and math.isfinite(f_t) and math.isfinite(tau)) or f_n < 0.03:

@@ -1,4 +1,4 @@
-"""One issue's section of BENCHMARKS.md: the text between ``<!-- issueN:begin -->`` and
+"""One marked section of BENCHMARKS.md: the text between ``<!-- issueN:begin -->`` and
 ``<!-- issueN:end -->``. Each benchmark script writes only its own section and keeps the rest of
 the file; a section not yet in the file is appended.
 

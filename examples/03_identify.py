@@ -52,7 +52,7 @@ def _main(tmp: Path, out_dir: str | None) -> lugrip.ContactParams:
 
     # The observer inside the cost has the default settings (bandwidth 3000/s: fast enough that
     # the physical parameters come back; a slow observer's lag would be absorbed by sigma0 and
-    # sigma_z, BENCHMARKS.md issue 4). Pass observer={...} to identify for another one.
+    # sigma_z, BENCHMARKS.md, section Identification). Pass observer={...} to identify for another one.
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", IdentificationWarning)
         fit = lugrip.identify(log)  # stages from the data, then eq. 32; all six free

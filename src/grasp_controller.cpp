@@ -282,7 +282,7 @@ Status GraspController::step(const GraspControllerInput& in, GraspControllerOutp
   }
   request_ = Request::None;
 
-  // Per-finger checks, C_d at the sensor rate, combination (MODEL.md 9.8).
+  // Per-finger checks, C_d at the sensor rate, combination (docs/model.md 9.8).
   const bool dynamic = mode_ == ControllerMode::SlippingAvoidance && s_.dynamic_enabled;
   bool any_present = false, valid = true;
   Status worst = Status::Ok;
@@ -423,7 +423,7 @@ void GraspController::issue_command(bool valid, double slip) noexcept {
       c.reflex = true;
     }
     clear_period();
-    // PI on e = S - s_ref: e > 0 (closer to slip than wanted) raises the force (MODEL.md 9.4).
+    // PI on e = S - s_ref: e > 0 (closer to slip than wanted) raises the force (docs/model.md 9.4).
     e = slip - s_.s_ref;
     // Integrated error: with static_equivalent_slippage the slippage the static part alone would
     // give, S_s = S ((f_ns + f_nd) / f_ns)^(1 + gamma) at the last command (= S when f_nd = 0).
@@ -561,7 +561,7 @@ double StaticForceSolver::slippage(double f_n, double f_t, double tau, double* c
   est_.step(CorInput{f_n, std::fabs(f_t), tau}, o);
   if (!is_valid(o.status) || !(o.g > 0.0)) return nan;
   if (c_tilde) *c_tilde = std::fabs(o.c_tilde);
-  // |tau - c f_t| = |tau| + |c| f_t (tau and c have opposite signs, MODEL.md 6). Equal to |y| of
+  // |tau - c f_t| = |tau| + |c| f_t (tau and c have opposite signs, docs/model.md 6). Equal to |y| of
   // the estimator except for a torque below its zero threshold, whose sign it holds from history.
   return (std::fabs(tau) + std::fabs(o.c) * std::fabs(f_t)) / o.g;
 }

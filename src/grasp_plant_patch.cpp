@@ -32,7 +32,7 @@ inline void twist_map(double& px, double& py, double Vx, double Vy, double omega
 }
 }  // namespace
 
-// One implicit step of the 3-DOF object on the two pads (MODEL.md 10.1 (b)).
+// One implicit step of the 3-DOF object on the two pads (docs/model.md 10.1 (b)).
 // State: CoG velocity v and omega (momentum), slip u of the object point that was at the pad
 // centre, angle theta; the CoG is at r = u + R(theta) cog. Unknowns q' = (V', omega'), the twist of
 // the object relative to the gripper (V' = velocity of the object point at the pad centre, i.e. the

@@ -140,7 +140,7 @@ inline bool scored_status(Status s) {
   return s == Status::Ok || s == Status::Saturated || s == Status::Degenerate || s == Status::Reinitialized;
 }
 
-// Parameter derivatives of |c~| = a as the CoR estimator computes it (MODEL.md 5.2-5.4), by the
+// Parameter derivatives of |c~| = a as the CoR estimator computes it (docs/model.md 5.2-5.4), by the
 // implicit-function theorem on the equation whose root the estimator found:
 //   inside:  (gamma+1) ln F(a) - ln T(a) = ln s,  s = f^(gamma+1) / t (eq. 13 first line, eq. 14)
 //   outside: f - F(a) - 2 xi a (t - T(a)) = 0    (eq. 13 second line)

@@ -149,7 +149,7 @@ LsPoint LimitSurface::integrate(double a) const {
   return quad(a, x, w);
 }
 
-// One point of the curves by the CoR-centred chord reduction (MODEL.md 3.3, method A, with
+// One point of the curves by the CoR-centred chord reduction (docs/model.md 3.3, method A, with
 // the chords taken whole through the CoR so every inner integrand is smooth):
 //   F = -(2/P_k) int cos(phi) I1,  T = (2/M_k) int (I2 + a cos(phi) I1),
 //   dF/da = (2/P_k) int sin(phi)^2 I0,  I_m(phi) = int_chord p t^m dt,  phi in [0, pi/2].

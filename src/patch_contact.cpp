@@ -191,7 +191,7 @@ void PatchContact::finish(double vx, double vy, double omega, PadWrench& wr) noe
     const double cvx = vx - omega * sy, cvy = vy + omega * sx;
     double nzx = e_[j] * zx_[j] + h * phi_[j] * cvx;
     double nzy = e_[j] * zy_[j] + h * phi_[j] * cvy;
-    // projection onto the saturation disc |z| <= z_max(|v|) (MODEL.md 7.1, per cell)
+    // projection onto the saturation disc |z| <= z_max(|v|) (docs/model.md 7.1, per cell)
     const double n2 = nzx * nzx + nzy * nzy;
     double zb2 = zc2;
     if (stribeck) {

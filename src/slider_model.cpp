@@ -89,7 +89,7 @@ bool rotor_advance(double& z, double& omega, double h, const RotorCoefficients& 
   bool cap_hit = false;
   int n = n_min;
   if (scheme == Integrator::Rk4Adaptive) {
-    // MODEL.md 7.4: n = ceil(h Lambda / 2), re-checked against the RK4 stability limit.
+    // docs/model.md 7.4: n = ceil(h Lambda / 2), re-checked against the RK4 stability limit.
     const auto stiffness = [&](double, double w) { return rotor_stiffness(w, c); };
     n = adaptive(z, omega, h, c, n_min, max_substeps, 2.0, kRk4StabilityLimit, detail::RotorRk4(), stiffness,
                  stiffness, [](int) {}, projected, cap_hit);

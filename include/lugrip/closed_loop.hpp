@@ -1,8 +1,8 @@
 // lugrip — closed-loop grasp simulation: plant -> two fingertip sensors -> two observers ->
-// grasp-force controller -> gripper command (MODEL.md 9.7, 9.8, 10.1), plus the two baseline
+// grasp-force controller -> gripper command (docs/model.md 9.7, 9.8, 10.1), plus the two baseline
 // controllers of the experiments (constant force, friction-cone threshold).
 //
-// Multi-rate (MODEL.md 9.7): the plant steps at PlantConfig::rate (1 kHz); both sensors are
+// Multi-rate (docs/model.md 9.7): the plant steps at PlantConfig::rate (1 kHz); both sensors are
 // sampled at sensor.rate (500 Hz) and each sample goes through its finger's Observer and the
 // controller at once (no computation delay); the controller issues a command every
 // command_ratio samples (50 Hz), which the plant's zero-order hold latches at its command tick

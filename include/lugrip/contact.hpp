@@ -43,7 +43,7 @@ class ContactModel {
   void wrench_at(double f_n, double c_tilde, double y, double& f_t, double& tau) const noexcept;
 
   //! Root of h(a) = f - F(a) - 2 xi a (t - T(a)) on [0, c_max] (eq. 13, second line,
-  //! MODEL.md 5.4); returns c_max when h(c_max) > 0.
+  //! docs/model.md 5.4); returns c_max when h(c_max) > 0.
   //! `guess` (optional, e.g. the inside-LS estimate) starts the iteration.
   //! `point` (optional) receives the LS point (F, T, dF, dT) at the returned a.
   double solve_outside(double ft_abs, double tau_abs, int* iterations = nullptr,
@@ -124,7 +124,7 @@ struct CorOutput {
   double c_tilde_unclipped = 0.0;
 };
 
-//! CoR estimator (MODEL.md 5.7): virtual CoR inside the LS, viscous-LS CoR outside, sign rule
+//! CoR estimator (docs/model.md 5.7): virtual CoR inside the LS, viscous-LS CoR outside, sign rule
 //! sign(c~) = -sign(f_t) sign(tau), saturation at c_max. Holds the previous estimate for the
 //! undefined cases (zero wrench: previous c~; torque below threshold: previous sign).
 class CorEstimator {

@@ -1,4 +1,4 @@
-// lugrip — grasp-force controller: slipping avoidance and pivoting (paper eqs. 34-37, MODEL.md 9)
+// lugrip — grasp-force controller: slipping avoidance and pivoting (paper eqs. 34-37, docs/model.md 9)
 // and the static grasp force a constant load settles at.
 #pragma once
 
@@ -28,7 +28,7 @@ struct GraspControllerSettings {
   double z_cd = 250.0;  //!< [rad/s] zero, > p_cd (lag network, DC gain k_cd z_cd / p_cd)
   bool dynamic_enabled = true;  //!< (*) dynamic part active in slipping avoidance
 
-  // --- static part in slipping avoidance: PI on e = S - s_ref (MODEL.md 9.4) -----------------
+  // --- static part in slipping avoidance: PI on e = S - s_ref (docs/model.md 9.4) -----------------
   double s_ref = 0.8;  //!< (*) reference of the slippage indicator S-bar_a, in (0, 1)
   double k_p = 4.0;    //!< (*) [N] proportional gain (e > 0 raises the force), > 0
   double k_i = 10.0;   //!< (*) [N/s] integral gain, > 0
@@ -106,7 +106,7 @@ struct GraspControllerSettings {
   int reflex_samples = 3;
   double reflex_factor = 1.25;  //!< (*) [-] raise of the static part per period of detected slip, > 1
 
-  // --- force range and rate limits (MODEL.md 9.5) --------------------------------------------
+  // --- force range and rate limits (docs/model.md 9.5) --------------------------------------------
   double f_min = 0.1;   //!< [N] minimum force (keeps contact), > 0
   double f_max = 20.0;  //!< [N] maximum force (gripper limit), > f_min
   double max_rate_up = 200.0;    //!< (*) [N/s] limit on command increase, > 0 (inf: off)
@@ -115,7 +115,7 @@ struct GraspControllerSettings {
   //! (NaN/Inf, InvalidSample, SensorFault, NoContact); 0 = hold. >= 0, finite.
   double invalid_raise_step = 0.0;
 
-  // --- pivoting mode (MODEL.md 9.6) -----------------------------------------------------------
+  // --- pivoting mode (docs/model.md 9.6) -----------------------------------------------------------
   double s_pivot = 1.3;      //!< (*) reference S-bar_p, > 1
   double tau_pivot = 2.0;    //!< (*) [s] time constant tau_p of the pivoting filter, > 0
   double k_f = 4.0;          //!< (*) [N] gain of the pivoting filter (paper: k_f = k_p), > 0
@@ -226,7 +226,7 @@ class LagFilter {
   double b0_ = 0.0, b1_ = 0.0, a1_ = 0.0, u_ = 0.0, y_ = 0.0;
 };
 
-//! Static utilization and static grasp force for a constant load (MODEL.md 6, 9.4).
+//! Static utilization and static grasp force for a constant load (docs/model.md 6, 9.4).
 //!
 //! S_static(f_n) = |tau - c f_t| / g(f_n, c) = (|tau| + |c| f_t) / g(f_n, c), with c~ from the
 //! CoR estimator at f_n (same estimator and c_max clip as the closed loop), is what S settles
@@ -260,7 +260,7 @@ class StaticForceSolver {
   CorEstimator est_;
 };
 
-//! Two-mode grasp-force controller f_n = f_ns + f_nd (eq. 34, MODEL.md 9).
+//! Two-mode grasp-force controller f_n = f_ns + f_nd (eq. 34, docs/model.md 9).
 //!
 //! * step() runs at the sensor rate. Every call updates one C_d filter per present finger
 //!   (Tustin at the sensor rate) and the peak of max_i |C_d omega_hat_i|; every command_ratio-th
@@ -274,7 +274,7 @@ class StaticForceSolver {
 //!   on the output and the filter state; ends on mean |c~_i| > pivot_end_c_tilde for
 //!   pivot_end_samples consecutive sensor samples, on timeout or on request, then returns to
 //!   slipping avoidance bumplessly (I = last command - k_p e at the next command, C_d reset).
-//! * Two fingers (MODEL.md 9.8): S = max_i S_i, f_nd from max_i |C_d omega_hat_i|, pivot end on
+//! * Two fingers (docs/model.md 9.8): S = max_i S_i, f_nd from max_i |C_d omega_hat_i|, pivot end on
 //!   the mean of |c~_i|; absent fingers are ignored.
 //! * Rate limits act on the total command after the force range; the floor wins over them.
 //! * Invalid input (a present finger with NaN/Inf/out-of-range values or status InvalidSample,

@@ -1,6 +1,6 @@
 // lugrip — planar grasp simulator: a rigid object between the two soft fingertips of a parallel
-// gripper, with a distributed-friction contact model (MODEL.md 10.1 (b)) or the lumped slider
-// of eqs. 1-2 (MODEL.md 10.1 (a)), a first-order gripper actuator behind a 50 Hz zero-order
+// gripper, with a distributed-friction contact model (docs/model.md 10.1 (b)) or the lumped slider
+// of eqs. 1-2 (docs/model.md 10.1 (a)), a first-order gripper actuator behind a 50 Hz zero-order
 // hold, fingertip force/torque sensors at 500 Hz and external pushes. Deterministic (seeded).
 //
 // Frames (all planar, SI units):
@@ -12,7 +12,7 @@
 //  * Fingertip i (i = 0, 1) sits on the -Z (i = 0) or +Z (i = 1) face of the object. Its sensor
 //    frame has z_i along the pad normal pointing into the object (z_0 = +Z, z_1 = -Z), y_i = Y and
 //    x_i = y_i x z_i (x_0 = +X, x_1 = -X). The sensor reads the wrench the OBJECT exerts on the
-//    fingertip (MODEL.md 7.2), so tau_i has the sign of the slip angular velocity omega_i =
+//    fingertip (docs/model.md 7.2), so tau_i has the sign of the slip angular velocity omega_i =
 //    z_i . omega while sliding, and f_n > 0 is the compression.
 #pragma once
 
@@ -94,7 +94,7 @@ struct ActuatorConfig {
 //! Fingertip force/torque sensor (one per finger, same settings, independent noise streams).
 struct SensorConfig {
   double rate = 500.0;            //!< sampling rate [Hz]; plant rate / rate must be an integer
-  double force_noise = 0.005;     //!< white noise std on f_n, f_x, f_y [N] (MODEL.md 10.1)
+  double force_noise = 0.005;     //!< white noise std on f_n, f_x, f_y [N] (docs/model.md 10.1)
   double torque_noise = 1.0e-5;   //!< white noise std on tau [N m] (0.01 N mm)
   double force_resolution = 0.0;  //!< quantisation step of the forces [N] (0: off)
   double torque_resolution = 0.0; //!< quantisation step of the torque [N m] (0: off)
@@ -202,16 +202,16 @@ struct PadWrench {
   double tau = 0.0;           //!< about Z [N m]
 };
 
-//! One fingertip pad as a discretised pressure patch (MODEL.md 10.1 (b)). Unit-disc polar grid:
+//! One fingertip pad as a discretised pressure patch (docs/model.md 10.1 (b)). Unit-disc polar grid:
 //! `rings` uniform rings, each split into ~square cells (staggered), cell at the pressure
-//! centroid radius of its ring, cell load share = exact integral of p(r) over the cell (MODEL.md
+//! centroid radius of its ring, cell load share = exact integral of p(r) over the cell (docs/model.md
 //! 2.2). At run time the cells are scaled by rho(f_n) = delta f_n^gamma and loaded with f_n.
 //! Each cell carries a 2-D bristle z_j [m]:
 //!   zdot_j = v_j - |v_j| z_j / z_max(|v_j|),   z_max(v) = mu(v) / kappa,
 //!   f_j = -(k_j z_j + c_j zdot_j),  k_j = kappa n_j,  c_j = t_d k_j,
 //! (so every cell saturates at mu(v) n_j), plus the viscous stress -beta_A v over the disc, which
 //! is linear in position and therefore integrated in closed form: -beta_A pi rho^2 v_centre and
-//! -beta_A (pi/2) rho^4 omega (MODEL.md 5.1, eqs. 7-8).
+//! -beta_A (pi/2) rho^4 omega (docs/model.md 5.1, eqs. 7-8).
 //!
 //! Step: the bristles are advanced exactly for velocities frozen over the step (exponential
 //! update) and the result is linear in the end-of-step velocity, which lets the plant solve the

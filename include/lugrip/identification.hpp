@@ -1,4 +1,4 @@
-// lugrip — offline identification (paper eqs. 32-33, MODEL.md 8): cost and exact gradient of the
+// lugrip — offline identification (paper eqs. 32-33, docs/model.md 8): cost and exact gradient of the
 // observer's velocity error over many sliding maneuvers.
 #pragma once
 
@@ -48,7 +48,7 @@ bool validate(const IdentificationSettings& s, std::string* message);
 //! concatenated. The observer restarts at every segment start and is never integrated across
 //! two segments.
 //!
-//! Per sample: f_n [N], f_t [N] (in-plane magnitude), tau [N m] (the sensor's wrench, MODEL.md
+//! Per sample: f_n [N], f_t [N] (in-plane magnitude), tau [N m] (the sensor's wrench, docs/model.md
 //! 7.2), dt [s] since the previous sample (0: the nominal observer dt; ignored at a segment
 //! start), omega the ground-truth slip velocity [rad/s] (NaN: unknown, not scored) and weight
 //! (>= 0, finite; 0: not scored). segment_start holds the first sample of each segment followed
@@ -92,7 +92,7 @@ struct IdentificationEval {
   int64_t truncated = 0;
 };
 
-//! The identification cost of MODEL.md 8.1 over a fixed data set:
+//! The identification cost of docs/model.md 8.1 over a fixed data set:
 //!
 //!   C(P) = sum_n w_n loss(omega_hat_n(P) - omega_n) / sum_n w_n,
 //!

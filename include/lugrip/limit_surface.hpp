@@ -37,7 +37,7 @@ struct LsPoint {
 };
 
 //! The normalized limit-surface curves f~*_tLS(c~) and tau~*_LS(c~) for a pressure
-//! p(r) = p0 (1 - (r/rho)^k)^(1/k) on the contact disc (MODEL.md section 3).
+//! p(r) = p0 (1 - (r/rho)^k)^(1/k) on the contact disc (docs/model.md section 3).
 //!
 //! Construction integrates the curves with Gauss-Jacobi / Gauss-Legendre quadrature of the
 //! 1-D reduction (CoR-centred chords) on two tables, a in [0, 1] and u = 1/a in [0, 1], values
@@ -47,7 +47,7 @@ struct LsPoint {
 //! better). For k not an even integer the chords are split at the point nearest the disc
 //! centre, where the pressure has a |r|^k cusp.
 //!
-//! Sign convention (MODEL.md 3.2): f~* is odd with the sign opposite to c~, tau~* is even
+//! Sign convention (docs/model.md 3.2): f~* is odd with the sign opposite to c~, tau~* is even
 //! and positive.
 class LimitSurface {
  public:

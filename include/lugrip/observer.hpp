@@ -15,7 +15,7 @@ namespace lugrip {
 enum class GainMode : int {
   Fixed = 0,      //!< l = ObserverSettings::gain
   //! l = bandwidth / sigma_1 clipped to [gain_min, gain_max]: the sliding convergence rate
-  //! l sigma_1 is then the same at every force, CoR and beta_A (MODEL.md 7.4 "scale the gain
+  //! l sigma_1 is then the same at every force, CoR and beta_A (docs/model.md 7.4 "scale the gain
   //! with sigma_1"); sigma_1 spans five decades, a fixed l is seconds late when it is small.
   Bandwidth = 1,
 };
@@ -25,11 +25,13 @@ const char* to_string(GainMode m) noexcept;
 
 //! Observer settings; every default lives here. The defaults were chosen on synthetic sliding
 //! data (plant = SliderModel, sensor = ContactModel::wrench_at + white noise); the figures are in
-//! the report of issue 3 and the tests in tests/cpp/test_observer.cpp pin the behaviour.
-//! The bandwidth is also the one identification uses by default (MODEL.md 7.4, 8.1: the
+//! BENCHMARKS.md (section Sliding-velocity observer), and tests/cpp/test_observer.cpp pins the
+//! behaviour.
+//! The bandwidth is also the one identification uses by default (docs/model.md 7.4, 8.1: the
 //! parameters are identified for the observer inside the cost): at 3000/s the Table 1 round
 //! trip and the per-object refit recover the parameters within 5 %, at 100/s the observer's lag
-//! behind slip ramps is absorbed by sigma0 (x2) and beta_A (-14 %); BENCHMARKS.md, issue 4.
+//! behind slip ramps is absorbed by sigma0 (x2) and beta_A (-14 %); BENCHMARKS.md, section
+//! Identification.
 //!
 //! | field | meaning | unit | range | default |
 //! |---|---|---|---|---|
@@ -102,7 +104,7 @@ inline double planar_norm(double x, double y) noexcept {
 }
 
 //! One fingertip sample: the wrench the OBJECT exerts on the FINGERTIP, i.e. what a fingertip
-//! force/torque sensor reads (MODEL.md 7.2), in a frame with z along the contact normal.
+//! force/torque sensor reads (docs/model.md 7.2), in a frame with z along the contact normal.
 //! With this wrench y = tau - c f_t has the sign of the slip velocity and omega_hat is the
 //! object's angular velocity relative to the fingertip about the sensor's z axis. Feeding the
 //! opposite wrench (fingertip on object) returns -omega_hat with the same S.
@@ -150,7 +152,7 @@ struct ObserverOutput {
   double ft_cor = 0.0;      //!< tangential force used for the CoR (filtered when filter_force) [N]
   double gain = 0.0;        //!< observer gain l used on this sample [1/(kg m^2)]
   //! Speed resolution torque_noise / sigma_1 [rad/s]: the slip speed enters the wrench only
-  //! through viscous friction (MODEL.md 6, 7.3), so speed changes below this are invisible.
+  //! through viscous friction (docs/model.md 6, 7.3), so speed changes below this are invisible.
   double omega_resolution = 0.0;
   bool speed_observable = false;  //!< omega_resolution <= settings.resolution_max
   bool inside = true;       //!< CoR wrench strictly inside the limit surface (eq. 15)
@@ -167,7 +169,7 @@ struct ObserverOutput {
   double v_slip = 0.0;        //!< slip speed of the patch centre [m/s], >= 0
 };
 
-//! Nonlinear sliding-velocity observer of the paper (eqs. 21-23, MODEL.md 7), per fingertip:
+//! Nonlinear sliding-velocity observer of the paper (eqs. 21-23, docs/model.md 7), per fingertip:
 //!
 //!   zhat' = omegahat - (sigma0/g) zhat |omegahat|,
 //!   omegahat' = l [y - sigma0 zhat - sigma_1 omegahat - sigma_z zhat'],

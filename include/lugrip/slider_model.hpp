@@ -1,5 +1,5 @@
 // lugrip — the planar slider about its centre of rotation (paper eqs. 1-2) and the one-step
-// integrators shared with the velocity observer (MODEL.md 7.1 and 7.4). The integrators are
+// integrators shared with the velocity observer (docs/model.md 7.1 and 7.4). The integrators are
 // implemented once, templated on the scalar type, in lugrip/detail/rotor_steps.hpp (double here,
 // dual numbers in the identification's forward sensitivities).
 #pragma once
@@ -21,11 +21,11 @@ enum class Integrator : int {
   //! first order: its lag is visible when sigma_1 is small and l large.
   Implicit = 0,
   //! The paper's scheme: one classical RK4 step per sample (zero-order-hold inputs). Unstable
-  //! when h l (sigma_z + sigma_1) > 2.785 or h sigma0 |omega| / g > 2.785 (MODEL.md 7.4).
+  //! when h l (sigma_z + sigma_1) > 2.785 or h sigma0 |omega| / g > 2.785 (docs/model.md 7.4).
   Rk4 = 1,
   //! RK4 with n = ceil(h Lambda / 2) substeps, Lambda = max(k (sigma_z + sigma_1),
   //! sigma0 |omega| / g) at the start of the sample, redone with more substeps when the largest
-  //! Lambda seen during the sample violates h Lambda / n <= 2.785; n is capped (MODEL.md 7.4).
+  //! Lambda seen during the sample violates h Lambda / n <= 2.785; n is capped (docs/model.md 7.4).
   Rk4Adaptive = 2,
   //! Default of the observer and the plant. Linearly implicit 2-stage Rosenbrock method ROS2
   //! (gamma = 1 + 1/sqrt(2)) with the exact 2x2 Jacobian: second order, L-stable (any gain l,
@@ -118,7 +118,7 @@ constexpr double kRosenbrockRate = 2.0;
 constexpr double kRosenbrockOmegaStep = 1.0;
 
 //! Integrates one sample of length h with `scheme`, projecting |z| <= g/sigma0 before the
-//! sample (g may have dropped since the last one) and after every (sub)step (MODEL.md 7.1).
+//! sample (g may have dropped since the last one) and after every (sub)step (docs/model.md 7.1).
 //! Implicit, Rosenbrock and Rk4 take `n_min` equal substeps; Rk4Adaptive takes
 //! max(n_min, ceil(h Lambda / 2)) and re-checks Lambda at the end (at most `max_substeps`).
 //! *substeps receives the number used, *capped whether the cap limited an unstable
@@ -157,7 +157,7 @@ struct SliderOutput {
   double dry_torque = 0.0;       //!< sigma0 z + sigma_z zdot [N m]
   //! Friction torque about the CoR, sigma0 z + sigma_z zdot + sigma_1 omega [N m] (eq. 19):
   //! the torque the fingertip exerts on the slider is minus this; a fingertip sensor reads +this
-  //! (MODEL.md 7.2), so this is the observer's y for a noiseless sensor.
+  //! (docs/model.md 7.2), so this is the observer's y for a noiseless sensor.
   double friction_torque = 0.0;
   double slip = 0.0;             //!< sigma0 |z| / g [-] (eq. 37 for the true state)
   int substeps = 0;              //!< internal steps used
@@ -167,7 +167,7 @@ struct SliderOutput {
 
 //! The planar slider of eqs. 1-2 about a given (virtual) CoR, as a plant for simulators and
 //! tests: z and omega, inertia J about the CoR axis, g and sigma_1 from the contact model at the
-//! current f_n and c~. After every substep z is projected onto |z| <= g / sigma0 (MODEL.md 7.1),
+//! current f_n and c~. After every substep z is projected onto |z| <= g / sigma0 (docs/model.md 7.1),
 //! so the friction never exceeds the current capacity when g drops.
 class SliderModel {
  public:

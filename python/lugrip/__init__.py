@@ -1,5 +1,5 @@
 """lugrip: model-based slip detection, slip avoidance and pivoting for parallel grippers with
-force/torque fingertips (limit surface + revisited LuGre friction, MODEL.md).
+force/torque fingertips (limit surface + revisited LuGre friction, docs/model.md).
 
 The real-time core is C++17 (``lugrip._core``); this package is numpy in, numpy out.
 

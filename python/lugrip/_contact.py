@@ -77,7 +77,7 @@ def _shaped(out: np.ndarray, shape):
 
 
 class LimitSurface:
-    """Normalized limit surface of a soft circular contact (paper Fig. 3, MODEL.md section 3).
+    """Normalized limit surface of a soft circular contact (paper Fig. 3, docs/model.md section 3).
 
     Tables are integrated at construction (~30 ms); evaluation is constant time in C++.
     `ft_star` is odd with the sign opposite to c~; `tau_star` is even and positive.
@@ -246,7 +246,7 @@ class CorEstimate:
 def estimate_cor(params, f_n, f_t, tau, *, f_n_min: float | None = None,
                  zero_force: float | None = None, zero_torque: float | None = None,
                  force_limit: float | None = None, torque_limit: float | None = None) -> CorEstimate:
-    """Estimate the signed normalized CoR c~ for each sample (paper eqs. 13-15, MODEL.md 5.7).
+    """Estimate the signed normalized CoR c~ for each sample (paper eqs. 13-15, docs/model.md 5.7).
 
     Samples are processed in order (flattened, C order) by one C++ estimator, so undefined
     samples (zero wrench, torque below `zero_torque`) hold the previous value / side. Never

@@ -1,7 +1,7 @@
 """Grasp-force controller (slipping avoidance + pivoting) and the static grasp force.
 
 Thin layer over the C++ ``lugrip::GraspController`` and ``lugrip::StaticForceSolver``
-(include/lugrip/grasp_controller.hpp, MODEL.md section 9). Loops run in C++.
+(include/lugrip/grasp_controller.hpp, docs/model.md section 9). Loops run in C++.
 """
 
 from __future__ import annotations
@@ -156,7 +156,7 @@ def _per_finger(value, n: int | None, name: str, dtype) -> np.ndarray:
 
 
 class GraspController:
-    """Two-mode grasp-force controller f_n = f_ns + f_nd (paper eqs. 34-37, MODEL.md 9).
+    """Two-mode grasp-force controller f_n = f_ns + f_nd (paper eqs. 34-37, docs/model.md 9).
 
     * Dynamic part f_nd = |C_d omega_hat|, C_d(s) = k_cd (s + z_cd)/(s + p_cd) discretised by
       Tustin at the sensor rate (one filter per finger); the peak over the last command period
@@ -371,7 +371,7 @@ def static_grasp_force(params, f_t, tau, s_ref: float = 0.8, *, full_output: boo
     """Per-finger grasp force at which the static controller settles for a constant load.
 
     Solves S_static(f_n) = s_ref with S_static = |tau - c f_t| / g(f_n, c) and c~ from the CoR
-    estimate at f_n (same estimator and c_max clip as the closed loop, MODEL.md 6). S_static
+    estimate at f_n (same estimator and c_max clip as the closed loop, docs/model.md 6). S_static
     decreases with f_n; the root is bracketed by doubling and refined by Illinois on log f_n
     (bounded: <= 120 bracket and 100 refinement evaluations, typically < 15 in all).
 
@@ -402,7 +402,7 @@ def static_grasp_force(params, f_t, tau, s_ref: float = 0.8, *, full_output: boo
 
 
 def static_slippage(params, f_n, f_t, tau):
-    """S_static(f_n) = |tau - c f_t| / g(f_n, c) for a constant load (MODEL.md 6, stick), with c~
+    """S_static(f_n) = |tau - c f_t| / g(f_n, c) for a constant load (docs/model.md 6, stick), with c~
     from the CoR estimate at f_n. Returns (S, |c~|), broadcast like the inputs; NaN where
     f_n <= 0 or an input is not finite."""
     p = _as_params(params)

@@ -4,7 +4,7 @@ slippage indicator S (eq. 37), and the observability check of Proposition 1 (eqs
 The loops run in C++ (``lugrip._core``); this module converts arguments, validates settings and
 returns numpy arrays in dataclasses.
 
-Sign convention (MODEL.md 7.2): the observer is fed the wrench the OBJECT exerts on the
+Sign convention (docs/model.md 7.2): the observer is fed the wrench the OBJECT exerts on the
 FINGERTIP, i.e. what a fingertip force/torque sensor reads. Then ``omega_hat`` is the object's
 angular velocity relative to the fingertip about the sensor's z axis (the contact normal).
 Feeding the opposite wrench returns ``-omega_hat`` with the same S.
@@ -175,7 +175,7 @@ def _column(log, name: str):
 
 
 class Observer:
-    """Sliding-velocity observer of one fingertip (paper eqs. 21-23, MODEL.md 7).
+    """Sliding-velocity observer of one fingertip (paper eqs. 21-23, docs/model.md 7).
 
     Per sample: CoR estimate from f_n, f_t and the low-pass filtered torque (raw torque for
     y), g and sigma_1, y = tau - c f_t, one update of (z_hat, omega_hat) with the chosen
@@ -431,7 +431,7 @@ class SliderModel:
 
     State z [rad], omega [rad/s]; inertia J [kg m^2] about the CoR axis; per step the normal
     force f_n [N], the CoR c_tilde [-] and the external torque tau_e [N m] about the CoR are held.
-    z is projected onto |z| <= g/sigma0 after every substep (MODEL.md 7.1).
+    z is projected onto |z| <= g/sigma0 after every substep (docs/model.md 7.1).
 
     Args:
         params: ContactParams, a preset name or a dict.

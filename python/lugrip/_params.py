@@ -33,7 +33,7 @@ class ContactParams:
         mu: Coulomb friction coefficient [-].
         beta_a: viscous friction per unit contact area and unit sliding speed [N s/m^3]. The
             paper prints "Ns/m"; eq. 7 (f_tv = pi beta_A rho^2 omega c) needs N s/m^3, so the
-            printed numbers are used unchanged with the unit corrected (MODEL.md section 11).
+            printed numbers are used unchanged with the unit corrected (docs/model.md section 11).
         sigma0: micro-asperity stiffness [N m/rad].
         sigma_z: micro-asperity damping [N m s/rad].
         delta, gamma: contact radius rho = delta * f_n**gamma [m], 0 < gamma < 1/3.
@@ -240,7 +240,7 @@ def read_observer_settings(path: str | Path) -> dict[str, Any] | None:
     """The ``observer:`` block of a parameter YAML (written by ``lugrip identify`` /
     :meth:`lugrip.identification.IdentificationResult.save_yaml`): the settings of the observer the
     parameters were identified with, as keywords of :class:`lugrip.Observer`, so that the
-    observer used online is the one inside the identification cost (MODEL.md 8.1). None when
+    observer used online is the one inside the identification cost (docs/model.md 8.1). None when
     the file has no such block (e.g. ``objects/*.yaml``, ``lugrip params`` output).
     ``lugrip.Observer(path)`` starts from this block (its keywords override it), as do
     ``lugrip observe --params``, ``lugrip identify --params0`` and ``lugrip.identify`` with a

@@ -9,7 +9,7 @@ velocity", ground truth omega from the robot's encoders. Here the slider is the 
   onto ``|z| <= g/sigma0``) about a fixed CoR ``c~`` at a constant normal force ``f_n`` per
   maneuver, driven by an external torque ``tau_e`` about the CoR;
 * **sensor**: the wrench the object exerts on the fingertip (what a fingertip F/T sensor reads,
-  MODEL.md 7.2) for that CoR and the plant's friction torque about it,
+  docs/model.md 7.2) for that CoR and the plant's friction torque about it,
   :func:`lugrip.sensor_wrench` (= ``ContactModel::wrench_at``), the in-plane force rotated to a
   random direction of the sensor frame (``f_x``, ``f_y``), plus white noise on ``f_n``,
   ``f_x``, ``f_y`` and ``tau``;
@@ -22,7 +22,7 @@ small set spans every range):
 * ``f_n`` uniform in ``f_n_range`` (default 1-10 N, the paper's Section 4 range);
 * ``|c~|`` log-uniform in ``c_range`` (default 0.02 to ``2 c_max``): from rotation-dominated to
   translation-dominated, including CoRs beyond the observer's clip ``c_max`` where the
-  estimated CoR saturates (MODEL.md 5.6) and the observer's omega refers to the clipped CoR;
+  estimated CoR saturates (docs/model.md 5.6) and the observer's omega refers to the clipped CoR;
 * direction of the load (the sign of omega) random;
 * torque profile: rest, linear ramp up, hold, ramp down, rest (durations in ``ramp``,
   ``hold``, ``release``, ``rest``; sliding maneuvers hold for at least three time constants
@@ -37,7 +37,7 @@ small set spans every range):
   direction, so translation-dominated maneuvers turn slower. Peak speeds are then tenths of
   rad/s as in the paper's Figure 5. With Table 1's ``beta_A = 4.9e9`` the viscous torque at
   these speeds is 10-60 times the dry capacity ``g``: the loads are far outside the limit
-  surface, as the identified parameters imply (MODEL.md 11, item 9). With a Table 2 object the
+  surface, as the identified parameters imply (docs/model.md 11, item 9). With a Table 2 object the
   same speeds need only a few per cent above ``g``.
 * **stick maneuvers** (a fraction ``stick_fraction``): the same profile with a peak load of
   ``load_ratio * g``, ``load_ratio`` uniform in ``stick_load`` (default 0.3-0.85); the plant
@@ -83,11 +83,11 @@ __all__ = [
 ]
 
 DEFAULT_NOISE: tuple[float, float] = (0.005, 1.0e-5)
-"""Default white sensor noise (force std [N], torque std [N m]): MODEL.md 10.1 (0.005 N and
+"""Default white sensor noise (force std [N], torque std [N m]): docs/model.md 10.1 (0.005 N and
 0.01 N mm), a fraction of the paper's stated accuracy."""
 
 PAPER_NOISE: tuple[float, float] = (0.1, 2.0e-3)
-"""The paper's sensor accuracy (0.1 N, 0.002 N m) taken as white-noise std (MODEL.md 10.1
+"""The paper's sensor accuracy (0.1 N, 0.002 N m) taken as white-noise std (docs/model.md 10.1
 explains why that is pessimistic)."""
 
 REGIMES: tuple[str, ...] = ("rotation", "mixed", "translation", "beyond_clip")

@@ -1,5 +1,5 @@
-// Contact quantities (MODEL.md 2, 5.1, 6), parameter validation and presets, and the CoR
-// estimator (MODEL.md 5.2-5.7): round trips inside and outside the LS, sign rule, degenerate
+// Contact quantities (docs/model.md 2, 5.1, 6), parameter validation and presets, and the CoR
+// estimator (docs/model.md 5.2-5.7): round trips inside and outside the LS, sign rule, degenerate
 // and invalid samples, saturation, and a seeded random property test.
 #include <gtest/gtest.h>
 
@@ -65,7 +65,7 @@ bool known_status(Status s) {
   return v >= static_cast<int>(Status::Ok) && v <= static_cast<int>(Status::Reinitialized);
 }
 
-// Sensor wrench on the LS at normal force f_n for the signed CoR c~ (frame of MODEL.md 1.2:
+// Sensor wrench on the LS at normal force f_n for the signed CoR c~ (frame of docs/model.md 1.2:
 // f_t >= 0, sign(c~) = -sign(tau)).
 void wrench_on_ls(const ContactModel& m, double f_n, double c_tilde, double& f_t, double& tau) {
   const LsPoint q = m.limit_surface().eval(c_tilde);
@@ -218,7 +218,7 @@ TEST(ContactParamsValidation, PrintableAndStatusStrings) {
   EXPECT_FALSE(is_valid(Status::InvalidSample));
 }
 
-// ------------------------------------------------------ contact quantities (MODEL.md 2, 5.1, 6) ----
+// ------------------------------------------------------ contact quantities (docs/model.md 2, 5.1, 6) ----
 
 TEST(ContactQuantities, FormulasOfTheSpec) {
   for (const ContactParams& p : {table1_params(), object_params("big_resin_block")}) {
@@ -247,7 +247,7 @@ TEST(ContactQuantities, FormulasOfTheSpec) {
         EXPECT_GT(m.g(f_n, c), 0.0);
         EXPECT_EQ(m.g(f_n, c), m.g(f_n, -c));
       }
-      // dg/d|c| = mu f_n F(a) (MODEL.md 3.2) with c = c~ rho.
+      // dg/d|c| = mu f_n F(a) (docs/model.md 3.2) with c = c~ rho.
       const double a = 0.8, h = 1e-5;
       const double dg = (m.g(f_n, a + h) - m.g(f_n, a - h)) / (2 * h * rho);
       EXPECT_NEAR(dg, p.mu * f_n * m.limit_surface().F(a), 1e-5 * p.mu * f_n);
@@ -256,7 +256,7 @@ TEST(ContactQuantities, FormulasOfTheSpec) {
 }
 
 TEST(ContactQuantities, MagnitudeTableOfSpecSection6) {
-  // MODEL.md 6 (delta = 0.0018, gamma = 0.254), printed to 3-4 significant digits. Tolerance
+  // docs/model.md 6 (delta = 0.0018, gamma = 0.254), printed to 3-4 significant digits. Tolerance
   // 4e-3 relative: two entries are rounded up in their last digit in the spec (sigma_1(0.2 N,
   // 0) = 1.5749e-2 printed 1.58e-2; g(5 N, 1.5) for mu = 0.85 = 18.165 printed 18.17); a
   // wrong exponent or factor in any formula is far outside.
@@ -288,12 +288,12 @@ TEST(ContactQuantities, MagnitudeTableOfSpecSection6) {
     EXPECT_NEAR(m.sigma_1(r.f_n, 1.5), r.s1_15, rel * r.s1_15);
     EXPECT_NEAR(m.g(r.f_n, 0.0), m.tau_max(r.f_n), 1e-14 * m.tau_max(r.f_n));  // pure rotation: g = tau_max
   }
-  // K at f_n = 5 N: 130 s/rad with Table 1, 0.18 s/rad for the big resin block (MODEL.md 5.1).
+  // K at f_n = 5 N: 130 s/rad with Table 1, 0.18 s/rad for the big resin block (docs/model.md 5.1).
   EXPECT_NEAR(model_for(table1_params()).viscous_ratio(5.0), 130.0, 1.0);
   EXPECT_NEAR(model_for(object_params("big_resin_block")).viscous_ratio(5.0), 0.18, 0.005);
 }
 
-// ------------------------------------------------------------- sigma inversion (MODEL.md 5.2) ----
+// ------------------------------------------------------------- sigma inversion (docs/model.md 5.2) ----
 
 TEST(SigmaInversion, AppendixAValues) {
   const ContactModel& m = model_for(table1_params());
@@ -330,7 +330,7 @@ TEST(SigmaInversion, RoundTripOverTheWholeRange) {
 }
 
 TEST(SigmaInversion, SolveOutsideRoundTrip) {
-  // Sliding state = LS point plus a non-negative multiple of (2 xi a, 1) (MODEL.md 5.1).
+  // Sliding state = LS point plus a non-negative multiple of (2 xi a, 1) (docs/model.md 5.1).
   const ContactModel& m = model_for(table1_params());
   const LimitSurface& ls = m.limit_surface();
   const double xi = m.xi();
@@ -401,7 +401,7 @@ TEST(CorEstimator, InsideBeyondClipSaturates) {
 
 TEST(CorEstimator, OutsideRoundTripWithViscousExcess) {
   // Eqs. 9-10 with omega != 0: the estimator returns the CoR of the motion, flags it outside,
-  // and the quasi-static speed |omega| = 2 xi (t - T(a)) / K is recovered (MODEL.md 5.4).
+  // and the quasi-static speed |omega| = 2 xi (t - T(a)) / K is recovered (docs/model.md 5.4).
   for (const ContactParams& p : {table1_params(), object_params("big_resin_block"), with_cmax(3.0, 2.0)}) {
     const ContactModel& m = model_for(p);
     CorEstimator est(m);
@@ -533,7 +533,7 @@ TEST(CorEstimator, OutputFieldsAreConsistent) {
         EXPECT_NEAR(o.g, m.g(f_n, o.c_tilde), 1e-13 * o.g);
         EXPECT_NEAR(o.sigma_1, m.sigma_1(f_n, o.c_tilde), 1e-13 * o.sigma_1);
         EXPECT_NEAR(o.c_tilde, c, 1e-7);
-        // Static utilization |tau - c f_t| / g: < 1 inside, > 1 outside, 1 on the LS (MODEL.md 6).
+        // Static utilization |tau - c f_t| / g: < 1 inside, > 1 outside, 1 on the LS (docs/model.md 6).
         EXPECT_NEAR(std::fabs(o.y) / o.g, util, 1e-7);
       }
     }
@@ -578,7 +578,7 @@ TEST(CorEstimator, RhoGSigma1AreBitIdenticalToTheModelFunctions) {
   }
 }
 
-// ------------------------------------------------------------ degenerate cases (MODEL.md 5.5) ----
+// ------------------------------------------------------------ degenerate cases (docs/model.md 5.5) ----
 
 TEST(CorEstimator, DegenerateCases) {
   const ContactModel& m = model_for(table1_params());
@@ -671,7 +671,7 @@ TEST(CorEstimator, InvalidAndNoContactSamplesHoldThePreviousEstimate) {
   EXPECT_EQ(o.c_tilde, 0.0);
 }
 
-// ------------------------------------------------------------ saturation (MODEL.md 5.6) ----
+// ------------------------------------------------------------ saturation (docs/model.md 5.6) ----
 
 TEST(CorEstimator, SaturationAtCustomCmax) {
   for (double c_max : {0.5, 1.0, 3.0, 10.0, 100.0}) {
@@ -692,7 +692,7 @@ TEST(CorEstimator, SaturationAtCustomCmax) {
 
 TEST(CorEstimator, TranslationalSlipThreshold) {
   // With |c~| clipped at c_max, a pure translational load reaches S_static = |y|/g = 1 at
-  // f_t/(mu f_n) = F(c_max) + xi T(c_max)/c_max (MODEL.md 5.6): 1.0518 for c_max = 1.5.
+  // f_t/(mu f_n) = F(c_max) + xi T(c_max)/c_max (docs/model.md 5.6): 1.0518 for c_max = 1.5.
   const std::vector<std::pair<double, double>> table = {{1.0, 1.120}, {1.5, 1.052}, {2.0, 1.029},
                                                         {5.0, 1.0046}, {10.0, 1.0011}, {20.0, 1.0003}};
   for (const auto& [c_max, printed] : table) {

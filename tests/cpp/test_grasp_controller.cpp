@@ -1,4 +1,4 @@
-// Grasp-force controller (MODEL.md 9) and static grasp force (MODEL.md 6, 10.2, Appendix A).
+// Grasp-force controller (docs/model.md 9) and static grasp force (docs/model.md 6, 10.2, Appendix A).
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -153,7 +153,7 @@ TEST(ControllerSettings, RunTimeChangesKeepFixedFields) {
   EXPECT_THROW(c.set_settings(s), std::invalid_argument);
 }
 
-// --- C_d discretisation (MODEL.md 9.2) ------------------------------------------------------------
+// --- C_d discretisation (docs/model.md 9.2) ------------------------------------------------------------
 
 TEST(ControllerDynamicPart, TustinCoefficientsMatchTheSpecTable) {
   const LagFilter f500(10, 250, 7, 1.0 / 500);
@@ -349,7 +349,7 @@ TEST(ControllerDynamicPart, DisabledAndReenabledFromRest) {
   EXPECT_NEAR(out.dynamic_sample[0], 12.413108, 1e-5);  // first sample of a zero-state filter
 }
 
-// --- static part: PI (MODEL.md 9.4-9.5) ----------------------------------------------------------
+// --- static part: PI (docs/model.md 9.4-9.5) ----------------------------------------------------------
 
 TEST(ControllerStaticPart, SAboveTheReferenceRaisesTheForceAndBelowLowersIt) {
   const double T = 0.02;
@@ -384,7 +384,7 @@ TEST(ControllerStaticPart, ProportionalStepHasTheRightSign) {
 }
 
 TEST(ControllerStaticPart, NoLoadDecaysToTheFloorInAQuarterSecond) {
-  // MODEL.md 9.5: from 2 N with S = 0 the integrator drains at k_i S_ref = 8 N/s.
+  // docs/model.md 9.5: from 2 N with S = 0 the integrator drains at k_i S_ref = 8 N/s.
   GraspController c(can(), paper_law());
   c.reset(2.0);
   GraspControllerOutput out;
@@ -486,7 +486,7 @@ TEST(ControllerMultiRate, CommandChangesOnlyEveryTenthCall) {
   }
 }
 
-// --- two fingers (MODEL.md 9.8) -------------------------------------------------------------------
+// --- two fingers (docs/model.md 9.8) -------------------------------------------------------------------
 
 TEST(ControllerTwoFingers, MaxOfSMaxOfDynamicPartMeanOfCoR) {
   GraspControllerSettings s = paper_law();
@@ -640,7 +640,7 @@ TEST(ControllerBadInput, RandomAdversarialInputsKeepTheCommandFiniteAndInRange) 
   }
 }
 
-// --- pivoting (MODEL.md 9.6) ----------------------------------------------------------------------
+// --- pivoting (docs/model.md 9.6) ----------------------------------------------------------------------
 
 TEST(ControllerPivoting, NoDynamicPartExponentialDecayNoJump) {
   GraspControllerSettings s = paper_law();
@@ -783,7 +783,7 @@ TEST(ControllerPivoting, InvalidInputHoldsInsteadOfDecaying) {
   EXPECT_EQ(out.force, f);
 }
 
-// --- static grasp force (MODEL.md 6, 10.2, Appendix A) --------------------------------------------
+// --- static grasp force (docs/model.md 6, 10.2, Appendix A) --------------------------------------------
 
 TEST(ControllerStaticGraspForce, ReferenceValues) {
   StaticForceSolver can_solver(can());

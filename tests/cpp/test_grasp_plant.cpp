@@ -1,4 +1,4 @@
-// Grasp simulator: distributed contact vs the limit surface (MODEL.md 3, 5.1), object dynamics
+// Grasp simulator: distributed contact vs the limit surface (docs/model.md 3, 5.1), object dynamics
 // (hold, slip, fall, pendulum), actuator ZOH/lag, sensor noise, determinism, robustness.
 #include <gtest/gtest.h>
 
@@ -103,7 +103,7 @@ TEST(PatchContact, PureRotationGivesTauMaxExactly) {
 
 TEST(PatchContact, ReproducesTheLimitSurfaceWithinOnePercent) {
   // Steady sliding about c~: the cell sum of saturated bristles is a quadrature of the LS
-  // integrals (MODEL.md 3.1). Compared with LimitSurface(k = 4) for CoRs along several directions
+  // integrals (docs/model.md 3.1). Compared with LimitSurface(k = 4) for CoRs along several directions
   // of the pad (the grid is not rotation invariant) and both signs of omega.
   ContactParams p = resin();
   p.beta_a = 0.0;
@@ -115,15 +115,15 @@ TEST(PatchContact, ReproducesTheLimitSurfaceWithinOnePercent) {
       for (double omega : {2.0, -2.0}) {
         PatchContact pc(p, PatchSettings());
         const Normalised r = steady_rotation(pc, p, f_n, ct, omega, dir);
-        // MODEL.md 3.1 / eqs. 5-6: f_t = -sign(omega) f~*(c~) f_tmax, tau = -sign(omega) tau~* tau_max
+        // docs/model.md 3.1 / eqs. 5-6: f_t = -sign(omega) f~*(c~) f_tmax, tau = -sign(omega) tau~* tau_max
         const double sgn = omega > 0 ? 1.0 : -1.0;
         const double c_signed = r.c_tilde >= 0.0 ? ct : -ct;
         const double ft_ls = -sgn * ls.ft_star(c_signed);
         const double tau_ls = -sgn * ls.tau_star(c_signed);
         EXPECT_NEAR(std::fabs(r.c_tilde), ct, 1e-4);  // the force is ~normal to the CoR direction
         if (ct > 0.0) {
-          EXPECT_GT(ft_ls, 0.0);  // friction frame: f_t >= 0 (MODEL.md 1.2)
-          EXPECT_EQ(r.c_tilde > 0, omega > 0);  // sign(c) = sign(omega) (MODEL.md 1.3)
+          EXPECT_GT(ft_ls, 0.0);  // friction frame: f_t >= 0 (docs/model.md 1.2)
+          EXPECT_EQ(r.c_tilde > 0, omega > 0);  // sign(c) = sign(omega) (docs/model.md 1.3)
         }
         const double err = std::hypot(r.ft - ft_ls, r.tau - tau_ls) / std::hypot(ft_ls, tau_ls);
         worst = std::max(worst, err);
@@ -394,7 +394,7 @@ TEST(GraspPlant, SteadyTorsionalSlidingMatchesViscousExtension) {
   EXPECT_NEAR(plant.sensor_sample(0).omega, omega, 0.01 * omega);
   EXPECT_NEAR(plant.sensor_sample(1).omega, -omega, 0.01 * omega);
   EXPECT_NEAR(plant.sensor_sample(0).c_tilde, 0.0, 1e-3);
-  // the sensors read the friction torque with the sign of their slip rate (MODEL.md 7.2)
+  // the sensors read the friction torque with the sign of their slip rate (docs/model.md 7.2)
   EXPECT_NEAR(plant.sensor_sample(0).true_tau, tau_e / 2.0, 1e-3 * tau_e);
   EXPECT_NEAR(plant.sensor_sample(1).true_tau, -tau_e / 2.0, 1e-3 * tau_e);
 }
@@ -653,7 +653,7 @@ TEST(GraspPlant, EnergyNeverIncreasesWithoutInput) {
 }
 
 // ---------------------------------------------------------------------------------------------
-// Lumped plant (MODEL.md 10.1 (a))
+// Lumped plant (docs/model.md 10.1 (a))
 
 TEST(GraspPlantLumped, TorsionalThresholdMatchesThePatchPlant) {
   // Pure external torque, no gravity: both plants start rotating above 2 tau_max.

@@ -1,4 +1,4 @@
-// Identification cost (MODEL.md 8.1, eqs. 32-33): the cost runs the online Observer, the gradient
+// Identification cost (docs/model.md 8.1, eqs. 32-33): the cost runs the online Observer, the gradient
 // is the exact derivative of that discretisation (checked against central differences of the
 // cost itself), the Gauss-Newton matrix against finite-difference Jacobians of omega_hat,
 // segments restart the observer, threads do not change a bit, bad input is named.
@@ -308,7 +308,7 @@ TEST(Identification, InvalidAndNoContactSamplesInsideASegment) {
 
 TEST(Identification, CostIsSmallestNearTheTruth) {
   // A fast observer (bandwidth 3000/s): with a slow one the stick parameters sigma0, sigma_z
-  // absorb its lag and the minimum moves away from the plant's values (MODEL.md 8.2).
+  // absorb its lag and the minimum moves away from the plant's values (docs/model.md 8.2).
   const ContactParams p = table1_params();
   IdentificationSettings s;
   s.observer.bandwidth = 3000.0;

@@ -1,4 +1,4 @@
-// Limit surface: reference values (MODEL.md 2.3, 3.2, 3.4, the independent quadrature in
+// Limit surface: reference values (docs/model.md 2.3, 3.2, 3.4, the independent quadrature in
 // tests/reference/ls_reference.csv), symmetries, limits, monotonicity, maximum dissipation.
 #include <gtest/gtest.h>
 
@@ -90,7 +90,7 @@ std::vector<double> dense_grid(double a_max = 1000.0) {
 
 }  // namespace
 
-// ---------------------------------------------------------------- xi(k) (MODEL.md 2.3) ----
+// ---------------------------------------------------------------- xi(k) (docs/model.md 2.3) ----
 
 TEST(ShapeFactor, MatchesSpecTable) {
   const std::vector<std::pair<double, double>> table = {
@@ -113,7 +113,7 @@ TEST(ShapeFactor, GammaClosedFormAndLimits) {
     prev = shape_factor(k);
   }
   EXPECT_NEAR(shape_factor(1e6), 2.0 / 3.0, 1e-6);
-  // The paper's xi = 0.6354 corresponds to k = 3.9991 (MODEL.md 2.3).
+  // The paper's xi = 0.6354 corresponds to k = 3.9991 (docs/model.md 2.3).
   // (k quoted to 4 decimals: dxi/dk = 0.011, so +-5e-5 in k is +-6e-7 in xi.)
   EXPECT_NEAR(shape_factor(3.9991), 0.6354, 6e-7);
   EXPECT_EQ(surface(4.0).xi(), shape_factor(4.0));
@@ -132,7 +132,7 @@ TEST(ShapeFactor, RejectsInvalidK) {
   EXPECT_NO_THROW(LimitSurface{kInf});
 }
 
-// ------------------------------------------------- reference values (MODEL.md 3.2, 3.4) ----
+// ------------------------------------------------- reference values (docs/model.md 3.2, 3.4) ----
 
 struct SpecRow {
   double c, ft, tau, G, sigma;
@@ -186,7 +186,7 @@ TEST(LimitSurfaceReference, ExtraCheckValuesK2K8) {
     EXPECT_NEAR(-q.F, r.ft, 1e-9);
     EXPECT_NEAR(q.T, r.tau, 1e-9);
   }
-  // Weak dependence on k at c~ = 1 (paper, MODEL.md 3.2).
+  // Weak dependence on k at c~ = 1 (paper, docs/model.md 3.2).
   EXPECT_NEAR(surface(2.0).F(1.0), 0.8836, 5e-5);
   EXPECT_NEAR(surface(2.0).T(1.0), 0.3750, 5e-5);
   EXPECT_NEAR(surface(4.0).F(1.0), 0.8641, 5e-5);
@@ -253,7 +253,7 @@ TEST(LimitSurfaceReference, IndependentQuadratureEveryK) {
   for (double k : ks) check_reference(k, 1e-6, 1e-6);
 }
 
-// ----------------------------------------------------- parity and signs (MODEL.md 3.2) ----
+// ----------------------------------------------------- parity and signs (docs/model.md 3.2) ----
 
 TEST(LimitSurfaceProperties, ParityAndSigns) {
   for (double k : kAllK) {
@@ -283,7 +283,7 @@ TEST(LimitSurfaceProperties, ParityAndSigns) {
   }
 }
 
-// ---------------------------------------------------------- limits (MODEL.md 3.2) ----
+// ---------------------------------------------------------- limits (docs/model.md 3.2) ----
 
 TEST(LimitSurfaceProperties, AsymptoticConstants) {
   // Appendix A, k = 4.
@@ -331,7 +331,7 @@ TEST(LimitSurfaceProperties, SmallCorLimit) {
 
 TEST(LimitSurfaceProperties, LargeCorLimit) {
   // F ~ 1 - A_f / c~^2, T ~ A_tau / c~ as c~ -> inf; at c~ = 10: (0.998856, 0.036013) vs exact
-  // (0.998855, 0.036041) (MODEL.md 3.2).
+  // (0.998855, 0.036041) (docs/model.md 3.2).
   for (double k : kAllK) {
     const LimitSurface& ls = surface(k);
     for (double a : {200.0, 1e3, 1e4, 1e6}) {  // absolute, at the accuracy target
@@ -360,7 +360,7 @@ TEST(LimitSurfaceProperties, LargeCorLimit) {
   EXPECT_NEAR(surface(4.0).tail_torque() / 10.0, 0.036013, 1e-6);
 }
 
-// ------------------------------------------------------------ monotonicity (MODEL.md 3.2, 5.2) ----
+// ------------------------------------------------------------ monotonicity (docs/model.md 3.2, 5.2) ----
 
 TEST(LimitSurfaceProperties, MonotoneCurvesAndSigma) {
   const std::vector<double> grid = dense_grid();
@@ -397,7 +397,7 @@ TEST(LimitSurfaceProperties, ConvexCurve) {
   }
 }
 
-// --------------------------------------------------------------- derivatives (MODEL.md 3.2) ----
+// --------------------------------------------------------------- derivatives (docs/model.md 3.2) ----
 
 TEST(LimitSurfaceProperties, MaximumDissipationFromValues) {
   // dT/da = -(a/xi) dF/da, checked with central differences of accurately integrated values
@@ -436,7 +436,7 @@ TEST(LimitSurfaceProperties, TableDerivativesMatchFiniteDifferences) {
 }
 
 TEST(LimitSurfaceProperties, TorqueCapacityDerivativeIsF) {
-  // G(a) = xi T + a F: G(0) = xi, G'(a) = F(a) (MODEL.md 3.2), hence dg/d|c| >= 0.
+  // G(a) = xi T + a F: G(0) = xi, G'(a) = F(a) (docs/model.md 3.2), hence dg/d|c| >= 0.
   for (double k : kSmoothK) {
     const LimitSurface& ls = surface(k);
     EXPECT_DOUBLE_EQ(ls.G(0.0), ls.xi());

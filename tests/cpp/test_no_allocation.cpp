@@ -1,5 +1,5 @@
 // The real-time path never allocates: global operator new/delete are replaced by counting
-// versions, and the count is taken only around the calls under test (STYLE.md 3 and 8).
+// versions, and the count is taken only around the calls under test.
 #include <gtest/gtest.h>
 
 #include <atomic>

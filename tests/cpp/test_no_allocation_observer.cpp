@@ -1,4 +1,4 @@
-// Observer::step, SliderModel::step and reset never allocate (STYLE.md 3 and 8): this binary
+// Observer::step, SliderModel::step and reset never allocate: this binary
 // replaces the global allocation functions with counting ones and counts only inside a window
 // around the real-time calls.
 #include <gtest/gtest.h>

@@ -212,7 +212,7 @@ TEST(Observer, ImplicitSchemeIsSecondsLateWithWeakViscousFriction) {
 
 TEST(Observer, StickConstantLoadInsideTheLimitSurface) {
   // Constant load inside the LS: omega_hat -> 0, sigma0 z_hat -> y and S -> S_static = |y|/g,
-  // which equals (xi |tau~| + a f~_t) / (xi T(a) + a F(a)) computed from the wrench (MODEL.md 6).
+  // which equals (xi |tau~| + a f~_t) / (xi T(a) + a F(a)) computed from the wrench (docs/model.md 6).
   for (const char* object : {"table1", "big_resin_block"}) {
     const ContactParams p = std::string(object) == "table1" ? table1_params() : object_params(object);
     const ContactModel m(p);
@@ -283,7 +283,7 @@ TEST(Observer, SignOfOmegaHatFollowsGroundTruth) {
       EXPECT_NEAR(out.omega_hat, omega, 0.03 * std::fabs(omega));  // quadrature vs LS tables
       EXPECT_NEAR(std::fabs(out.c_tilde), 0.7, 0.02);
       EXPECT_NEAR(out.S, 1.0, 1e-9);
-      // The opposite wrench (fingertip on object) gives -omega_hat with the same S (MODEL.md 7.2).
+      // The opposite wrench (fingertip on object) gives -omega_hat with the same S (docs/model.md 7.2).
       Observer flipped(p);
       ObserverOutput o2;
       for (int i = 0; i < 1000; ++i) flipped.step(ObserverInput::from_force_vector(f_n, -w.fx, -w.fy, -w.tau, kDt), o2);
@@ -384,7 +384,7 @@ TEST(Observer, BeyondTheClipOmegaObjectOnAnIndependentPatchPlant) {
 // ---------------------------------------------------------------------------------------------
 
 TEST(Observer, OneStepRk4DivergesAtLowNormalForceWhileStableSchemesTrack) {
-  // MODEL.md 7.4: RK4 one step per sample needs h sigma0 |omega| / g <= 2.785. Regime (Table 1,
+  // docs/model.md 7.4: RK4 one step per sample needs h sigma0 |omega| / g <= 2.785. Regime (Table 1,
   // c~ = 0.3, fixed l = 200, 500 Hz): slip onset from 0.5 g to steady sliding at w0 within 0.2 s,
   //   f_n = 0.2 N, w0 = 0.02 rad/s  (h sigma0 w0 / g = 8.7)
   //   f_n = 1.0 N, w0 = 0.2 rad/s   (h sigma0 w0 / g = 11.5)

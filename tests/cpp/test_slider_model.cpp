@@ -107,7 +107,7 @@ TEST(SliderModel, SchemesAgreeOnALoadRamp) {
 
 TEST(SliderModel, ProjectionLetsTheObjectSlipWhenTheGripOpens) {
   // Stick at 0.8 g with 5 N, then the normal force drops to 1 N: the old deflection exceeds the
-  // new capacity. With the projection (MODEL.md 7.1) |sigma0 z| <= g after every step, the
+  // new capacity. With the projection (docs/model.md 7.1) |sigma0 z| <= g after every step, the
   // friction cannot exceed the new capacity and the object starts sliding.
   const ContactParams p = table1_params();
   SliderModel sim(p, 1e-4);
@@ -208,7 +208,7 @@ TEST(RotorStep, EquilibriaAreFixedPointsOfTheStableSchemes) {
 }
 
 TEST(RotorStep, Rk4StabilityLimitOfTheLinearMode) {
-  // MODEL.md 7.4: in stick the fast mode is lambda_1 ~ -l (sigma_z + sigma_1); one RK4 step per
+  // docs/model.md 7.4: in stick the fast mode is lambda_1 ~ -l (sigma_z + sigma_1); one RK4 step per
   // sample is stable only for h |lambda| <= 2.785. The scheme-independent check: above the limit
   // a perturbation grows with Rk4 and decays with Rk4Adaptive, Rosenbrock and Implicit.
   RotorCoefficients c;

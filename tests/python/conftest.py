@@ -70,7 +70,7 @@ def tau_max(p: lugrip.ContactParams, f_n):
 
 
 def viscous_ratio(p: lugrip.ContactParams, f_n):
-    """K = pi delta^3 beta_A f_n^(3 gamma - 1) / mu (MODEL.md 5.1)."""
+    """K = pi delta^3 beta_A f_n^(3 gamma - 1) / mu (docs/model.md 5.1)."""
     return math.pi * p.delta**3 * p.beta_a * np.asarray(f_n, float) ** (3 * p.gamma - 1) / p.mu
 
 

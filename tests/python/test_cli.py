@@ -90,8 +90,8 @@ def test_ls_stdout_table_matches_the_core_and_the_sign_convention(tmp_path, caps
             ls = lugrip.LimitSurface(k)
             assert f == pytest.approx(float(ls.ft_star(c)), abs=1e-8)
             assert t == pytest.approx(float(ls.tau_star(c)), abs=1e-8)
-    assert rows[1.0][0] == pytest.approx(-0.8640993375, abs=1e-8)  # MODEL.md 3.4
-    assert rows[0.5][2] == pytest.approx(-0.5522330836, abs=1e-8)  # k = 2, MODEL.md 3.2
+    assert rows[1.0][0] == pytest.approx(-0.8640993375, abs=1e-8)  # docs/model.md 3.4
+    assert rows[0.5][2] == pytest.approx(-0.5522330836, abs=1e-8)  # k = 2, docs/model.md 3.2
     assert rows[-1.0][0] == -rows[1.0][0] and rows[-1.0][1] == rows[1.0][1]
     assert not list(tmp_path.iterdir())
 

@@ -86,7 +86,7 @@ def test_deterministic_for_a_seed_and_noise_changes_with_it():
 )
 def test_steady_force_matches_static_grasp_force(contact, mass, cog):
     """After the lift the PI holds S = 0.8, where the command equals static_grasp_force of the
-    measured-true per-finger load within a few percent (MODEL.md 9.4)."""
+    measured-true per-finger load within a few percent (docs/model.md 9.4)."""
     r = run_closed_loop(plant(mass, cog, contact), {}, OBS, None, 10.0)
     w = r.window(7.0, 10.0)
     ft = 0.5 * (r.f_t_true_0[w] + r.f_t_true_1[w]).mean()
@@ -191,7 +191,7 @@ def test_property_command_finite_in_limits(
     mass, cog_x, cog_y, f_min, gs, contact, kind, push, pivot
 ):
     """Any object, load and setting: every value finite, the command in [f_min, f_max], S in
-    [0, 1] (MODEL.md 10.3 criterion 6)."""
+    [0, 1] (docs/model.md 10.3 criterion 6)."""
     d = plant(
         mass,
         (cog_x, cog_y),

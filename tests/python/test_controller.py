@@ -1,4 +1,4 @@
-"""Grasp-force controller and static grasp force through the Python API (MODEL.md 6, 9, 10.2)."""
+"""Grasp-force controller and static grasp force through the Python API (docs/model.md 6, 9, 10.2)."""
 
 from __future__ import annotations
 
@@ -24,7 +24,7 @@ T_CMD = 10 * T_SENSOR
 # --- C_d discretisation -------------------------------------------------------------------------
 
 def test_cd_coefficients_match_scipy_bilinear_and_the_spec_table():
-    """Tustin coefficients equal scipy's bilinear transform and the MODEL.md 9.2 table."""
+    """Tustin coefficients equal scipy's bilinear transform and the docs/model.md 9.2 table."""
     b0, b1, a1 = GraspController(CAN).dynamic_filter_coefficients
     num, den = signal.bilinear([10.0, 2500.0], [1.0, 7.0], fs=500.0)
     np.testing.assert_allclose([b0, b1], num / den[0], rtol=1e-13)
@@ -241,7 +241,7 @@ def test_pivoting_decay_floor_end_and_bumpless_return():
 # --- static grasp force -------------------------------------------------------------------------
 
 def test_static_grasp_force_reference_values():
-    """MODEL.md Appendix A and 10.2."""
+    """docs/model.md Appendix A and 10.2."""
     f = lugrip.static_grasp_force(CAN, [0.12, 2.0, 2.0, 4.0], [0.0, 3e-3, 6e-3, 6e-3])
     np.testing.assert_allclose(f, [0.190, 4.75, 6.66, 8.90], atol=0.005)
     wide = CAN.replace(c_max=1000.0)

@@ -92,7 +92,7 @@ def test_status_enum_matches_core():
 @pytest.mark.parametrize("k", [4.0, 2.0, math.inf], ids=lambda k: f"k={k:g}")
 def test_inside_round_trip(k, table1, lsk):
     """A wrench on the LS at f_n0, evaluated at a larger f_n, gives the same c~ and inside;
-    slightly below f_n0 it is outside (MODEL.md 5.2-5.3)."""
+    slightly below f_n0 it is outside (docs/model.md 5.2-5.3)."""
     p = table1.replace(k=k)
     ls = lsk(k)
     a = np.array([0.01, 0.1, 0.3, 0.5, 0.9, 1.0, 1.1, 1.45])
@@ -112,7 +112,7 @@ def test_inside_round_trip(k, table1, lsk):
 @pytest.mark.parametrize("preset", ["table1", "big_resin_block", "aluminium_can"])
 def test_outside_round_trip_with_viscous_excess(preset, lsk, phys):
     """Eqs. 9-10 with omega != 0 (K from the parameters): c~ comes back, flagged outside, for
-    both signs of omega and of f_t; |omega| = 2 xi (t - T(a)) / K is recovered (MODEL.md 5.4)."""
+    both signs of omega and of f_t; |omega| = 2 xi (t - T(a)) / K is recovered (docs/model.md 5.4)."""
     p = lugrip.ContactParams.preset(preset)
     ls = lsk(p.k)
     xi = ls.xi
@@ -236,7 +236,7 @@ def test_step_by_step_equals_batch_exactly(table1):
 
 
 def oracle(p, ls, f_n, f_t, tau, zero=1e-4):
-    """Slow independent CoR estimate (MODEL.md 5.7) with brentq on LimitSurface values."""
+    """Slow independent CoR estimate (docs/model.md 5.7) with brentq on LimitSurface values."""
     xi = ls.xi
     ft_n = f_t / (p.mu * f_n)
     tau_n = tau / (p.mu * xi * p.delta * f_n ** (p.gamma + 1))
@@ -295,7 +295,7 @@ def test_vectorized_contact_quantities(table1, lsk):
     np.testing.assert_allclose(ft_n, np.array([0.5, 1.0, 2.0, 3.0]) / (p.mu * f_n), rtol=1e-15)
     np.testing.assert_allclose(tau_n, np.broadcast_to(1e-3 / (p.mu * p.xi * rho * f_n), (3, 4)), rtol=1e-13)
     assert np.ndim(lugrip.g(p, 5.0, 0.3)) == 0
-    # Magnitudes of MODEL.md 6 at f_n = 5 N, Table 1: rho 2.709 mm, tau_max = g(0) 4.045 N mm.
+    # Magnitudes of docs/model.md 6 at f_n = 5 N, Table 1: rho 2.709 mm, tau_max = g(0) 4.045 N mm.
     assert lugrip.contact_radius(p, 5.0) * 1e3 == pytest.approx(2.709, abs=5e-4)
     assert lugrip.g(p, 5.0, 0.0) * 1e3 == pytest.approx(4.045, abs=5e-4)
     assert lugrip.g(p, 5.0, 1.5) * 1e3 == pytest.approx(10.04, abs=5e-3)

@@ -1,4 +1,4 @@
-"""Identification (lugrip.identify, paper Section 4, MODEL.md 8) and the rubbing estimate
+"""Identification (lugrip.identify, paper Section 4, docs/model.md 8) and the rubbing estimate
 (lugrip.estimate_rubbing, paper Section 6): round trips on synthetic logs with known
 parameters from perturbed starts, the online observer inside the cost, object refit, rubbing on
 an independent distributed-contact model, gaps, robust loss, identifiability checks, bad logs,
@@ -126,7 +126,7 @@ def test_beta_delta_combination_is_reported(table1_fit):
 
 def test_slow_observer_fit_absorbs_its_lag_and_beats_the_true_parameters(table1_log):
     """With a slow observer (B = 100/s, the former default) the stick parameters absorb the
-    observer's lag behind slip ramps (MODEL.md 8.2): eq. 32 identifies the parameters that make
+    observer's lag behind slip ramps (docs/model.md 8.2): eq. 32 identifies the parameters that make
     THAT observer best (better for it than the plant's own values; sigma0 well off), which is
     why the default bandwidth is fast and why the result records the observer it was fitted
     with."""

@@ -12,7 +12,7 @@ import lugrip
 
 REF_KS = (1.5, 2.0, 3.0, 4.0, 6.0, 8.0, math.inf)
 
-# MODEL.md 3.4 (k = 4): c~, f~*, tau~*, G, sigma_LS (gamma = 0.254)
+# docs/model.md 3.4 (k = 4): c~, f~*, tau~*, G, sigma_LS (gamma = 0.254)
 SPEC_TABLE = np.array([
     [0.0, 0.0, 1.0, 0.63540981, 0.0],
     [0.1, -0.1059068333, 0.9916725251, 0.64070914, 0.060379],
@@ -57,7 +57,7 @@ def test_reference_includes_the_rim_and_the_tail(ls_reference):
 
 
 def test_spec_table_k4(lsk):
-    """MODEL.md 3.4 values (10 decimals) within the 1e-6 accuracy target; integrate() to 1e-9."""
+    """docs/model.md 3.4 values (10 decimals) within the 1e-6 accuracy target; integrate() to 1e-9."""
     ls = lsk(4.0)
     c, ft, tau, G, sig = SPEC_TABLE.T
     np.testing.assert_allclose(ls.ft_star(c), ft, atol=1e-6, rtol=0)
@@ -81,7 +81,7 @@ def test_hertz_closed_form(lsk):
 
 
 def test_shape_factor():
-    """xi(k) table of MODEL.md 2.3 and Appendix A."""
+    """xi(k) table of docs/model.md 2.3 and Appendix A."""
     table = {2: 0.58904862, 3: 0.62024501, 4: 0.63540981, 6: 0.64951905, 8: 0.65578547,
              10: 0.65913446, 20: 0.66442651, 100: 0.66656163, math.inf: 2 / 3}
     for k, xi in table.items():

@@ -310,7 +310,7 @@ def test_slip_onset_follows_the_plant():
 
 
 # ---------------------------------------------------------------------------------------------
-# accuracy on synthetic maneuvers (issue 3 acceptance, reduced size)
+# accuracy on synthetic maneuvers (the observer report's figures, reduced size)
 # ---------------------------------------------------------------------------------------------
 
 
@@ -333,7 +333,7 @@ def test_table1_rmse_below_the_paper():
 
 def test_bandwidth_gain_beats_fixed_gain_with_weak_viscous_friction():
     """Table 2 object: l = B / sigma_1 tracks the slip much better than the fixed l = 200, which
-    needs ~1/(l sigma_1) ~ seconds (MODEL.md 7.4); S detects the slips either way."""
+    needs ~1/(l sigma_1) ~ seconds (docs/model.md 7.4); S detects the slips either way."""
     ms = maneuvers(CAN, 25, seed=2, f_range=(0.5, 10.0), peak_range=(1.05, 2.0))
     log = concat(ms)
     bw = Observer(CAN).run(log)

@@ -20,7 +20,7 @@ TABLE2 = {
     "aluminium_can": (0.75, 2.121e7),
 }
 
-# One bad value per field, with the rule of MODEL.md / params.hpp.
+# One bad value per field, with the rule of docs/model.md / params.hpp.
 BAD = {
     "mu": [0.0, -0.47, 10.5, math.nan, math.inf],
     "beta_a": [-1.0, math.nan, math.inf],

@@ -1,5 +1,5 @@
 """Grasp plant (lugrip.sim): the distributed contact against the limit surface and its viscous
-extension (MODEL.md 3, 5.1), configuration from dicts, batch runs (hold, slip, fall, pendulum,
+extension (docs/model.md 3, 5.1), configuration from dicts, batch runs (hold, slip, fall, pendulum,
 lift), actuator, sensor noise, determinism, the lumped plant."""
 
 from __future__ import annotations
@@ -62,7 +62,7 @@ def test_patch_reproduces_the_limit_surface_k4(c_tilde, direction):
 
 
 def test_patch_matches_the_exact_hertz_surface_k2_and_converges():
-    # k = 2, |c~| <= 1 has a closed form (MODEL.md 3.2) independent of the library's tables.
+    # k = 2, |c~| <= 1 has a closed form (docs/model.md 3.2) independent of the library's tables.
     c = np.array([0.15, 0.4, 0.7, 0.95])
     F_exact = 3 * math.pi / 8 * c * (1 - c**2 / 4)
     T_exact = 1 - c**2 + 3 / 8 * c**4
@@ -294,7 +294,7 @@ def test_no_nan_under_extreme_inputs():
 
 
 # ---------------------------------------------------------------------------------------------
-# lumped plant (MODEL.md 10.1 (a))
+# lumped plant (docs/model.md 10.1 (a))
 
 
 @pytest.mark.parametrize("model", ["patch", "lumped"])
@@ -333,7 +333,7 @@ def test_lumped_plant_has_no_translation_and_is_fast():
 @pytest.mark.parametrize("force, torque_ratio", [(1.0, 1.1), (3.0, 0.75), (5.0, 0.5), (2.0, -1.0)])
 def test_true_cor_agrees_with_the_cor_estimator_on_the_true_wrench(force, torque_ratio):
     # Steady combined sliding (no gravity, constant push and torque): the CoR of the relative motion
-    # (ground truth of the plant) and the CoR the estimator (MODEL.md 5.4, viscous LS) recovers from
+    # (ground truth of the plant) and the CoR the estimator (docs/model.md 5.4, viscous LS) recovers from
     # the true sensor wrench must agree, with the estimator's sign convention, on both fingers.
     f_n = 4.0
     cfg = config(
@@ -357,5 +357,5 @@ def test_true_cor_agrees_with_the_cor_estimator_on_the_true_wrench(force, torque
         est = lugrip.estimate_cor(RESIN, f_n, ft, f["true_tau"][-1])
         assert not est.inside  # sliding
         assert est.c_tilde == pytest.approx(f["c_tilde"][-1], rel=0.01, abs=2e-3)
-        assert np.sign(f["true_tau"][-1]) == np.sign(f["omega"][-1])  # MODEL.md 7.2
+        assert np.sign(f["true_tau"][-1]) == np.sign(f["omega"][-1])  # docs/model.md 7.2
     assert log.omega_0[-1] == -log.omega_1[-1]

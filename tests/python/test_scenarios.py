@@ -1,5 +1,5 @@
 """The paper's experiments as scenarios (scenarios/*.yaml): loading and validation, every
-scenario passing its criteria in the CI (--short) version with the baselines, the issue-5
+scenario passing its criteria in the CI (--short) version with the baselines, the
 acceptance comparisons (friction cone fails the rotational loads, the constant force needs more
 than lugrip's steady force, full can >= 10x empty can, pivot ends near vertical and avoidance
 resumes), metrics.json, figures and the ``lugrip simulate`` command."""
@@ -90,7 +90,7 @@ def cfg_preset(name: str) -> str:
 
 
 def test_loads_match_the_paper(results):
-    """The inferred masses reproduce the loads the paper reports (MODEL.md 10.2)."""
+    """The inferred masses reproduce the loads the paper reports (docs/model.md 10.2)."""
     m = {n: r.metrics["lugrip"] for n, r in results.items()}
     assert m["exp1_big_resin_block"]["steady_f_t"] == pytest.approx(3.43, abs=0.05)
     assert m["exp1_big_resin_block"]["steady_c_tilde"] == pytest.approx(1.5, abs=0.01)

@@ -1,5 +1,5 @@
 """Synthetic sliding maneuvers (lugrip.sliding): determinism, design coverage, physics of the
-plant and the sensor wrench, the issue-3 RMSE figure on a reduced set, slip-detection scoring on
+plant and the sensor wrench, the observer report's RMSE figure on a reduced set, slip-detection scoring on
 hand-built cases, the sign of omega_hat through files, and the one-step RK4 divergence regime."""
 
 from __future__ import annotations
@@ -27,7 +27,7 @@ DT = 0.002
 
 @pytest.fixture(scope="module")
 def table1_set():
-    """The reduced issue-3 set: 60 maneuvers, Table 1, default noise (~0.1 s to build)."""
+    """The reduced observer-report set: 60 maneuvers, Table 1, default noise (~0.1 s to build)."""
     return simulate_maneuvers(TABLE1, 60, seed=11)
 
 
@@ -106,7 +106,7 @@ def test_sliding_maneuvers_reach_the_target_speed_and_full_utilisation(clean_set
 
 def test_sensor_wrench_is_the_object_on_fingertip_wrench(clean_set):
     """Noise-free sensor: tau has the sign of omega while sliding (object on fingertip,
-    MODEL.md 7.2), f_t = |(f_x, f_y)| with a constant direction per maneuver, and the CoR
+    docs/model.md 7.2), f_t = |(f_x, f_y)| with a constant direction per maneuver, and the CoR
     estimate of the wrench recovers the designed |c~| (clipped at c_max) while sliding."""
     d = clean_set
     log = d.log
@@ -161,7 +161,7 @@ def test_bad_arguments_are_named(kwargs, match):
 
 
 # ---------------------------------------------------------------------------------------------
-# issue-3 acceptance on a reduced set
+# the observer report's acceptance figures on a reduced set
 # ---------------------------------------------------------------------------------------------
 
 
@@ -188,7 +188,7 @@ def test_table2_object_detects_slip_but_speed_is_poorly_observable():
     """Aluminium can (beta_A 230x smaller than Table 1): S still detects every slip that
     reaches 0.01 rad/s (within 0.3 s) without false alarms, while omega_hat is much worse
     relative to the motion than with Table 1 (speed only observable through viscous friction,
-    MODEL.md 6-7)."""
+    docs/model.md 6-7)."""
     d = simulate_maneuvers(CAN, 40, seed=12)
     _run, sc = lugrip.sliding.evaluate(d)
     assert sc.n_slide > 25
@@ -202,7 +202,7 @@ def test_table2_object_detects_slip_but_speed_is_poorly_observable():
 
 def test_one_step_rk4_diverges_where_the_default_scheme_does_not():
     """Steady sliding at f_n = 1 N, |c~| = 0.1, omega = 0.3 rad/s (Table 1): one RK4 step per
-    2 ms sample (the paper's scheme, l = 200) violates h sigma0 |omega| / g <= 2.785 (MODEL.md
+    2 ms sample (the paper's scheme, l = 200) violates h sigma0 |omega| / g <= 2.785 (docs/model.md
     7.4) and diverges (the observer's guard re-initialises it, the RMSE explodes); the default
     (Rosenbrock) tracks omega within 2 %."""
     d = simulate_maneuvers(

@@ -1,11 +1,11 @@
 #!/usr/bin/env python3
-"""Independent high-accuracy reference values of the normalized limit surface (MODEL.md 3).
+"""Independent high-accuracy reference values of the normalized limit surface (docs/model.md 3).
 
 Computes f~*_tLS(c~) and tau~*_LS(c~) for several pressure exponents k with SciPy, by a
 method that shares nothing with the C++ core (which integrates CoR-centred chords with
 Gauss-Jacobi rules built by its own Golub-Welsch solver):
 
-* disc-centred polar coordinates (MODEL.md 3.3, method B): outer r in [0, 1] with a break
+* disc-centred polar coordinates (docs/model.md 3.3, method B): outer r in [0, 1] with a break
   point at r = |c~|, inner theta over the full circle;
 * the inner theta integral is done in closed form with complete elliptic integrals. With
   d^2 = r^2 + c^2 - 2 r c cos(theta) and m = 4 r c / (r + c)^2,
@@ -20,8 +20,8 @@ Gauss-Jacobi rules built by its own Golub-Welsch solver):
   smooth factor ((1 - r^k)/(1 - r))^(1/k) left in the integrand.
 
 Self-checks run before anything is written (the script exits non-zero if one fails):
-the k = 2 closed form for |c~| <= 1, the MODEL.md 3.4 table (k = 4) and extra check values
-(k = 2, 8), the limits of MODEL.md 3.2, and a literal 2-D adaptive quadrature (nested QAGS
+the k = 2 closed form for |c~| <= 1, the docs/model.md 3.4 table (k = 4) and extra check values
+(k = 2, 8), the limits of docs/model.md 3.2, and a literal 2-D adaptive quadrature (nested QAGS
 in r and theta, no elliptic integrals) at a few points.
 
 Usage (from the repository root; about a minute on one core):
@@ -55,7 +55,7 @@ def beta(x: float, y: float) -> float:
 
 
 def norms(k: float) -> tuple[float, float]:
-    """P_k = int (1-|u|^k)^(1/k) dA, M_k = int (1-|u|^k)^(1/k) |u| dA (MODEL.md 2.2)."""
+    """P_k = int (1-|u|^k)^(1/k) dA, M_k = int (1-|u|^k)^(1/k) |u| dA (docs/model.md 2.2)."""
     if math.isinf(k):
         return math.pi, 2.0 * math.pi / 3.0
     return 2 * math.pi / k * beta(2 / k, 1 + 1 / k), 2 * math.pi / k * beta(3 / k, 1 + 1 / k)
@@ -163,7 +163,7 @@ def ls_point(c: float, k: float) -> tuple[float, float, float]:
 
 
 def ls_point_2d(c: float, k: float) -> tuple[float, float]:
-    """Literal MODEL.md 3.3 method B: nested adaptive quadrature of the boxed 2-D integrals
+    """Literal docs/model.md 3.3 method B: nested adaptive quadrature of the boxed 2-D integrals
     (outer r with a break at |c|, inner theta in [0, pi] doubled). Slow; cross-check only."""
     p_k, m_k = norms(k)
 
@@ -206,7 +206,7 @@ def self_check(verbose: bool = True) -> list[str]:
         f, t, _ = ls_point(c, 2.0)
         check(f"k=2 f*({c})", f, -3 * math.pi / 8 * c * (1 - c * c / 4), 1e-12)
         check(f"k=2 tau*({c})", t, 1 - c * c + 0.375 * c**4, 1e-12)
-    print("MODEL.md 3.4 table (k = 4) and extra check values:")
+    print("docs/model.md 3.4 table (k = 4) and extra check values:")
     table = {
         4.0: [(0.1, -0.1059068333, 0.9916725251), (0.25, -0.2626505930, 0.9485788612),
               (0.5, -0.5094317274, 0.8037455127), (0.75, -0.7203649578, 0.5978502942),
@@ -222,7 +222,7 @@ def self_check(verbose: bool = True) -> list[str]:
             f, t, _ = ls_point(c, k)
             check(f"k={k:g} f*({c})", f, f_ref, 6e-11)
             check(f"k={k:g} tau*({c})", t, t_ref, 6e-11)
-    print("Limits (MODEL.md 3.2): small-c~ slope, large-c~ tails, xi closed form:")
+    print("Limits (docs/model.md 3.2): small-c~ slope, large-c~ tails, xi closed form:")
     for k in (2.0, 4.0, 8.0, math.inf):
         p_k, m_k = norms(k)
         if not math.isinf(k):

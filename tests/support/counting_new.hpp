@@ -1,5 +1,5 @@
 // Replaces the global operator new/delete with versions that count every allocation, for the
-// "step() never allocates" tests and the benchmarks' allocation reports (STYLE.md 3 and 8).
+// "step() never allocates" tests and the benchmarks' allocation reports.
 // Include from exactly one translation unit of a binary; read g_allocations around the calls
 // under test.
 #pragma once

@@ -1,4 +1,4 @@
-// lugrip — the one implementation of the rotor integrators (MODEL.md 7.1 and 7.4), templated on
+// lugrip — the one implementation of the rotor integrators (docs/model.md 7.1 and 7.4), templated on
 // the scalar type. Instantiated with double by slider_model.cpp (rotor_step_*, rotor_advance: the
 // plant, the observer) and with the forward-mode dual numbers of identification.cpp, whose value
 // part repeats the double arithmetic operation for operation, so the identification's tangent
@@ -32,7 +32,7 @@ inline void rotor_rhs(const T& z, const T& w, const C& c, T& dz, T& dw) noexcept
   dw = c.gain * (c.drive - c.sigma0 * z - c.sigma_z * dz - c.sigma_1 * w);
 }
 
-//! Projection |z| <= g / sigma0 (MODEL.md 7.1); returns whether it was active.
+//! Projection |z| <= g / sigma0 (docs/model.md 7.1); returns whether it was active.
 template <class T, class C>
 inline bool rotor_project(T& z, const C& c) noexcept {
   const T bound = c.g / c.sigma0;

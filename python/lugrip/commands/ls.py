@@ -1,7 +1,7 @@
 """``lugrip ls``: the normalized limit surface (paper Figures 3 and 7) and a table of values.
 
 All values come from :class:`lugrip.LimitSurface` (the C++ tables); nothing is integrated here.
-Sign convention (MODEL.md 3.2): f~*_tLS(c~) is odd with the sign opposite to c~, tau~*_LS(c~)
+Sign convention (docs/model.md 3.2): f~*_tLS(c~) is odd with the sign opposite to c~, tau~*_LS(c~)
 is even and positive.
 """
 
@@ -55,7 +55,7 @@ def register(subparsers) -> None:
             "Draw the normalized limit surface of a soft circular contact for pressure "
             "exponents k (paper Figure 3: f~*_tLS(c~) and tau~*_LS(c~) vs the normalized CoR "
             "c~; Figure 7: the LS cross-section (f~*, tau~*) parametrized by c~) and print "
-            "f~* and tau~* per k with the shape factor xi(k). Sign convention (MODEL.md 3.2): "
+            "f~* and tau~* per k with the shape factor xi(k). Sign convention (docs/model.md 3.2): "
             "f~* is odd with the sign opposite to c~, tau~* is even and positive."),
         epilog=_EPILOG,
         formatter_class=argparse.RawDescriptionHelpFormatter,
@@ -95,7 +95,7 @@ class LsTable:
         """Fixed-width text table: c~, then f~* and tau~* per k, with xi(k) in the header."""
         cw, vw = 8, 13
         lines = [
-            ("Normalized limit surface (MODEL.md 3.2): f~*(c~) = f~*_tLS is odd, with the sign "
+            ("Normalized limit surface (docs/model.md 3.2): f~*(c~) = f~*_tLS is odd, with the sign "
             "opposite to c~;"),
             ("tau~*(c~) = tau~*_LS is even and positive. f_t,max = mu f_n, "
             "tau_max = mu xi(k) rho f_n."),
@@ -285,7 +285,7 @@ def _place_label(ax, x, y, nx, ny, text, color):
 def figure7(ks, marked=MARKED_C):
     """Paper Figure 7: the normalized LS cross-section, the closed curve
     +-(f~*(c~), tau~*(c~)), with the values of c~ marked on the upper half (omega < 0 in the
-    sign convention of MODEL.md 1.3) for k = 4 (or the first k)."""
+    sign convention of docs/model.md 1.3) for k = 4 (or the first k)."""
     import numpy as np
     from matplotlib.patches import Rectangle
 
@@ -321,7 +321,7 @@ def figure7(ks, marked=MARKED_C):
         ax.plot(fm, tm, "o", color=col, markersize=5.5, markeredgecolor="white", zorder=4)
         xi = s.xi
         for cv, fx, ty in zip(cm, fm, tm):
-            # outward normal of the LS at this point is parallel to (-c~, xi) (MODEL.md 3.2)
+            # outward normal of the LS at this point is parallel to (-c~, xi) (docs/model.md 3.2)
             nx, ny = -cv, xi
             norm = math.hypot(nx, ny)
             label = r"$\tilde c = 0$" if cv == 0 else f"{cv:+g}"
@@ -421,7 +421,7 @@ def demo_section(out_dir: Path) -> str:
         f"![Figure 3: f~*_tLS(c~) and tau~*_LS(c~)]({rel[0].as_posix()})",
         "",
         ("Figure 3: the two normalized curves vs c~ for k = 2 (Hertz), 4 (the paper) and inf "
-        "(uniform). f~* is odd with the sign opposite to c~ (MODEL.md 3.2); the bottom row "
+        "(uniform). f~* is odd with the sign opposite to c~ (docs/model.md 3.2); the bottom row "
         "shows how weakly the shape depends on k."),
         "",
         f"![Figure 7: normalized limit surface]({rel[1].as_posix()})",

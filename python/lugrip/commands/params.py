@@ -21,9 +21,9 @@ PRESET_SOURCES = {
 
 _BETA_NOTE = (
     "beta_A: the paper prints the unit 'Ns/m'; eq. 7 (f_tv = pi beta_A rho^2 omega c) needs "
-    "N s/m^3, so the printed numbers are used unchanged in N s/m^3 (MODEL.md section 11, item 6). "
+    "N s/m^3, so the printed numbers are used unchanged in N s/m^3 (docs/model.md section 11, item 6). "
     "Table 1 (cardboard, 4.9e9) and Table 2 (objects, 1.2e7-2.1e7) differ by 230-400x; each is "
-    "used as printed for its own objects (MODEL.md section 11, item 9)."
+    "used as printed for its own objects (docs/model.md section 11, item 9)."
 )
 
 _EPILOG = """\

@@ -1,5 +1,5 @@
 """Grasp simulation: the planar grasp plant (distributed-contact or lumped slider), gripper
-actuator, fingertip sensors, robot moves and disturbances (MODEL.md 10), and the closed loop with
+actuator, fingertip sensors, robot moves and disturbances (docs/model.md 10), and the closed loop with
 the observers and the grasp-force controller or a baseline (``run_closed_loop``; the paper's
 experiments as scenarios in :mod:`lugrip.sim.scenarios`). The loops run in C++.
 

@@ -1,7 +1,7 @@
 """Closed-loop grasp simulation: plant -> two fingertip sensors -> two observers -> grasp-force
 controller (or a baseline) -> gripper command, looping in C++ (``lugrip::ClosedLoop``).
 
-Multi-rate as MODEL.md 9.7 / 10.1: the plant steps at 1 kHz, the sensors, observers and the
+Multi-rate as docs/model.md 9.7 / 10.1: the plant steps at 1 kHz, the sensors, observers and the
 controller's C_d run at 500 Hz, the force command is issued at 50 Hz and held (zero-order hold)
 by the gripper, whose force follows it with a first-order lag. Deterministic with the plant seed.
 """

@@ -3,7 +3,7 @@
 Frames and conventions are those of ``include/lugrip/grasp_plant.hpp``: gripper frame X horizontal,
 Y up (gravity along -Y), Z along the grasp axis; finger 0 on the -Z face with sensor frame
 (X, Y, +Z), finger 1 on the +Z face with sensor frame (-X, Y, -Z); each sensor reads the wrench
-the object exerts on its fingertip (MODEL.md 7.2). SI units everywhere.
+the object exerts on its fingertip (docs/model.md 7.2). SI units everywhere.
 """
 
 from __future__ import annotations
@@ -122,7 +122,7 @@ class ActuatorConfig:
 @dataclasses.dataclass
 class SensorConfig:
     """Fingertip sensors (both fingers): rate [Hz]; white noise std on forces [N] and torque
-    [N m] (MODEL.md 10.1: 0.005 N, 0.01 N mm); quantisation steps (0: off); first-order low-pass
+    [N m] (docs/model.md 10.1: 0.005 N, 0.01 N mm); quantisation steps (0: off); first-order low-pass
     before sampling [s] (0: off); bias per finger of (f_n, f_x, f_y, tau)."""
 
     rate: float = 500.0
@@ -515,7 +515,7 @@ class GraspPlant:
 
 
 class PatchContact:
-    """One fingertip pad as a discretised pressure patch with per-cell bristles (MODEL.md 10.1
+    """One fingertip pad as a discretised pressure patch with per-cell bristles (docs/model.md 10.1
     (b)), driven by prescribed kinematics; for checking the limit surface it produces.
 
     Args:
@@ -554,7 +554,7 @@ class PatchContact:
         h: float = 0.01,
     ) -> tuple[float, float]:
         """Steady rotation at omega about the CoR at c~ rho(f_n) along `direction` [rad]. Returns
-        the pad's wrench on the object in the paper's frame (y along the friction force, MODEL.md
+        the pad's wrench on the object in the paper's frame (y along the friction force, docs/model.md
         1.2) normalised: (f_t / (mu f_n), tau / tau_max). The bristle update is exact for a constant
         velocity, so a coarse step h loses nothing."""
         p = self.params

@@ -1,5 +1,5 @@
 """The paper's experiments as closed-loop scenarios: YAML loading, runner, baselines, metrics and
-pass criteria (MODEL.md 10).
+pass criteria (docs/model.md 10).
 
 A scenario file (``scenarios/<name>.yaml``) holds::
 
