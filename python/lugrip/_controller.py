@@ -386,6 +386,9 @@ def static_grasp_force(params, f_t, tau, s_ref: float = 0.8, *, full_output: boo
         f_n [N] (0 for a zero load, NaN for non-finite input), shaped like the broadcast inputs;
         with full_output, (f_n, info).
 
+    Raises:
+        ValueError: a finite load whose force lies outside 1e-12 to 1e12 N (names f_t, tau).
+
     Example: the empty can (0.12 N per finger, mu = 0.75) needs 0.190 N with c_max = 1.5.
     """
     s_ref = float(s_ref)
@@ -394,6 +397,12 @@ def static_grasp_force(params, f_t, tau, s_ref: float = 0.8, *, full_output: boo
     p = _as_params(params)
     (ft, tq), shape = _flat(f_t, tau)
     r = _solver(p).solve(ft, tq, s_ref)
+    lost = np.isfinite(ft) & np.isfinite(tq) & ~np.isfinite(r["force"])
+    if np.any(lost):  # a finite load whose force lies outside what the solver evaluates
+        i = int(np.flatnonzero(lost)[0])
+        raise ValueError(
+            f"f_t, tau: the load at index {i} needs a grasp force outside the range the solver "
+            "evaluates (1e-12 to 1e12 N)")
     force = _shaped(r["force"], shape)
     if not full_output:
         return force

@@ -13,6 +13,7 @@ Feeding the opposite wrench returns ``-omega_hat`` with the same S.
 from __future__ import annotations
 
 import dataclasses
+import math
 from collections.abc import Mapping
 
 import numpy as np
@@ -20,6 +21,7 @@ import numpy as np
 from . import _core
 from ._contact import Status, _as_params, _flat, _model, _params_path, _shaped
 from ._params import read_observer_settings
+from ._yaml import to_number
 
 __all__ = [
     "GAIN_MODES",
@@ -248,23 +250,28 @@ class Observer:
             gain_mode = "fixed" if gain is not None and bandwidth is None else "bandwidth"
         s.gain_mode = _enum(GAIN_MODES, "gain_mode", gain_mode)
         if gain is not None:
-            s.gain = float(gain)
+            s.gain = to_number(gain, "gain")
         if bandwidth is not None:
-            s.bandwidth = float(bandwidth)
+            s.bandwidth = to_number(bandwidth, "bandwidth")
         cor = s.cor
         for name, value in given.items():
             if name in _COR_FIELDS:
-                setattr(cor, name, float(value))
+                setattr(cor, name, to_number(value, name))
             elif name in _OBS_FIELDS:
                 kind = _OBS_KINDS[name]
                 if kind == "int":
-                    if isinstance(value, bool) or int(value) != value:
-                        raise ValueError(f"{name} = {value!r}: must be an integer")
-                    value = int(value)
+                    number = to_number(value, name)
+                    if isinstance(value, bool) or not math.isfinite(number) or number != int(number):
+                        raise ValueError(f"{name}: must be an integer")
+                    if abs(number) >= 2**31:
+                        raise ValueError(f"{name}: out of range for an integer setting")
+                    value = int(number)
                 elif kind == "bool":
+                    if not isinstance(value, (bool, np.bool_)):
+                        raise ValueError(f"{name}: must be true or false")
                     value = bool(value)
                 else:
-                    value = float(value)
+                    value = to_number(value, name)
                 setattr(s, name, value)
             else:
                 raise TypeError(f"Observer() got an unexpected keyword argument {name!r}")

@@ -111,3 +111,33 @@ def test_limit_surface_and_shape_factor(k):
             continue
         xi = out.xi if isinstance(out, lugrip.LimitSurface) else out
         assert math.isfinite(xi) and 0.0 <= xi <= 2.0 / 3.0 + 1e-12  # xi(inf) = 2/3
+
+
+OBSERVER_FIELDS = ("dt", "gain", "bandwidth", "torque_noise", "resolution_max", "max_invalid",
+                   "substeps", "max_substeps", "filter_force", "f_n_min", "torque_cutoff")
+
+
+@settings(max_examples=300, deadline=None)
+@given(values=st.dictionaries(st.sampled_from(OBSERVER_FIELDS), hostile, min_size=1, max_size=3))
+def test_observer_hostile_keywords(values):
+    """Observer keywords: an observer whose first step is finite, or a ValueError naming the
+    field; never a TypeError or OverflowError from the bindings."""
+    try:
+        obs = lugrip.Observer("table1", **values)
+    except ValueError as err:
+        assert _names_a_field(str(err), values), str(err)
+        return
+    run = obs.run(lugrip.simulate_sliding("table1", n_maneuvers=1, seed=0))
+    assert np.all(np.isfinite(run.omega_hat))
+
+
+@settings(max_examples=200, deadline=None)
+@given(f_t=st.floats(min_value=0.0, max_value=1e300), tau=st.floats(min_value=-1e300, max_value=1e300))
+def test_static_grasp_force_finite_or_value_error(f_t, tau):
+    """A finite load: a finite, non-negative force, or a ValueError naming the load."""
+    try:
+        f = lugrip.static_grasp_force("aluminium_can", f_t=f_t, tau=tau)
+    except ValueError as err:
+        assert "f_t" in str(err) and "tau" in str(err)
+        return
+    assert math.isfinite(float(f)) and float(f) >= 0.0
