@@ -37,7 +37,7 @@ from pathlib import Path
 import lugrip
 import numpy as np
 from lugrip import ContactParams
-from lugrip.identify import PARAMETERS, IdentificationWarning, initial_guess
+from lugrip.identification import PARAMETERS, IdentificationWarning, initial_guess
 from lugrip.io import SlidingLog
 from lugrip.sim import PatchContact, PatchSettings
 from lugrip.sliding import PAPER_NOISE, evaluate, simulate_maneuvers, simulate_sliding
@@ -150,7 +150,7 @@ def batch_cost(log: SlidingLog, params: ContactParams, settings: dict, mask: np.
 
 def slsqp_fd(cost, log, p0, settings, *, max_iterations=200, time_limit=None):
     """SLSQP on the log-parameters (scaled by the start), 2-point finite differences."""
-    from lugrip.identify import DEFAULT_BOUNDS
+    from lugrip.identification import DEFAULT_BOUNDS
     from scipy.optimize import minimize
 
     scale = np.array([getattr(p0, n) for n in PARAMETERS])
@@ -325,7 +325,7 @@ def timed_eval(prob, params, derivatives, repeat=7):
 
 def run(quick: bool) -> dict:
     from lugrip import _core
-    from lugrip.identify._fit import _observer_settings, _Problem, load_maneuvers
+    from lugrip.identification._data import _observer_settings, _Problem, load_maneuvers
 
     n_man = 60 if quick else 240
     n_sub = 4 if quick else 6

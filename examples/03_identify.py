@@ -3,9 +3,12 @@ mu and beta_A (paper Sections 4 and 6).
 
 1. Simulate Section-4 maneuvers of a fingertip on the Table 1 slider (the "fingertip logs",
    with ground-truth velocity) and write them as a CSV sliding log.
-2. Identify all six parameters with lugrip.identify: the start point is computed from the data,
-   the cost is the online observer's velocity error (eq. 32) in C++ with its exact gradient;
-   the fit reports the validation RMSE, standard errors and what the data cannot separate.
+2. Identify all six parameters (and the pressure exponent k) with lugrip.identify: stages from
+   the data (limit surface from the gross-sliding wrench, viscous shear with a significance
+   test, bristles from the loading runs, noise from the still samples), then the online
+   observer's velocity error (eq. 32, C++ with its exact gradient) as a regularised
+   refinement; the fit reports each stage, the validation RMSE, sandwich standard errors and
+   what the data cannot separate.
    The parameters are identified FOR that observer (default settings: bandwidth 3000/s), so
    the YAML carries its settings as an observer: block, and the online observer built from the
    YAML (lugrip.Observer("fingertip.yaml"), lugrip observe --params) is the same one.
@@ -31,7 +34,7 @@ from pathlib import Path
 
 import lugrip
 import numpy as np
-from lugrip.identify import IdentificationWarning
+from lugrip.identification import IdentificationWarning
 from lugrip.sim import PatchContact
 from lugrip.sliding import simulate_sliding
 
@@ -52,7 +55,7 @@ def _main(tmp: Path, out_dir: str | None) -> lugrip.ContactParams:
     # sigma_z, BENCHMARKS.md issue 4). Pass observer={...} to identify for another one.
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", IdentificationWarning)
-        fit = lugrip.identify(log)  # start from the data, all six free
+        fit = lugrip.identify(log)  # stages from the data, then eq. 32; all six free
     print(fit.summary())
     for name in ("mu", "beta_a", "sigma0", "sigma_z", "delta", "gamma"):
         print(

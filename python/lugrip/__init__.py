@@ -48,8 +48,8 @@ from ._slip_control import SlipControl, SlipControlRun
 from .io import LogError, LogWarning, SlidingLog, read_log, write_log
 from .sliding import simulate_sliding
 
-# lugrip.identify is the function (the subpackage stays importable: from lugrip.identify import ...)
-from .identify import (
+# lugrip.identify is the function; its subpackage is lugrip.identification
+from .identification import (
     IdentificationError,
     IdentificationResult,
     RubbingEstimate,

@@ -191,7 +191,7 @@ def _check_observer_block(block: Any, where: str) -> dict[str, Any]:
 
 def read_observer_settings(path: str | Path) -> dict[str, Any] | None:
     """The ``observer:`` block of a parameter YAML (written by ``lugrip identify`` /
-    :meth:`lugrip.identify.IdentificationResult.save_yaml`): the settings of the observer the
+    :meth:`lugrip.identification.IdentificationResult.save_yaml`): the settings of the observer the
     parameters were identified with, as keywords of :class:`lugrip.Observer`, so that the
     observer used online is the one inside the identification cost (MODEL.md 8.1). None when
     the file has no such block (e.g. ``objects/*.yaml``, ``lugrip params`` output).

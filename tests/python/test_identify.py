@@ -15,7 +15,7 @@ import lugrip
 import numpy as np
 import pytest
 from lugrip import ContactParams, IdentificationError
-from lugrip.identify import (
+from lugrip.identification import (
     PARAMETERS,
     IdentifiabilityWarning,
     IdentificationWarning,
@@ -247,7 +247,7 @@ def test_gaps_split_segments_and_are_never_integrated_across():
 
 def test_maneuver_weighting_makes_short_maneuvers_count():
     """weighting='maneuver': every maneuver carries the same total weight."""
-    from lugrip.identify._fit import _observer_settings, _Problem, load_maneuvers
+    from lugrip.identification._data import _observer_settings, _Problem, load_maneuvers
 
     log = simulate_sliding(TABLE1, 5, seed=2, hold=(0.05, 2.0))
     mans = load_maneuvers(log)
@@ -522,7 +522,8 @@ def test_identify_yaml_observer_block_is_used_online(tmp_path, capsys):
     import yaml
     from lugrip.cli import main
 
-    log = simulate_sliding(TABLE1, 4, seed=11, c_range=(0.02, 1.4), omega_range=(0.002, 0.5))
+    # 8 maneuvers: the staged start needs gross sliding in three or more
+    log = simulate_sliding(TABLE1, 8, seed=11, c_range=(0.02, 1.4), omega_range=(0.002, 0.5))
     csv = tmp_path / "log.csv"
     lugrip.write_log(log, csv)
     fit = tmp_path / "fit.yaml"
@@ -723,7 +724,7 @@ def test_cli_identify_does_not_overwrite_without_force(tmp_path, capsys):
     """An existing --out file is refused before any work (exit 2, one line); --force replaces it."""
     from lugrip.cli import main
 
-    log = simulate_sliding(TABLE1, 3, seed=12, c_range=(0.02, 1.4))
+    log = simulate_sliding(TABLE1, 8, seed=12, c_range=(0.02, 1.4))
     csv = tmp_path / "log.csv"
     lugrip.write_log(log, csv)
     out = tmp_path / "fit.yaml"

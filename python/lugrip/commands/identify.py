@@ -1,5 +1,5 @@
 """``lugrip identify``: contact parameters from sliding logs with ground-truth velocity (paper
-Section 4, MODEL.md 8), or an object's mu and beta_A from a rubbing log (paper Section 6)."""
+Section 4, docs/model.md §8), or an object's mu and beta_A from a rubbing log (paper Section 6)."""
 
 from __future__ import annotations
 
@@ -19,23 +19,44 @@ examples:
   lugrip identify obj/*.parquet --free mu,beta_a --params0 fingertip.yaml --out object.yaml
   lugrip identify rub.csv --rubbing --params0 fingertip.yaml --out object.yaml
 
+Without --params0 the parameters come from stages, each from what the data carry: the
+phase of every sample (still, loading, gross sliding) from the wrench and the motion, the
+sensor noise from the still samples, the limit surface (mu, delta, gamma, k) from the
+gross-sliding wrench, beta_A from its speed dependence (not significant: "sliding speed not
+observable", beta_A set so that the observer reports speed_observable = False), sigma0 and
+sigma_z from the loading runs; then the paper's eq. 32 refines them, regularised toward the
+stage values (--no-refine: stages only). A parameter at a bound is a failure: the YAML's
+status says "failed" and the exit code is 3. User errors exit with 2 and one line.
+
 The cost runs the online observer, and the parameters are identified FOR that observer
-(MODEL.md 8.1): the output YAML records its settings in an 'observer' block, and 'lugrip
-observe --params' and 'lugrip identify --params0' use that block (options override it).
-Every log needs an 'omega' column (ground truth, rad/s); maneuvers come from the 'maneuver'
-column and are never integrated across a gap.
+(docs/model.md §8): the output YAML records its settings in an 'observer' block (with the
+measured torque noise), and 'lugrip observe --params' and 'lugrip identify --params0' use
+that block (options override it). Every log needs an 'omega' column (ground truth, rad/s);
+maneuvers come from the 'maneuver' column and are never integrated across a gap.
 """
+
+
+def _exponent(text: str) -> float:
+    try:
+        k = float(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"{text!r} is not a number (inf allowed)") from None
+    if not k >= 0.5:
+        raise argparse.ArgumentTypeError(f"{text!r}: the pressure exponent must be >= 0.5")
+    return k
 
 
 def register(subparsers) -> None:
     p = subparsers.add_parser(
         "identify",
-        help="identify contact parameters from sliding logs (SQP on the observer's velocity error)",
+        help="identify contact parameters from sliding logs (stages from the data, then the "
+        "observer's velocity error)",
         description=(
-            "Identify the contact parameters (mu, beta_A, sigma0, sigma_z, delta, gamma) from "
-            "sliding logs with ground-truth velocity by minimising the online observer's "
-            "velocity error (paper eqs. 32-33), or with --rubbing an object's mu and beta_A "
-            "from a rubbing log at known angular velocity."
+            "Identify the contact parameters (mu, beta_A, sigma0, sigma_z, delta, gamma and the "
+            "pressure exponent k) from sliding logs with ground-truth velocity: stages from "
+            "the data, then the online observer's velocity error (paper eqs. 32-33) as a "
+            "regularised refinement; or with --rubbing an object's mu and beta_A from a "
+            "rubbing log at known angular velocity."
         ),
         epilog=_EPILOG,
         formatter_class=argparse.RawDescriptionHelpFormatter,
@@ -113,8 +134,23 @@ def register(subparsers) -> None:
     p.add_argument(
         "--uncertainty",
         choices=("gauss-newton", "sandwich", "bootstrap"),
-        default="gauss-newton",
-        help="standard errors (default: Gauss-Newton)",
+        default="sandwich",
+        help="standard errors: sandwich (default, clustered by maneuver: robust to the "
+        "autocorrelation within a maneuver), gauss-newton (independent residuals: optimistic) "
+        "or bootstrap",
+    )
+    p.add_argument(
+        "--no-refine",
+        dest="refine",
+        action="store_false",
+        help="stop after the stages (no eq. 32 refinement)",
+    )
+    p.add_argument(
+        "--k",
+        type=_exponent,
+        default=None,
+        metavar="K",
+        help="hold the pressure exponent at K (0.5 .. inf; 2 Hertzian); default: identified",
     )
     p.add_argument(
         "--bootstrap", type=int, default=20, metavar="N", help="refits for --uncertainty bootstrap"
@@ -238,6 +274,11 @@ def write_report(result, out_dir: Path, *, title: str | None = None) -> list[Pat
         ax.set_title(f"{result.status}, {result.iterations} iterations, {result.fit_time:.2f} s")
         written.append(plot.save(fig, out_dir / "cost_trace.png"))
 
+    if result.stages is not None:
+        written.append(plot.save(limit_surface_figure(result), out_dir / "fig07_limit_surface.png"))
+    if result.validation_trace is not None and len(result.validation_trace["omega"]):
+        written.append(plot.save(validation_figure(result), out_dir / "validation_S_omega.png"))
+
     tr = result.validation_trace
     if tr is not None and len(tr["omega"]):
         # a continuous time axis over the validation maneuvers, in log order
@@ -276,10 +317,86 @@ def write_report(result, out_dir: Path, *, title: str | None = None) -> list[Pat
     return written
 
 
+def limit_surface_figure(result):
+    """The limit-surface stage like the paper's Figure 7: the gross-sliding points in
+    normalised coordinates (f_t / (mu f_n), |tau| / tau_max(f_n)), coloured by |omega|, the
+    fitted dry limit surface and the points with their fitted viscous part removed."""
+    import numpy as np
+
+    from .. import plot
+    from ..identification._stages import _A, _curves
+
+    ls = result.stages.ls
+    pts = ls.points
+    F, T, xi = _curves(0.0 if np.isinf(ls.k) else 1.0 / ls.k)
+    ft = pts.f_t / (ls.mu * pts.f_n)
+    tt = pts.tau_abs / (ls.mu * xi * ls.delta * pts.f_n ** (1.0 + ls.gamma))
+    lam = ls.kappa * pts.f_n ** (3.0 * ls.gamma - 1.0) * pts.omega_abs / (2.0 * xi)
+    with plot.style():
+        fig, ax = plot.new_figure(1, 1, width=5.5, row_height=4.5)
+        keep = _A <= 30.0
+        ax.plot(F[keep], T[keep], color="k", lw=1.2, label=f"fitted LS (k = {ls.k:.3g})")
+        sc = ax.scatter(ft, tt, c=pts.omega_abs, s=12, cmap="viridis", label="measured")
+        if ls.kappa > 0:
+            ax.scatter(ft - 2 * xi * ls.c_abs * lam, tt - lam, s=6, marker="x",
+                       color=plot.color(3), label="measured minus fitted viscous part")
+        fig.colorbar(sc, ax=ax, label="|omega| [rad/s]")
+        ax.set_xlabel(plot.axis_label("tangential", r"f_t/(\mu f_n)"))
+        ax.set_ylabel(plot.axis_label("torsional", r"|\tau|/\tau_{max}"))
+        ax.set_xlim(0, max(1.1, float(np.percentile(ft, 98)) * 1.05))
+        ax.set_ylim(0, max(1.1, float(np.percentile(tt, 98)) * 1.05))
+        ax.set_title(f"mu {ls.mu:.3g}, delta {ls.delta:.3g}, gamma {ls.gamma:.3g}, "
+                     f"{len(pts)} points", fontsize=9)
+        ax.legend(loc="upper right", fontsize=7)
+    return fig
+
+
+def validation_figure(result):
+    """The online observer with the identified parameters on the validation maneuvers:
+    omega and omega_hat, and the slippage indicator S with the 0.9 line."""
+    import numpy as np
+
+    from .. import plot
+
+    tr = result.validation_trace
+    obs = result.make_observer()
+    man = np.asarray(tr["maneuver"])
+    S = np.empty(man.size)
+    what = np.empty(man.size)
+    obsv = np.zeros(man.size, bool)
+    t_plot = np.empty(man.size)
+    offset = 0.0
+    for i in range(man.max() + 1):
+        sel = np.flatnonzero(man == i)
+        run = obs.run({"t": tr["t"][sel], "f_n": tr["f_n"][sel], "f_t": tr["f_t"][sel],
+                       "tau": tr["tau"][sel]})
+        S[sel] = np.asarray(run.S)
+        what[sel] = np.asarray(run.omega_hat)
+        obsv[sel] = np.asarray(run.speed_observable, bool)
+        ti = tr["t"][sel] - tr["t"][sel][0]
+        t_plot[sel] = ti + offset
+        offset += ti[-1] + 0.1
+    with plot.style():
+        fig, (a0, a1) = plot.new_figure(2, 1, width=10.0, row_height=2.6, sharex=True)
+        a0.plot(t_plot, tr["omega"], color=plot.color(0), lw=0.8, label="omega (truth)")
+        a0.plot(t_plot, what, color=plot.color(1), lw=0.8, label="omega_hat")
+        a0.set_ylabel(plot.axis_label("angular velocity", r"\omega", "rad/s"))
+        a0.legend(loc="upper right", fontsize=7)
+        a1.plot(t_plot, S, color=plot.color(2), lw=0.8, label="S")
+        a1.axhline(0.9, color="k", lw=0.6, ls="--")
+        a1.fill_between(t_plot, 0, 1.05, where=obsv, color=plot.color(4), alpha=0.15,
+                        label="speed_observable")
+        a1.set_ylim(0, 1.05)
+        a1.set_ylabel(plot.axis_label("slippage", "S"))
+        a1.set_xlabel(plot.axis_label("time (validation maneuvers back to back)", None, "s"))
+        a1.legend(loc="lower right", fontsize=7)
+    return fig
+
+
 def run(args) -> int:
     import warnings
 
-    from ..identify import IdentificationError, estimate_rubbing, identify
+    from ..identification import IdentificationError, estimate_rubbing, identify
     from ..io import read_log
 
     for path in args.logs:
@@ -358,6 +475,8 @@ def run(args) -> int:
                 uncertainty=args.uncertainty,
                 n_bootstrap=args.bootstrap,
                 start=args.start,
+                refine=args.refine,
+                k=args.k,
                 threads=args.threads,
                 score_saturated=args.score_saturated,
                 progress=bar,
@@ -367,12 +486,20 @@ def run(args) -> int:
         finally:
             if bar is not None:
                 bar.close()
+    seen = set()
     for w in caught:
-        print(f"warning: {w.message}", file=sys.stderr)
+        text = str(w.message)
+        if text not in seen:
+            seen.add(text)
+            print(f"warning: {text}", file=sys.stderr)
     print(result.summary())
     result.save_yaml(args.out)
     print(f"wrote {args.out}")
     if args.report is not None:
         for path in write_report(result, args.report):
             print(f"wrote {path}")
+    if result.status == "failed":
+        print(f"lugrip identify: fit failed: {result.message} (written with status: failed)",
+              file=sys.stderr)
+        return 3
     return 0

@@ -1,7 +1,7 @@
 """Per-object friction from a "rubbing" exploration (paper Section 6): the robot rubs the
 fingertip on the object at a KNOWN sliding velocity and the measured friction is compared with
-it. In steady sliding the friction is the limit-surface value plus the viscous part (MODEL.md
-5.1, eqs. 3-4, 7-8):
+it. In steady sliding the friction is the limit-surface value plus the viscous part (docs/model.md
+§5.1, eqs. 3-4, 7-8):
 
 * translation (CoR at infinity, sliding speed v [m/s]):
   ``f_t = mu f_n + beta_A pi rho^2 |v|``;
@@ -25,7 +25,7 @@ import numpy as np
 from .._contact import _as_params
 from .._params import ContactParams
 from ..io import SlidingLog
-from ._fit import IdentificationError
+from ._common import IdentificationError
 
 __all__ = ["RubbingEstimate", "estimate_rubbing"]
 

@@ -1,0 +1,425 @@
+"""The driver of the identification: the staged estimate from the data, then the eq. 32
+refinement regularised toward it (docs/model.md §8)."""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+import time
+import warnings
+from collections.abc import Callable, Mapping, Sequence
+from typing import Any
+
+import numpy as np
+
+from .. import _core
+from .._observer import Observer
+from .._params import ContactParams
+from ._checks import check_data, force_range_too_small, rotation_only
+from ._common import (
+    _DEFAULT_SLIP,
+    PARAMETERS,
+    IdentifiabilityWarning,
+    IdentificationError,
+    IdentificationWarning,
+)
+from ._data import _Maneuver, _observer_settings, _Problem, load_maneuvers
+from ._guess import _clip
+from ._optimize import _refit, minimise
+from ._result import IdentificationResult, estimates_of, evaluate_split
+from ._setup import _bounds, _parse_free, _split, check_options, read_params0
+from ._start import staged_estimate
+from ._uncertainty import covariance
+
+__all__ = ["identify"]
+
+
+def identify(
+    logs,
+    params0=None,
+    free: Sequence[str] | str = PARAMETERS,
+    bounds: Mapping[str, tuple[float, float]] | None = None,
+    *,
+    observer: Mapping[str, Any] | Observer | None = None,
+    validation: float | Sequence = 0.2,
+    seed: int = 0,
+    loss: str = "squared",
+    huber_scale: float = 0.05,
+    weighting: str = "maneuver",
+    method: str = "gauss-newton",
+    max_iterations: int = 200,
+    tolerance: float | None = None,
+    uncertainty: str = "sandwich",
+    n_bootstrap: int = 20,
+    start: str | None = None,
+    refine: bool = True,
+    slip_threshold: float = _DEFAULT_SLIP,
+    max_gap: float | None = None,
+    fix_unidentifiable: bool = True,
+    score_saturated: bool = False,
+    threads: int = 0,
+    k: float | None = None,
+    c_max: float | None = None,
+    progress: Callable[[int, float, ContactParams], None] | None = None,
+) -> IdentificationResult:
+    """Identify contact parameters from sliding logs with ground-truth velocity.
+
+    Without ``params0`` (``start="data"``) the parameters come from stages, each from what
+    the data carry (docs/model.md §8): the phases of every sample from the wrench and the
+    motion together, the sensor noise from the still samples, (a) the limit surface (mu,
+    delta, gamma, the pressure exponent k) from the gross-sliding wrench, (c) beta_A from its
+    speed dependence with a significance test (not significant: "sliding speed not
+    observable", beta_A set so that the observer reports speed_observable = False, and kept
+    fixed), (b) sigma0 and sigma_z from the loading runs. Then (``refine``) the paper's eq. 32
+    (the online observer's velocity error, C++ cost and exact gradient) refines them,
+    regularised toward the stage values within their standard errors. A parameter that ends
+    at a bound makes the status "failed".
+
+    With ``params0`` (``start="params0"``) only eq. 32 is minimised from it, without
+    regularisation (the per-object refit of the paper is ``free=("mu", "beta_a")``).
+
+    Args:
+        logs: :class:`lugrip.SlidingLog`, a path, a mapping of arrays or a sequence of these;
+            needs ``omega``. Each maneuver and gap-free stretch is a separate observer run.
+        params0: start point and values of the fixed parameters (ContactParams, preset name,
+            dict or YAML path; a YAML also gives its observer block).
+        free: parameters to identify; bounds: {name: (lower, upper)} for eq. 32.
+        observer: settings of the online observer (keywords of :class:`lugrip.Observer`); the
+            result records them, with the torque noise measured on the data when the
+            stages ran and ``torque_noise`` was not given.
+        validation: fraction of maneuvers held out (random, ``seed``) or their keys/indices.
+        loss, huber_scale, weighting, method, max_iterations, tolerance: the eq. 32 fit
+            ("squared"/"huber", "maneuver"/"sample", "gauss-newton"/"slsqp"/"trust-constr").
+        uncertainty: "sandwich" (default, clustered by maneuver), "gauss-newton" or
+            "bootstrap" (``n_bootstrap`` refits).
+        start: "data" or "params0" (default: params0 when given). refine: run eq. 32.
+        slip_threshold: |omega| [rad/s] for the all-stick check of a params0 start and the
+            clipped-CoR exclusion.
+        max_gap: split segments at larger time steps [s].
+        fix_unidentifiable: fix gamma when the normal force hardly varies and delta on
+            rotation-only data (warned either way).
+        score_saturated: also score sliding samples whose CoR the observer clips at c_max.
+        threads: C++ threads (0: all cores). k, c_max: pressure exponent (None: identified
+            by the stages; 4 for a params0-less fit without stages) and CoR clip (1.5).
+        progress: called as progress(iteration, cost, params).
+
+    Raises:
+        IdentificationError: data that cannot give a fit (no ground truth, omega apparently
+            in deg/s, no gross sliding, sliding in fewer than three maneuvers, ...).
+        ValueError: bad arguments.
+    """
+    t_start = time.perf_counter()
+    free = _parse_free(free)
+    bnds = _bounds(bounds)
+    tolerance = check_options(
+        loss=loss, weighting=weighting, method=method, tolerance=tolerance, uncertainty=uncertainty
+    )
+    p_given, observer = read_params0(params0, observer)
+    if p_given is None and len(free) < len(PARAMETERS):
+        fixed = [n for n in PARAMETERS if n not in free]
+        raise IdentificationError(
+            f"params0 is needed for the fixed parameter(s) {', '.join(fixed)} (e.g. the "
+            "fingertip's identified parameters for an object refit)"
+        )
+    start = start or ("params0" if p_given is not None else "data")
+    if start not in ("data", "params0"):
+        raise ValueError(f"start = {start!r}: 'data' or 'params0'")
+    if start == "params0" and p_given is None:
+        raise ValueError("start = 'params0' needs params0")
+    cm = p_given.c_max if p_given is not None else (1.5 if c_max is None else float(c_max))
+
+    mans = load_maneuvers(logs, max_gap=max_gap)
+    staged = start == "data"
+    notes = check_data(mans, free, slip_threshold, staged=staged)
+    fixed_notes: dict[str, str] = {}
+    free_list = list(free)
+    short = force_range_too_small(mans)
+    fix_gamma = None
+    if short and "gamma" in free_list and "delta" in free_list:
+        g_fix = p_given.gamma if p_given is not None else 0.25
+        if fix_unidentifiable:
+            free_list.remove("gamma")
+            fix_gamma = g_fix
+            fixed_notes["gamma"] = f"fixed at {g_fix:.4g}: too little normal-force range"
+            short += f"; gamma fixed at {g_fix:.4g}"
+        warnings.warn(short, IdentifiabilityWarning, stacklevel=2)
+        notes.append(short)
+
+    # --- the start point: stages from the data, or params0
+    stage = None
+    guess_notes: dict[str, str] = {n: "params0" for n in PARAMETERS}
+    if staged:
+        kk = k if k is not None else (p_given.k if p_given is not None else None)
+        stage = staged_estimate(mans, k=kk, c_max=cm, fix_gamma=fix_gamma)
+        base = stage.params if p_given is None else p_given.replace(k=stage.params.k)
+        p0 = base.replace(**{n: getattr(stage.params, n) for n in free})
+        guess_notes = {n: "stages" for n in PARAMETERS}
+        for n, why in stage.fixed.items():
+            if n in free_list:
+                free_list.remove(n)
+                fixed_notes[n] = f"fixed at {getattr(p0, n):.4g}: {why}"
+    else:
+        p0 = p_given
+    for n in free_list:  # inside the bounds
+        v = getattr(p0, n)
+        lo, hi = bnds[n]
+        if not (lo < v < hi):
+            p0 = p0.replace(**{n: _clip(n, v, bnds)})
+            notes.append(
+                f"{n}: start {v:.4g} outside the bounds [{lo:.3g}, {hi:.3g}], moved inside"
+            )
+    if (
+        "delta" in free_list
+        and ("mu" in free_list or "beta_a" in free_list)
+        and not staged
+        and rotation_only(mans, p0, slip_threshold)
+    ):
+        msg = (
+            "the data hold only rotations (estimated |c~| < 0.15 on 95 % of the sliding "
+            "samples): mu and delta enter only as mu delta (tau_max) and beta_A only as "
+            "beta_A delta^4, so delta is not separately identifiable"
+        )
+        if fix_unidentifiable:
+            free_list.remove("delta")
+            fixed_notes["delta"] = f"fixed at {p0.delta:.4g}: rotation-only data"
+            msg += f"; delta fixed at {p0.delta:.4g}"
+        warnings.warn(msg, IdentifiabilityWarning, stacklevel=2)
+        notes.append(msg)
+    free_t = tuple(n for n in PARAMETERS if n in free_list)
+    if not free_t and refine:
+        refine = False
+        notes.append("no parameter left for the eq. 32 refinement")
+
+    # --- the observer inside the cost
+    observer = {} if observer is None else observer
+    if isinstance(observer, Mapping):
+        observer = dict(observer)
+        if observer.get("dt") is None:
+            steps = np.concatenate([m.dt[m.dt > 0] for m in mans] or [np.zeros(0)])
+            if steps.size:
+                observer["dt"] = float(np.median(steps))
+        if (
+            stage is not None
+            and "torque_noise" not in observer
+            and math.isfinite(stage.noise.torque)
+        ):
+            observer["torque_noise"] = float(stage.noise.torque)
+    osettings, odict = _observer_settings(observer, p0)
+    settings = _core.IdentificationSettings()
+    settings.observer = osettings
+    settings.loss = _core.IdLoss.Huber if loss == "huber" else _core.IdLoss.Squared
+    settings.huber_scale = float(huber_scale)
+    settings.threads = int(threads)
+    msg = _core.validate_identification_settings(settings)
+    if msg:
+        raise ValueError("invalid identification settings:\n" + msg.rstrip())
+
+    keys = [m.key for m in mans]
+    val_idx = set(_split(keys, validation, seed))
+    prior = stage.prior if stage is not None else None
+    n_train = len(mans) - len(val_idx)
+
+    def scored_copies(p_clip: ContactParams):
+        """Maneuvers with the clipped-CoR sliding samples left unscored (at p_clip)."""
+        out, n_clip = [], 0
+        online = Observer(p_clip, **odict) if not score_saturated else None
+        for m in mans:
+            om = m.omega
+            if online is not None:
+                mask = _clipped_sliding(m, online, slip_threshold)
+                n_clip += int(mask.sum())
+                om = np.where(mask, np.nan, om)
+            out.append(dataclasses.replace(m, omega=om))
+        return out, n_clip
+
+    def fit(p_clip: ContactParams):
+        ms, n_clip = scored_copies(p_clip)
+        train_m = [m for i, m in enumerate(ms) if i not in val_idx]
+        val_m = [ms[i] for i in sorted(val_idx)]
+        train = _Problem(train_m, settings, weighting)
+        val = _Problem(val_m, settings, weighting) if val_m else None
+        mn = minimise(
+            train,
+            p0,
+            free_t,
+            bnds,
+            method=method,
+            max_iterations=max_iterations if refine else 0,
+            tolerance=tolerance,
+            prior=prior,
+            prior_weight=1.0 / max(n_train, 1) if prior else 0.0,
+            progress=progress,
+        )
+        return train, val, train_m, val_m, mn, n_clip
+
+    if not free_t:
+        free_t = ("mu",)  # evaluation only: the minimiser runs no iteration
+        max_iterations, refine = 0, False
+    train, val, train_m, val_m, mn, n_clip = fit(p0)
+    fits, fit_time = 1, mn.fit_time
+    while refine and not score_saturated and fits < 4:
+        _, n_at = scored_copies(mn.params)
+        if n_at == n_clip:
+            break
+        train, val, train_m, val_m, mn, n_clip = fit(mn.params)
+        fits += 1
+        fit_time += mn.fit_time
+    if fits > 1:
+        notes.append(
+            f"{fits} fits: the clipped-CoR samples were located again at each "
+            "fit's result until the set settled"
+        )
+    p_hat = mn.params
+    res = mn.result
+    ev, split = evaluate_split(train, val, train_m, val_m, p_hat)
+    if not free_list:
+        free_t = ()
+
+    def refit(ms):
+        return _refit(
+            _Problem(ms, settings, weighting), p_hat, free_t, bnds, max_iterations, tolerance
+        )
+
+    if free_t:
+        stderr_log, corr, weak, unc_notes = covariance(
+            train,
+            ev,
+            mn,
+            free_t,
+            loss=loss,
+            uncertainty=uncertainty,
+            sse=split["sse"],
+            refit=refit,
+            n_bootstrap=n_bootstrap,
+            seed=seed,
+        )
+    else:
+        stderr_log, corr, weak, unc_notes = np.zeros(0), np.zeros((0, 0)), (), []
+    ident = notes + unc_notes
+    if n_clip:
+        n_all = sum(m.n for m in mans)
+        ident.append(
+            f"{n_clip} samples ({100 * n_clip / max(n_all, 1):.1f} %) not scored: "
+            "sliding with the CoR clipped at c_max (translation beyond the clip), "
+            "where omega_hat is the slip about the clipped CoR, not the object's rotation"
+        )
+    if int(ev["truncated"]):
+        ident.append(
+            f"gradient truncated on {int(ev['truncated'])} samples where the observer "
+            "chatters (its discrete map is locally chaotic there)"
+        )
+    estimates, bound_notes = estimates_of(
+        p_hat, p0, free_t, mn, bnds, stderr_log, guess_notes, fixed_notes, stage
+    )
+    ident += bound_notes
+    at_bound = [(e.name, e.at_bound) for e in estimates if e.at_bound]
+    if stage is not None:
+        at_bound += [
+            (n, "limit-surface stage")
+            for n in stage.ls.at_bound
+            if n not in {name for name, _ in at_bound}
+        ]
+    if not refine:
+        status, message = "stages", "stage values (no eq. 32 refinement)"
+    elif res.success:
+        status, message = "converged", str(res.message)
+    elif "iteration" in str(res.message).lower():
+        status, message = "max_iterations", str(res.message)
+    else:
+        status, message = "failed", str(res.message)
+    if at_bound:
+        status = "failed"
+        message = "parameter(s) at a bound: " + ", ".join(f"{n} ({where})" for n, where in at_bound)
+        if any(n == "k" for n, _ in at_bound):
+            message += (
+                " (k at 0.5: the sliding wrench is more elliptic than any pressure "
+                "profile of the limit-surface family; hold it with k=0.5, --k 0.5, to accept it)"
+            )
+        warnings.warn(message, IdentificationWarning, stacklevel=2)
+    elif status not in ("converged", "stages"):
+        warnings.warn(
+            f"the optimiser stopped without convergence: {res.message}",
+            IdentificationWarning,
+            stacklevel=2,
+        )
+    data_warnings = _data_warnings(split, stage)
+    for w in data_warnings:
+        warnings.warn(w, IdentificationWarning, stacklevel=2)
+    return IdentificationResult(
+        status=status,
+        message=message,
+        params=p_hat,
+        params0=p0,
+        estimates=tuple(estimates),
+        free=free_t,
+        cost_trace=tuple(mn.trace),
+        rmse_train=split["rmse_train"],
+        rmse_validation=split["rmse_val"],
+        rms_omega_train=split["rms_train"],
+        rms_omega_validation=split["rms_val"],
+        maneuver_rmse=split["maneuver_rmse"],
+        validation_keys=tuple(m.key for m in val_m),
+        correlation=corr,
+        identifiability=tuple(ident),
+        weak_directions=tuple(weak),
+        uncertainty=uncertainty,
+        wall_time=time.perf_counter() - t_start,
+        fit_time=fit_time,
+        iterations=mn.iterations,
+        evaluations=train.evaluations,
+        samples_train=split["n_train"],
+        samples_validation=split["n_val"],
+        truncated=int(ev["truncated"]),
+        samples_saturated=n_clip,
+        settings={
+            "loss": loss,
+            "huber_scale": float(huber_scale),
+            "weighting": weighting,
+            "method": method,
+            "start": start,
+            "refine": bool(refine),
+            "validation": len(val_m),
+            "seed": int(seed),
+            "slip_threshold": float(slip_threshold),
+            "score_saturated": bool(score_saturated),
+            "observer": dict(odict),
+            "bounds": {n: list(bnds[n]) for n in free_t},
+            "threads": int(threads),
+            "maneuvers": len(mans),
+        },
+        validation_trace=split["trace"],
+        stages=stage,
+        warnings=tuple(data_warnings),
+    )
+
+
+def _data_warnings(split: dict, stage) -> list[str]:
+    """Warnings that look at the fit's outcome on the data."""
+    out = []
+    rmse, rms = split["rmse_val"], split["rms_val"]
+    which = "validation"
+    if not math.isfinite(rmse):
+        rmse, rms, which = split["rmse_train"], split["rms_train"], "training"
+    if math.isfinite(rmse) and math.isfinite(rms) and rmse >= 0.9 * rms:
+        out.append(
+            f"omega_hat is no better than predicting zero on the {which} maneuvers (RMSE "
+            f"{rmse:.3g} rad/s against {rms:.3g} for omega_hat = 0)"
+            + (
+                ""
+                if stage is None or stage.speed_observable
+                else ": expected, the sliding speed is not observable on these data (S and the "
+                "slip decision still are)"
+            )
+        )
+    return out
+
+
+def _clipped_sliding(m: _Maneuver, observer: Observer, slip_threshold: float) -> np.ndarray:
+    """Samples of a maneuver where the online observer (restarted per segment, as in the cost)
+    clips the CoR at c_max while the ground truth slides (|omega| > slip_threshold)."""
+    mask = np.zeros(m.n, dtype=bool)
+    for a, b in zip(m.starts[:-1], m.starts[1:]):
+        run = observer.run({"f_n": m.f_n[a:b], "f_t": m.f_t[a:b], "tau": m.tau[a:b], "t": m.t[a:b]})
+        mask[a:b] = np.asarray(run.saturated, dtype=bool)
+    with np.errstate(invalid="ignore"):
+        return mask & (np.abs(m.omega) > slip_threshold)

@@ -1,0 +1,141 @@
+"""Standard errors and identifiability of the eq. 32 refinement (log-parameter space)."""
+
+from __future__ import annotations
+
+from collections.abc import Mapping, Sequence
+
+import numpy as np
+
+
+def _weak_directions(H: np.ndarray, names: Sequence[str]):
+    """Eigen-decomposition of the scale-free (unit-diagonal) Gauss-Newton matrix: pairs
+    (eigenvalue / largest, {name: weight}), weakest first; and the correlation matrix."""
+    d = np.sqrt(np.maximum(np.diag(H), 1e-300))
+    Hn = H / np.outer(d, d)
+    lam, vec = np.linalg.eigh(Hn)
+    lam_max = max(lam.max(), 1e-300)
+    dirs = []
+    for i in np.argsort(lam):
+        v = vec[:, i] / d  # back to log-parameter units
+        v = v / np.max(np.abs(v))
+        dirs.append(
+            (
+                float(max(lam[i], 0.0) / lam_max),
+                {n: float(round(c, 3)) for n, c in zip(names, v) if abs(c) >= 0.05},
+            )
+        )
+    try:
+        cov = np.linalg.inv(Hn)
+        s = np.sqrt(np.abs(np.diag(cov)))
+        corr = cov / np.outer(s, s)
+    except np.linalg.LinAlgError:
+        corr = np.full_like(H, np.nan)
+    return dirs, corr
+
+
+def _combination_text(weights: Mapping[str, float]) -> str:
+    parts = []
+    for n, c in weights.items():
+        ex = f"{c:+.2g}"
+        parts.append(f"{n}^{ex}")
+    return " * ".join(parts)
+
+
+def covariance(train, ev, mn, free_t, *, loss: str, uncertainty: str, sse, refit=None,
+               n_bootstrap: int = 20, seed: int = 0):
+    """Covariance of the free log-parameters at the minimum ``mn`` (:class:`Minimum`), the
+    standard errors (NaN for parameters held at a bound) and the notes on weak and
+    unidentifiable combinations.
+
+    * "gauss-newton": 2 sigma^2 / W (J^T J)^-1, independent residuals (optimistic when the
+      residuals are autocorrelated within a maneuver);
+    * "sandwich" (default): H^-1 (sum_m g_m g_m^T) H^-1 with the per-maneuver gradients g_m,
+      robust to autocorrelation within maneuvers;
+    * "bootstrap": refits on maneuvers resampled with replacement (``refit(problem)`` -> p).
+
+    The regularisation toward the stage values (prior precision) is part of H.
+    """
+    import math
+
+    from ._common import PARAMETERS
+
+    idx = [PARAMETERS.index(n) for n in free_t]
+    p_hat, x, lo, hi = mn.params, mn.x, mn.lo, mn.hi
+    notes: list[str] = []
+    s_free = np.array([getattr(p_hat, n) for n in free_t])
+    H = np.asarray(ev["gauss_newton"]).reshape(6, 6)[np.ix_(idx, idx)] * np.outer(s_free, s_free)
+    dirs, corr = _weak_directions(H, free_t)
+    n_sc = int(ev["scored"])
+    wsum = float(ev["weight_sum"])
+    dof = max(n_sc - len(free_t), 1)
+    # Hessian of the regularisation in units of the cost's Hessian
+    # (mn.precision: weight x C^-1 of the normalised objective cost / c0)
+    P = 2.0 * mn.c0 * np.asarray(mn.precision, dtype=float)
+    cov = np.full((len(free_t), len(free_t)), np.nan)
+    inner = np.array([lo[i] + 1e-6 < x[i] < hi[i] - 1e-6 for i in range(len(free_t))])
+    ii = np.ix_(inner, inner)
+    try:
+        if uncertainty == "gauss-newton":
+            sigma2 = float(ev["cost"]) * wsum / dof if loss == "squared" else float(sse.sum()) / dof
+            cov[ii] = 2.0 * sigma2 / wsum * np.linalg.inv((H + P)[ii])
+        elif uncertainty == "sandwich":
+            G = train.maneuver_gradients(ev)[:, idx] * s_free
+            Hi = np.linalg.inv((H + P)[ii] * wsum)
+            M = G.shape[0]
+            cov[ii] = Hi @ (G[:, inner].T @ G[:, inner]) @ Hi * (M / max(M - 1, 1))
+    except np.linalg.LinAlgError:
+        notes.append("Gauss-Newton matrix singular: standard errors not available")
+    if uncertainty == "bootstrap":
+        if refit is not None and len(train.maneuvers) >= 2:
+            rng = np.random.default_rng(seed + 1)
+            samples = []
+            for _ in range(int(n_bootstrap)):
+                pick = rng.integers(0, len(train.maneuvers), size=len(train.maneuvers))
+                pb = refit([train.maneuvers[i] for i in pick])
+                samples.append(np.log([getattr(pb, n) for n in free_t]))
+            cov = np.atleast_2d(np.cov(np.array(samples).T, ddof=1))
+        else:
+            notes.append("bootstrap needs two or more training maneuvers")
+    stderr_log = np.sqrt(np.abs(np.diag(cov)))
+    if uncertainty != "bootstrap":
+        stderr_log[~inner] = np.nan
+    if np.all(np.isfinite(cov[ii])) and inner.any():
+        s = np.sqrt(np.maximum(np.diag(cov), 1e-300))
+        corr = np.where(np.outer(inner, inner), cov / np.outer(s, s), np.nan)
+
+    for ratio, weights in dirs:
+        if ratio < 1e-10:
+            notes.append(
+                f"not identifiable from these data: {_combination_text(weights)} "
+                f"(the scale-free Gauss-Newton matrix is singular along it, eigenvalue "
+                f"{ratio:.1e} of the largest)"
+            )
+    weak: list[tuple[float, dict[str, float]]] = []
+    names_in = [n for n, k in zip(free_t, inner) if k]
+    if names_in and np.all(np.isfinite(cov[ii])):
+        var, vec = np.linalg.eigh(cov[ii])
+        for ax in np.argsort(var)[::-1]:
+            v = vec[:, ax] / np.max(np.abs(vec[:, ax]))
+            sd = math.sqrt(max(var[ax], 0.0)) * float(np.linalg.norm(v))
+            weak.append(
+                (sd, {n: float(round(c, 3)) for n, c in zip(names_in, v) if abs(c) >= 0.05})
+            )
+        for sd, weights in weak:
+            if sd > 0.05 and len(weights) > 1:
+                notes.append(
+                    f"weakly identifiable: {_combination_text(weights)} is determined "
+                    f"only to +-{100 * sd:.0f} % (one standard error)"
+                )
+    for i in range(len(free_t)):
+        for j in range(i + 1, len(free_t)):
+            if np.isfinite(corr[i, j]) and abs(corr[i, j]) > 0.99:
+                c = -cov[i, j] / cov[j, j]
+                sd = math.sqrt(max(cov[i, i] + 2 * c * cov[i, j] + c * c * cov[j, j], 0.0))
+                notes.append(
+                    f"{free_t[i]} and {free_t[j]} are strongly correlated "
+                    f"({corr[i, j]:+.3f}): {free_t[i]} * {free_t[j]}^{c:.2g} is "
+                    f"determined to +-{100 * sd:.2g} %, {free_t[i]} alone to "
+                    f"+-{100 * stderr_log[i]:.2g} %"
+                )
+    return stderr_log, corr, tuple(weak), notes
+
