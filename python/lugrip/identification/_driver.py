@@ -33,6 +33,8 @@ from ._uncertainty import covariance
 
 __all__ = ["identify"]
 
+CUTOFFS = (2.0, 5.0, 10.0, 20.0)  # [Hz] candidates of the CoR torque filter (speed observable)
+
 
 def identify(
     logs,
@@ -86,7 +88,9 @@ def identify(
         free: parameters to identify; bounds: {name: (lower, upper)} for eq. 32.
         observer: settings of the online observer (keywords of :class:`lugrip.Observer`); the
             result records them, with the torque noise measured on the data when the
-            stages ran and ``torque_noise`` was not given.
+            stages ran and ``torque_noise`` was not given, and, where the stages found the
+            speed observable and ``torque_cutoff`` was not given, the CoR torque filter's
+            cutoff among 2, 5, 10 and 20 Hz with the smallest eq. 32 cost at the stage values.
         validation: fraction of maneuvers held out (random, ``seed``) or their keys/indices.
         loss, huber_scale, weighting, method, max_iterations, tolerance: the eq. 32 fit
             ("squared"/"huber", "maneuver"/"sample", "gauss-newton"/"slsqp"/"trust-constr").
@@ -192,6 +196,7 @@ def identify(
 
     # --- the observer inside the cost
     observer = {} if observer is None else observer
+    given = set(observer) if isinstance(observer, Mapping) else None
     if isinstance(observer, Mapping):
         observer = dict(observer)
         if observer.get("dt") is None:
@@ -251,6 +256,36 @@ def identify(
             progress=progress,
         )
         return train, val, train_m, val_m, mn, n_clip
+
+    if (
+        stage is not None
+        and stage.speed_observable
+        and given is not None
+        and "torque_cutoff" not in given
+    ):
+        # the CoR torque filter: where the speed is observable, the cutoff whose observer
+        # has the smallest eq. 32 cost at the stage values (same scored samples for all)
+        ms, _ = scored_copies(p0)
+        train_c = [m for i, m in enumerate(ms) if i not in val_idx]
+        costs = {}
+        for cut in CUTOFFS:
+            st = _core.IdentificationSettings()
+            st.observer = _observer_settings({**observer, "torque_cutoff": cut}, p0)[0]
+            st.loss, st.huber_scale, st.threads = (
+                settings.loss,
+                settings.huber_scale,
+                settings.threads,
+            )
+            costs[cut] = float(_Problem(train_c, st, weighting).evaluate(p0, False)["cost"])
+        best = min(costs, key=lambda c: costs[c] if math.isfinite(costs[c]) else math.inf)
+        observer["torque_cutoff"] = float(best)
+        osettings, odict = _observer_settings(observer, p0)
+        settings.observer = osettings
+        notes.append(
+            "CoR torque filter: cutoff "
+            + ", ".join(f"{c:g} Hz RMSE {math.sqrt(max(v, 0.0)):.3g}" for c, v in costs.items())
+            + f" at the stage values: {best:g} Hz"
+        )
 
     if not free_t:
         free_t = ("mu",)  # evaluation only: the minimiser runs no iteration
