@@ -33,7 +33,6 @@ import warnings
 from pathlib import Path
 
 import numpy as np
-
 from lugrip import ContactParams
 from lugrip.rigs import RubbingData, RubbingDesign
 from lugrip.rigs.mujoco_rig import MujocoRubbingRig
@@ -53,9 +52,7 @@ OBJECTS = {
     "plate": "plate_pivot",
 }
 #: scenario -> object file (the full can shares the empty can's)
-SCENARIO_OBJECT = {v: k for k, v in OBJECTS.items()} | {
-    "exp4_aluminium_can_full": "aluminium_can"
-}
+SCENARIO_OBJECT = {v: k for k, v in OBJECTS.items()} | {"exp4_aluminium_can_full": "aluminium_can"}
 #: the scene whose pad and contact-radius law the pad fit uses (every scene has the same pad)
 PAD_SCENE = "exp2_small_resin_block"
 PAD_SEED = 0  #: the pad data set's seed; object k uses PAD_SEED + 101 + k
@@ -83,8 +80,9 @@ def pad_rig(mu: float, scene: str = PAD_SCENE) -> MujocoRubbingRig:
     return MujocoRubbingRig.for_scene(s.scene_spec(), s.params.replace(mu=float(mu)))
 
 
-def rubbing_data(rig: MujocoRubbingRig, n: int, seed: int, directory: Path,
-                 force: bool) -> RubbingData:
+def rubbing_data(
+    rig: MujocoRubbingRig, n: int, seed: int, directory: Path, force: bool
+) -> RubbingData:
     """The rig's rubbing data set (n maneuvers of the default design, `seed`), cached in
     `directory` with its parameters in the metadata."""
     key = {"n": int(n), "seed": int(seed), "pad": repr(rig.pad), "settings": repr(rig.settings)}
@@ -110,8 +108,18 @@ def _log_file(directory: Path) -> Path:
 
 def identify(log: Path, out: Path, extra: list[str], report: Path | None) -> int:
     """Run ``lugrip identify`` (the installed command's module) on `log`; its exit code."""
-    cmd = [sys.executable, "-m", "lugrip", "identify", str(log), "--out", str(out), "--force",
-           "--quiet", *extra]
+    cmd = [
+        sys.executable,
+        "-m",
+        "lugrip",
+        "identify",
+        str(log),
+        "--out",
+        str(out),
+        "--force",
+        "--quiet",
+        *extra,
+    ]
     if report is not None:
         cmd += ["--report", str(report)]
     print("  $", " ".join(["lugrip", *cmd[3:]]))
@@ -141,16 +149,26 @@ def fit_status(path: Path) -> dict:
             if x <= lo + 1e-3 * abs(lo) or x >= hi - 1e-3 * abs(hi):
                 at_bound.append(name)
     keys = ("rmse_train", "rmse_validation", "rms_omega_train", "rms_omega_validation")
-    return {"status": ident.get("status"), "message": ident.get("message", ""),
-            "at_bound": at_bound} | {k: ident.get(k) for k in keys}
+    return {
+        "status": ident.get("status"),
+        "message": ident.get("message", ""),
+        "at_bound": at_bound,
+    } | {k: ident.get(k) for k in keys}
 
 
 def compare(rig: MujocoRubbingRig, fitted: Path) -> dict:
     """Identified against true mu and tau_max(f_n) at 1, 4 and 10 N."""
     p = ContactParams.from_yaml(fitted)
-    row = {"mu_true": rig.pad.mu, "mu_fit": p.mu, "beta_a_fit": p.beta_a,
-           "sigma0_fit": p.sigma0, "sigma_z_fit": p.sigma_z, "delta_fit": p.delta,
-           "gamma_fit": p.gamma, "k_fit": p.k}
+    row = {
+        "mu_true": rig.pad.mu,
+        "mu_fit": p.mu,
+        "beta_a_fit": p.beta_a,
+        "sigma0_fit": p.sigma0,
+        "sigma_z_fit": p.sigma_z,
+        "delta_fit": p.delta,
+        "gamma_fit": p.gamma,
+        "k_fit": p.k,
+    }
     for f in (1.0, 4.0, 10.0):
         row[f"tau_max_true_{f:g}N"] = float(rig.pad.tau_max(f))
         row[f"tau_max_fit_{f:g}N"] = tau_max(p, f)
@@ -160,21 +178,32 @@ def compare(rig: MujocoRubbingRig, fitted: Path) -> dict:
 
 def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
-    ap.add_argument("--only", choices=("pad", "objects"), help="one step only (objects needs "
-                    "the pad file)")
+    ap.add_argument(
+        "--only", choices=("pad", "objects"), help="one step only (objects needs the pad file)"
+    )
     ap.add_argument("--objects", default=",".join(OBJECTS), help="comma-separated object names")
     ap.add_argument("--maneuvers", type=int, default=PAD_MANEUVERS, help="pad data set size")
     ap.add_argument("--object-maneuvers", type=int, default=OBJECT_MANEUVERS)
     ap.add_argument("--seed", type=int, default=PAD_SEED)
     ap.add_argument("--pad-mu", type=float, default=0.7, help="the pad fit's slider friction")
-    ap.add_argument("--pad-k", default=str(PAD_K), help="identify's --k for the pad fit "
-                    "('free': identify's default, k identified)")
+    ap.add_argument(
+        "--pad-k",
+        default=str(PAD_K),
+        help="identify's --k for the pad fit ('free': identify's default, k identified)",
+    )
     ap.add_argument("--out-dir", type=Path, default=ROOT / "objects" / "mujoco")
     ap.add_argument("--cache", type=Path, default=ROOT / "build" / "mujoco_ident")
-    ap.add_argument("--object-free", default=OBJECT_FREE, help="identify's --free for the "
-                    f"object refits (default {OBJECT_FREE})")
-    ap.add_argument("--object-refine", action="store_true", help="object refits with identify's "
-                    "eq. 32 refinement from pad.yaml (default: the limit-surface stage alone)")
+    ap.add_argument(
+        "--object-free",
+        default=OBJECT_FREE,
+        help=f"identify's --free for the object refits (default {OBJECT_FREE})",
+    )
+    ap.add_argument(
+        "--object-refine",
+        action="store_true",
+        help="object refits with identify's "
+        "eq. 32 refinement from pad.yaml (default: the limit-surface stage alone)",
+    )
     ap.add_argument("--report", action="store_true", help="identify's report per fit")
     ap.add_argument("--force", action="store_true", help="regenerate cached data sets")
     args = ap.parse_args(argv)
@@ -217,10 +246,12 @@ def main(argv=None) -> int:
     print("| fit | mu true | mu identified | tau_max(4 N) true [N mm] | identified | status |")
     print("|---|---|---|---|---|---|")
     for name, r in summary.items():
-        print(f"| {name} | {r['mu_true']:.3f} | {r['mu_fit']:.4f} | "
-              f"{1e3 * r['tau_max_true_4N']:.3f} | {1e3 * r['tau_max_fit_4N']:.3f} | "
-              f"{r['status']}{' at bound: ' + ','.join(r['at_bound']) if r['at_bound'] else ''}"
-              f" |")
+        print(
+            f"| {name} | {r['mu_true']:.3f} | {r['mu_fit']:.4f} | "
+            f"{1e3 * r['tau_max_true_4N']:.3f} | {1e3 * r['tau_max_fit_4N']:.3f} | "
+            f"{r['status']}{' at bound: ' + ','.join(r['at_bound']) if r['at_bound'] else ''}"
+            f" |"
+        )
     if failed:
         print("failed fits: " + ", ".join(f"{n} (exit {rc})" for n, rc in failed), file=sys.stderr)
         return 1
