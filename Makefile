@@ -8,7 +8,7 @@ OUT    ?= out
 
 SOURCES := $(shell find src include bindings python -type f \( -name '*.cpp' -o -name '*.hpp' -o -name '*.py' \)) pyproject.toml CMakeLists.txt
 
-.PHONY: all install demo test test-cpp test-python test-install deps-cpp validate bench sanitize sanitize-campaign clean
+.PHONY: all install demo test test-cpp test-python test-install deps-cpp validate identify-mujoco bench sanitize sanitize-campaign clean
 
 all: install
 
@@ -45,6 +45,11 @@ test-install: deps-cpp
 # lugrip in closed loop on MuJoCo (validation/mujoco/README.md): out/mujoco_grasp.{json,png}
 validate: install
 	$(VPY) validation/mujoco/grasp.py --out $(OUT)
+
+# the MuJoCo scenes' identified pad and objects (objects/mujoco/*.yaml) from seeded MuJoCo rubbing
+# data cached in build/mujoco_ident/ (validation/mujoco/README.md); ~3 minutes
+identify-mujoco: install
+	$(VPY) validation/mujoco/identify_pad.py --force
 
 test-cpp: deps-cpp
 	cmake -S . -B $(CPP_BUILD) -DCMAKE_BUILD_TYPE=Release -DLUGRIP_BUILD_TESTS=ON -DLUGRIP_BUILD_BENCHMARKS=ON > /dev/null

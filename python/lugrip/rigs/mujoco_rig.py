@@ -65,8 +65,19 @@ class RigSettings:
     #: (stick-slip and normal kicks at low f_n; validation/mujoco/README.md)
     impratio: float = 1.0
     timestep: float = float(CONTACT_OPTIONS["timestep"])  #: MuJoCo step [s]
+    #: MuJoCo's implicit joint damping of the pad springs, (in-plane [N s/m], twist
+    #: [N m s/rad]), in place of the pad's explicit d_slide / d_twist; None: the pad's own
+    pad_damping: tuple[float, float] | None = None
 
     def __post_init__(self) -> None:
+        if self.pad_damping is not None:
+            pd = tuple(float(v) for v in self.pad_damping)
+            if len(pd) != 2 or not all(math.isfinite(v) and v >= 0 for v in pd):
+                raise ValueError(
+                    f"RigSettings.pad_damping must be two finite numbers >= 0, got "
+                    f"{self.pad_damping!r}"
+                )
+            object.__setattr__(self, "pad_damping", pd)
         for name in ("finger_mass", "mount_mass", "slip_speed", "timestep", "impratio"):
             v = getattr(self, name)
             if not (isinstance(v, (int, float)) and math.isfinite(v) and v > 0):
@@ -152,6 +163,8 @@ class MujocoRubbingRig:
     def __init__(
         self, mu: float = 0.7, pad: PadSpec | None = None, settings: RigSettings | None = None
     ):
+        """``pad``: the pad (default: PadSpec with mu 0.7); a ``mu`` other than 0.7 replaces
+        the pad's. ``settings``: the rig's mechanics (default RigSettings())."""
         base = pad if pad is not None else _default_pad()
         if pad is None or mu != 0.7:
             base = dataclasses.replace(base, mu=float(mu))
@@ -226,7 +239,32 @@ class MujocoRubbingRig:
 
         m = mujoco.MjModel.from_xml_string(self.model_xml())
         d = mujoco.MjData(m)
-        return m, d, Pad(m, self.pad)
+        pad = Pad(m, self.pad)
+        pd = self.settings.pad_damping
+        if pd is not None:  # the springs' damping implicit, as the gripper scenes have it
+            m.dof_damping[pad.joint_dof] = (pd[0], pd[0], pd[1])
+            pad._damping = np.zeros(3)
+        return m, d, pad
+
+    @classmethod
+    def for_scene(cls, spec, params) -> MujocoRubbingRig:
+        """The rig with the pad of a MuJoCo gripper scene: ``spec`` a
+        :class:`lugrip.sim.mujoco.SceneSpec` (its pad overrides, implicit pad damping, finger
+        mass and contact options), ``params`` the scene's ContactParams (mu, the radius law
+        delta, gamma and the torsional factor xi of k), as
+        :func:`lugrip.sim.mujoco.gripper.pad_spec` builds the scene's pads."""
+        from ..sim.mujoco.gripper import pad_spec
+
+        pad = dataclasses.replace(pad_spec(spec, params, 0), name="pad")
+        settings = RigSettings(
+            finger_mass=float(spec.finger_mass),
+            normal_damping=float(spec.finger_damping),
+            noslip_iterations=int(spec.noslip_iterations),
+            impratio=float(spec.impratio),
+            timestep=float(spec.timestep),
+            pad_damping=tuple(spec.pad_damping),
+        )
+        return cls(pad=pad, settings=settings)
 
     # --- one maneuver --------------------------------------------------------------------------
     def run_maneuver(self, plan: ManeuverPlan, model=None) -> dict[str, np.ndarray]:

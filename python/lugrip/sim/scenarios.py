@@ -298,6 +298,8 @@ class Scenario:
         s.plant_config()  # validates the plant block now, naming bad fields
         if s.mujoco:
             s.scene_spec()  # and the MuJoCo scene
+        for m in s.estimator:
+            s.estimator_for(m)  # and that parameter files exist
         return s
 
     def to_dict(self) -> dict:
@@ -374,8 +376,13 @@ class Scenario:
 
     def estimator_for(self, model: str) -> Any:
         """What the observers and the controller believe about the contact with this plant model
-        (``estimator_params`` forms), or None: the plant's own parameters."""
-        return self.estimator.get(model)
+        (``estimator_params`` forms), or None: the plant's own parameters. A relative parameter
+        file (``mujoco/box.yaml``) names a file next to the scenario, else one of the shipped
+        objects (``objects/mujoco/box.yaml``, written by ``lugrip identify``)."""
+        value = self.estimator.get(model)
+        if isinstance(value, str) and Path(value).suffix.lower() in (".yaml", ".yml"):
+            return _estimator_file(value, self.source)
+        return value
 
     @property
     def has_pivot(self) -> bool:
@@ -384,6 +391,24 @@ class Scenario:
     @property
     def params(self) -> ContactParams:
         return self.plant_config().contact
+
+
+def _estimator_file(name: str, source: Path | None) -> Path:
+    """The parameter file `name` of an estimator block: as given when absolute, else next to
+    the scenario file `source`, else in the shipped objects directory."""
+    from .._data import data_dir
+
+    p = Path(name)
+    if p.is_absolute():
+        return p
+    candidates = [] if source is None else [Path(source).parent / p]
+    objects = data_dir("objects")
+    candidates += [] if objects is None else [objects / p]
+    for c in candidates:
+        if c.is_file():
+            return c
+    where = ", ".join(str(c.parent) for c in candidates) or "no scenario or objects directory"
+    raise ValueError(f"estimator parameter file {name!r} not found (looked in {where})")
 
 
 def _estimator_block(value: Any, where: str) -> dict:

@@ -1,0 +1,181 @@
+"""The MuJoCo scenes' identified parameters (objects/mujoco/*.yaml, validation/mujoco/identify_pad.py).
+
+Independent-plant tests (the data come from MuJoCo's contact solver, not lugrip's model): the
+shipped fits are not at a bound and their mu and torsional capacity tau_max(f_n) match the MuJoCo
+pad's true ones; regenerating the pad fit on a small seeded data set lands near the shipped
+values; a short MuJoCo closed loop runs with the identified file. Consistency tests (lugrip
+against itself): the rubbing rig carries the scene's pad, every MuJoCo scenario names its file.
+"""
+
+from __future__ import annotations
+
+import importlib.util
+import math
+from pathlib import Path
+
+import numpy as np
+import pytest
+import yaml
+
+mujoco = pytest.importorskip("mujoco")
+from lugrip import ContactParams, LimitSurface
+from lugrip._data import data_dir
+from lugrip.rigs.mujoco_rig import MujocoRubbingRig
+from lugrip.sim import PlantConfig
+from lugrip.sim import scenarios as sc
+from lugrip.sim.mujoco.gripper import SceneSpec, pad_spec
+from lugrip.sim.mujoco.loop import run_mujoco_loop
+
+ROOT = Path(__file__).resolve().parents[2]
+FITS = ROOT / "objects" / "mujoco"
+
+
+def _script():
+    spec = importlib.util.spec_from_file_location(
+        "identify_pad", ROOT / "validation" / "mujoco" / "identify_pad.py"
+    )
+    mod = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(mod)
+    return mod
+
+
+IP = _script()
+
+
+@pytest.fixture(scope="module", autouse=True)
+def _scenario_dir():
+    mp = pytest.MonkeyPatch()
+    mp.setenv("LUGRIP_SCENARIOS", str(ROOT / "scenarios"))
+    yield
+    mp.undo()
+
+
+def _tau_max(p: ContactParams, f: float) -> float:
+    return p.mu * LimitSurface(p.k).xi * p.delta * f ** (p.gamma + 1.0)
+
+
+def test_rig_for_scene_carries_the_scene_pad():
+    """Consistency: the rubbing rig's pad is the scene's (PadSpec, implicit spring damping)."""
+    s = sc.load_scenario("box_heavy")
+    spec = s.scene_spec()
+    rig = MujocoRubbingRig.for_scene(spec, s.params)
+    scene_pad = pad_spec(spec, s.params, 0)
+    assert rig.pad.mu == s.params.mu == 0.6
+    for f in ("radius", "mass", "k_slide", "k_twist", "delta", "gamma", "xi", "solref"):
+        assert getattr(rig.pad, f) == getattr(scene_pad, f), f
+    m, _, pad = rig.build()
+    np.testing.assert_allclose(m.dof_damping[pad.joint_dof], [20.0, 20.0, 0.05])
+    assert m.opt.impratio == spec.impratio
+    with pytest.raises(ValueError, match="pad_damping"):
+        IP.MujocoRubbingRig(settings=IP.MujocoRubbingRig().settings.__class__(pad_damping=(1, -1)))
+
+
+@pytest.mark.parametrize("name", ["pad", *IP.OBJECTS])
+def test_shipped_fit_loads_is_not_at_a_bound_and_matches_mujoco(name):
+    """Independent plant: each shipped file loads, its fit did not fail, no free parameter sits
+    at a bound, and mu and tau_max(f_n) at 1-10 N are within 5 % of the MuJoCo pad's (the
+    scene's mu; tau_max = mu xi(4) 1.8e-3 f_n^1.254). k is held at 0.5 (the elliptic cone)."""
+    path = FITS / f"{name}.yaml"
+    p = ContactParams.from_yaml(path)
+    st = IP.fit_status(path)
+    assert st["status"] not in (None, "failed"), st["message"]
+    assert st["at_bound"] == []
+    doc = yaml.safe_load(path.read_text())
+    assert "observer" in doc
+    assert p.k == 0.5 and not doc["contact"]["k"].get("free", False)
+    mu_true = 0.7 if name == "pad" else sc.load_scenario(IP.OBJECTS[name]).params.mu
+    assert p.mu == pytest.approx(mu_true, rel=0.05)
+    true = IP.pad_rig(mu_true).pad
+    for f in (1.0, 4.0, 10.0):
+        assert _tau_max(p, f) == pytest.approx(float(true.tau_max(f)), rel=0.05)
+    if name != "pad":  # only mu refitted: the rest is the pad file's
+        pad = ContactParams.from_yaml(FITS / "pad.yaml")
+        assert (p.sigma0, p.sigma_z, p.delta, p.gamma, p.beta_a) == (
+            pad.sigma0,
+            pad.sigma_z,
+            pad.delta,
+            pad.gamma,
+            pad.beta_a,
+        )
+
+
+def test_every_mujoco_scenario_has_its_identified_file():
+    """Consistency: every scenario's object has a shipped fit next to the presets (the scenes
+    still run the preset sigma_z by default: with the identified files they drop objects,
+    validation/mujoco/README.md), and its scenario file names it."""
+    names = sc.list_scenarios(suite="all")
+    assert len(names) == len(IP.SCENARIO_OBJECT)
+    for n in names:
+        s = sc.load_scenario(n)
+        path = data_dir("objects") / "mujoco" / f"{IP.SCENARIO_OBJECT[n]}.yaml"
+        assert ContactParams.from_yaml(path) != s.params
+        assert f"mujoco/{IP.SCENARIO_OBJECT[n]}.yaml" in s.source.read_text()
+
+
+def test_missing_estimator_file_is_a_clear_error(tmp_path):
+    """A scenario naming a parameter file that does not exist fails at load, naming it."""
+    src = (ROOT / "scenarios" / "unseen" / "box_heavy.yaml").read_text()
+    bad = tmp_path / "box.yaml"
+    assert "  mujoco: {sigma_z: 3.3e-3}" in src
+    bad.write_text(src.replace("  mujoco: {sigma_z: 3.3e-3}", "  mujoco: mujoco/nothing_here.yaml"))
+    with pytest.raises(ValueError, match="nothing_here.yaml"):
+        sc.load_scenario(bad)
+
+
+@pytest.mark.xfail(strict=True, reason="known defect: with the identified pad/object file (its "
+                   "sigma_z and the small beta_A set when the speed is unobservable) the current "
+                   "controller drops exp 2's block on MuJoCo; the scenarios keep the preset "
+                   "sigma_z (validation/mujoco/README.md)")
+def test_short_mujoco_loop_runs_with_the_identified_file():
+    """Independent plant: 3 s of exp 2's block on MuJoCo (lift 0.5-1.5 s) with the identified
+    small_resin_block file runs, stays finite and in range, keeps both pads on the block and
+    does not drop it. The hold criteria (1 mm, 1 deg) are not asserted: with these parameters
+    the block turns on the pads (validation/mujoco/README.md reports by how much)."""
+    block = {
+        "model": "patch",
+        "contact": "small_resin_block",
+        "object": {"mass": 0.245, "inertia": 2.2e-4, "cog": [0.0035, 0.0]},
+        "actuator": {"f_init": 2.0},
+        "support": True,
+        "lift": {"t_start": 0.5, "duration": 1.0, "height": 0.05},
+        "seed": 3,
+    }
+    est = data_dir("objects") / "mujoco" / "small_resin_block.yaml"
+    r = run_mujoco_loop(
+        PlantConfig.from_dict(block),
+        SceneSpec.from_dict({"shape": "box", "size": [0.015, 0.05, 0.015]}),
+        duration=3.0,
+        estimator=est,
+    )
+    assert r.scene["status"] == "ok"
+    assert r["finite"].all() and not r["dropped"].any()
+    i0 = r.index(0.5)
+    assert np.all((r["command"] >= 0.1) & (r["command"] <= 20.0))
+    assert r["gripper_y"][-1] == pytest.approx(0.05, abs=1e-3)
+    assert np.mean(r["command"][i0:]) > 2.0  # it grips (more than the 1.2 N per pad of weight)
+
+
+def test_regenerated_pad_fit_is_near_the_shipped_one(tmp_path):
+    """Independent plant: the pad fit regenerated by the script on 24 maneuvers (seed 0)
+    lands within 5 % of the shipped mu and tau_max(1-10 N) and within 15 % of its sigma0
+    (sigma_z is not compared: 0.059 here against 0.095 shipped, see the README)."""
+    rc = IP.main(
+        [
+            "--only",
+            "pad",
+            "--maneuvers",
+            "24",
+            "--out-dir",
+            str(tmp_path / "fit"),
+            "--cache",
+            str(tmp_path / "cache"),
+        ]
+    )
+    assert rc == 0
+    new = ContactParams.from_yaml(tmp_path / "fit" / "pad.yaml")
+    ref = ContactParams.from_yaml(FITS / "pad.yaml")
+    assert new.mu == pytest.approx(ref.mu, rel=0.05)
+    for f in (1.0, 4.0, 10.0):
+        assert _tau_max(new, f) == pytest.approx(_tau_max(ref, f), rel=0.05)
+    assert new.sigma0 == pytest.approx(ref.sigma0, rel=0.15)
+    assert math.isfinite(new.sigma_z) and new.sigma_z > 0
