@@ -134,16 +134,7 @@ def staged_estimate(
     tn = noise.torque if math.isfinite(noise.torque) else 1.0e-5
     _, resolution, observable, beta, line = _viscous(ls, pts, tn, c_max, resolution_max)
     lines.append(line)
-    probe = ContactParams(
-        mu=ls.mu,
-        beta_a=max(ls.beta_a, 1.0),
-        sigma0=1.0,
-        sigma_z=0.01,
-        delta=ls.delta,
-        gamma=ls.gamma,
-        k=ls.k,
-        c_max=c_max,
-    )
+    probe = _probe(ls, c_max)
     p_ls = probe.replace(beta_a=beta)
     pre = fit_presliding(mans, phases, p_ls)
     second = False
@@ -292,10 +283,10 @@ def _ls_line(ls: LimitSurfaceFit, pts, fix_gamma) -> str:
     )
 
 
-def _viscous(ls: LimitSurfaceFit, pts, tn: float, c_max: float, resolution_max: float):
-    """(significant, resolution, observable, beta_A, report line) of stage (c)."""
-    significant = ls.kappa > 0 and math.isfinite(ls.viscous_t) and ls.viscous_t >= VISCOUS_T
-    probe = ContactParams(
+def _probe(ls: LimitSurfaceFit, c_max: float) -> ContactParams:
+    """Contact parameters with the limit-surface stage's mu, delta, gamma, k and beta_A (at
+    least 1) and placeholder bristle values, for evaluating the stage's contact model."""
+    return ContactParams(
         mu=ls.mu,
         beta_a=max(ls.beta_a, 1.0),
         sigma0=1.0,
@@ -305,6 +296,12 @@ def _viscous(ls: LimitSurfaceFit, pts, tn: float, c_max: float, resolution_max: 
         k=ls.k,
         c_max=c_max,
     )
+
+
+def _viscous(ls: LimitSurfaceFit, pts, tn: float, c_max: float, resolution_max: float):
+    """(significant, resolution, observable, beta_A, report line) of stage (c)."""
+    significant = ls.kappa > 0 and math.isfinite(ls.viscous_t) and ls.viscous_t >= VISCOUS_T
+    probe = _probe(ls, c_max)
     c_pts = np.minimum(ls.c_abs, c_max)
     res_pts = tn / np.maximum(np.asarray(_sigma_1(probe, pts.f_n, c_pts), float), 1e-300)
     resolution = float(np.median(np.repeat(res_pts, pts.samples)))
