@@ -33,17 +33,6 @@ SECTION = "mujoco-rig"
 TARGET_S = 60.0  # [s] 160 maneuvers on one core
 
 
-def _presliding(data) -> np.ndarray:
-    """Time from the motion start to the first gross-sliding sample, per maneuver [s]."""
-    out = []
-    for m in np.unique(data.log.maneuver):
-        sel = data.log.maneuver == m
-        ph, t = data.phase[sel], data.log.t[sel]
-        if np.any(ph == 2):
-            out.append(t[np.flatnonzero(ph == 2)[0]] - t[np.flatnonzero(ph == 1)[0]])
-    return np.asarray(out)
-
-
 def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("--out", type=Path, default=Path("BENCHMARKS.md"))
@@ -66,7 +55,7 @@ def main(argv=None) -> int:
     load = 0.0
     if hasattr(os, "getloadavg"):
         load = os.getloadavg()[0]
-    pre = 1e3 * _presliding(data)
+    pre = 1e3 * data.presliding_durations()
     share = [100.0 * np.mean(data.phase == k) for k in range(4)]
     g = data.gross_sliding
     tr = data.truth

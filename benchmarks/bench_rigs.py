@@ -33,18 +33,6 @@ SECTION = "rigs"
 TARGET_S = 60.0  # [s] 160 maneuvers of the grid plant on one core
 
 
-def _presliding(data) -> np.ndarray:
-    """Time from the motion start to the first gross-sliding sample, per maneuver [s]."""
-    out = []
-    log = data.log
-    for m in np.unique(log.maneuver):
-        sel = log.maneuver == m
-        ph, t = data.phase[sel], log.t[sel]
-        if np.any(ph == 2):
-            out.append(t[np.flatnonzero(ph == 2)[0]] - t[np.flatnonzero(ph == 1)[0]])
-    return np.asarray(out)
-
-
 def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("--out", type=Path, default=Path("BENCHMARKS.md"))
@@ -98,7 +86,7 @@ def main(argv=None) -> int:
               "|---|---|---|---|---|---|---|---|---|---|"]
     for name, d in sets.items():
         share = [100.0 * np.mean(d.phase == k) for k in range(4)]
-        pre = 1e3 * _presliding(d)
+        pre = 1e3 * d.presliding_durations()
         lr = np.percentile(d.load_ratio[d.gross_sliding], [5, 50, 95])
         tr = d.truth
         beta = "none" if tr.beta_a is None else f"{tr.beta_a:.3g}"

@@ -185,6 +185,17 @@ class RubbingData:
         """Mask of the gross-sliding samples (phase 2)."""
         return self.phase == 2
 
+    def presliding_durations(self) -> np.ndarray:
+        """Time from the motion start (first presliding sample) to the first gross-sliding
+        sample, per maneuver that reaches gross sliding [s]."""
+        out = []
+        for m in np.unique(self.log.maneuver):
+            sel = self.log.maneuver == m
+            ph, t = self.phase[sel], self.log.t[sel]
+            if np.any(ph == 2):
+                out.append(t[np.flatnonzero(ph == 2)[0]] - t[np.flatnonzero(ph == 1)[0]])
+        return np.asarray(out)
+
     def stick_below(self, ratio: float = 0.7) -> np.ndarray:
         """Mask of the samples not in gross sliding (phases 0, 1, 3) whose true load ratio is
         below ``ratio`` of the static friction limit."""
