@@ -11,9 +11,13 @@ from the presets the scenes are built with:
    its defaults (staged identification, observer block included): ``objects/mujoco/pad.yaml``.
 2. **Each object** (the paper's Table 2 procedure): rubbing data of the pad on that object's
    friction (the scene's mu), fitted by ``lugrip identify --free mu --params0 pad.yaml``
-   from the limit-surface stage on that object's gross-sliding wrench (``--start data
-   --no-refine``; beta_A only where the data carry it: ``--object-free mu,beta_a``):
-   ``objects/mujoco/<object>.yaml``.
+   from the limit-surface stage on that object's gross-sliding wrench with the pad's delta
+   and gamma held (``--start data --no-refine``; beta_A only where the data carry it:
+   ``--object-free mu,beta_a``): ``objects/mujoco/<object>.yaml``.
+
+The pad's sigma_z is not significant on the loading runs, which bound it near zero; the
+identification then gives the observer the sigma_z that damps its stick mode critically
+(docs/identification.md, stage (b)), and the file's note says so.
 
 Every data set is drawn from a fixed seed, so the files are reproducible; the logs are cached
 under ``build/mujoco_ident/`` (regenerated with ``--force``). A summary of identified against
@@ -21,6 +25,7 @@ true mu and tau_max goes to ``build/mujoco_ident/summary.json`` and is printed a
 
     python validation/mujoco/identify_pad.py                 # both steps (make identify-mujoco)
     python validation/mujoco/identify_pad.py --only pad --maneuvers 24 --out-dir /tmp/fit
+    python validation/mujoco/identify_pad.py --only pad --observer-check 0.0115,0.048,0.095
 """
 
 from __future__ import annotations
@@ -57,18 +62,18 @@ SCENARIO_OBJECT = {v: k for k, v in OBJECTS.items()} | {"exp4_aluminium_can_full
 PAD_SCENE = "exp2_small_resin_block"
 PAD_SEED = 0  #: the pad data set's seed; object k uses PAD_SEED + 101 + k
 PAD_MANEUVERS = 160
-OBJECT_MANEUVERS = 40
-#: the pad fit holds the pressure exponent at its lower bound 0.5: with k free, identify's
-#: limit-surface stage ends there and fails the fit, because MuJoCo's elliptic cone is more
-#: elliptic than any pressure profile of the model's family (validation/mujoco/README.md);
-#: 0.5 is the family's closest member, so it is held there and reported
-PAD_K = 0.5
+OBJECT_MANEUVERS = 80  #: per object (58-71 of them reach gross sliding)
+#: the pad fit's limit-surface shape: identify's default ('free': the pressure family and the
+#: elliptic limit surface both fitted, the lower RMS distance kept; on MuJoCo's elliptic cone
+#: that is the ellipse, k = 0)
+PAD_K = "free"
 #: the object refits free mu only: MuJoCo's friction is Coulomb, the pad fit finds no speed
 #: dependence (beta_A "not observable"), and freeing beta_A as well lets the velocity-error
 #: cost trade mu for a large beta_A (mu 0.05-0.46 for true 0.6-0.9, validation/mujoco/README.md)
 OBJECT_FREE = "mu"
 #: identify's options of the object refits: mu from the limit-surface stage on the object's
-#: gross-sliding wrench (the other parameters from pad.yaml), without the eq. 32 refinement,
+#: gross-sliding wrench with pad.yaml's delta and gamma held (the other parameters from
+#: pad.yaml too), without the eq. 32 refinement,
 #: whose velocity-error cost cannot see mu when the speed is unobservable (it drifts to
 #: 1.1-1.9 for true 0.85-0.9; validation/mujoco/README.md); --object-refine adds it back
 OBJECT_OPTIONS = ("--start", "data", "--no-refine")
@@ -176,6 +181,50 @@ def compare(rig: MujocoRubbingRig, fitted: Path) -> dict:
     return row
 
 
+def observer_check(fitted: Path, data: RubbingData, sigma_z: list[float]) -> list[dict]:
+    """The online observer of `fitted` (its observer block) on the fit's held-out maneuvers of
+    `data`, once per sigma_z value (the other parameters the file's), against the rig's truth:
+    the share of gross-sliding samples with S >= 0.9, of stick samples below 0.7 of the
+    friction limit with S >= 0.9, and the delay from each maneuver's first gross-sliding
+    sample to S >= 0.9 (median and 90 % quantile [s]; 0: S was there first)."""
+    import yaml
+    from lugrip import Observer
+    from lugrip.identification import read_observer_settings
+
+    doc = yaml.safe_load(fitted.read_text())
+    held = sorted(int(str(m).rsplit("#", 1)[1])
+                  for m in doc["identification"]["validation_maneuvers"])
+    d = data.select_maneuvers(held)
+    log, p0, kw = d.log, ContactParams.from_yaml(fitted), read_observer_settings(fitted)
+    rows = []
+    for sz in sigma_z:
+        p = p0.replace(sigma_z=float(sz))
+        S = np.empty(len(log))
+        delays = []
+        for m in np.unique(log.maneuver):
+            sel = np.flatnonzero(log.maneuver == m)
+            run = Observer(p, **kw).run(
+                {"t": log.t[sel], "f_n": log.f_n[sel], "f_t": log.f_t[sel], "tau": log.tau[sel]}
+            )
+            S[sel] = np.asarray(run.S)
+            gross = np.flatnonzero(d.phase[sel] == 2)
+            if gross.size:
+                i0 = int(gross[0])
+                hit = np.flatnonzero(S[sel][i0:] >= 0.9)
+                delays.append(log.t[sel][i0 + hit[0]] - log.t[sel][i0] if hit.size else np.inf)
+        delays = np.asarray(delays)
+        stick = d.stick_below(0.7)
+        rows.append({
+            "sigma_z": float(sz),
+            "S_sliding": float(np.mean(S[d.gross_sliding] >= 0.9)),
+            "S_stick": float(np.mean(S[stick] >= 0.9)),
+            "delay_median": float(np.median(delays)),
+            "delay_p90": float(np.quantile(delays, 0.9)),
+            "maneuvers": int(delays.size),
+        })
+    return rows
+
+
 def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument(
@@ -189,7 +238,8 @@ def main(argv=None) -> int:
     ap.add_argument(
         "--pad-k",
         default=str(PAD_K),
-        help="identify's --k for the pad fit ('free': identify's default, k identified)",
+        help="identify's --k for the pad fit (default 'free': identify's default, the shape "
+        "identified; a number holds k there)",
     )
     ap.add_argument("--out-dir", type=Path, default=ROOT / "objects" / "mujoco")
     ap.add_argument("--cache", type=Path, default=ROOT / "build" / "mujoco_ident")
@@ -205,6 +255,13 @@ def main(argv=None) -> int:
         "eq. 32 refinement from pad.yaml (default: the limit-surface stage alone)",
     )
     ap.add_argument("--report", action="store_true", help="identify's report per fit")
+    ap.add_argument(
+        "--observer-check",
+        default="",
+        metavar="SIGMA_Z,...",
+        help="after the pad fit: S of its observer on the held-out maneuvers against the rig's "
+        "truth with the file's sigma_z and with each of these values",
+    )
     ap.add_argument("--force", action="store_true", help="regenerate cached data sets")
     args = ap.parse_args(argv)
     args.out_dir.mkdir(parents=True, exist_ok=True)
@@ -222,6 +279,18 @@ def main(argv=None) -> int:
             failed.append(("pad", rc))
         if pad_file.is_file():
             summary["pad"] = compare(rig, pad_file) | {"exit": rc}
+            if args.observer_check:
+                own = ContactParams.from_yaml(pad_file).sigma_z
+                values = [own] + [float(v) for v in args.observer_check.split(",") if v]
+                rows = observer_check(pad_file, RubbingData.load(d), values)
+                summary["pad"]["observer_check"] = rows
+                print("| sigma_z [N m s/rad] | S >= 0.9 sliding | S >= 0.9 stick < 0.7 "
+                      "| delay to S >= 0.9 median / 90 % [ms] | maneuvers |")
+                print("|---|---|---|---|---|")
+                for r in rows:
+                    print(f"| {r['sigma_z']:.3g} | {r['S_sliding']:.3f} | {r['S_stick']:.4f} | "
+                          f"{1e3 * r['delay_median']:.0f} / {1e3 * r['delay_p90']:.0f} | "
+                          f"{r['maneuvers']} |")
     if args.only in (None, "objects"):
         if not pad_file.is_file():
             raise SystemExit(f"{pad_file} is missing: run the pad step first")
@@ -229,7 +298,7 @@ def main(argv=None) -> int:
             scene = OBJECTS[name]
             mu = load_scenario(scene).params.mu
             rig = pad_rig(mu, scene)
-            seed = args.seed + 101 + i
+            seed = args.seed + 101 + list(OBJECTS).index(name)
             d = args.cache / f"{name}_n{args.object_maneuvers}_s{seed}"
             print(f"{name}: {args.object_maneuvers} maneuvers, seed {seed}, mu {mu}")
             rubbing_data(rig, args.object_maneuvers, seed, d, args.force)
