@@ -118,17 +118,28 @@ def identify(log: Path, out: Path, extra: list[str], report: Path | None) -> int
         "-m",
         "lugrip",
         "identify",
-        str(log),
+        _from_root(log),
         "--out",
-        str(out),
+        _from_root(out),
         "--force",
         "--quiet",
         *extra,
     ]
     if report is not None:
-        cmd += ["--report", str(report)]
+        cmd += ["--report", _from_root(report)]
     print("  $", " ".join(["lugrip", *cmd[3:]]))
-    return subprocess.run(cmd, check=False).returncode
+    # run from the repository root so that the files name their logs by repository-relative
+    # paths (build/mujoco_ident/...), not by this machine's absolute ones
+    return subprocess.run(cmd, check=False, cwd=ROOT).returncode
+
+
+def _from_root(path: Path) -> str:
+    """`path` relative to the repository root when it lies inside it, else absolute."""
+    path = Path(path).resolve()
+    try:
+        return str(path.relative_to(ROOT))
+    except ValueError:
+        return str(path)
 
 
 def tau_max(p: ContactParams, f_n: float) -> float:
@@ -303,7 +314,7 @@ def main(argv=None) -> int:
             print(f"{name}: {args.object_maneuvers} maneuvers, seed {seed}, mu {mu}")
             rubbing_data(rig, args.object_maneuvers, seed, d, args.force)
             out = args.out_dir / f"{name}.yaml"
-            extra = ["--free", args.object_free, "--params0", str(pad_file)]
+            extra = ["--free", args.object_free, "--params0", str(Path(pad_file).resolve())]
             extra += [] if args.object_refine else list(OBJECT_OPTIONS)
             rc = identify(_log_file(d), out, extra, d / "report" if args.report else None)
             if rc != 0:
