@@ -50,6 +50,9 @@ PAPER_SETTINGS: dict[str, Any] = {
     "average_slippage": False,
     "static_equivalent_slippage": False,
     "omega_deadband": 0.0,
+    "feedforward_horizon": 0.0,
+    "reaction_lag": 0.0,
+    "react_when_invalid": False,
 }
 
 
