@@ -29,7 +29,10 @@ struct GraspControllerSettings {
   bool dynamic_enabled = true;  //!< (*) dynamic part active in slipping avoidance
 
   // --- static part in slipping avoidance: PI on e = S - s_ref (docs/model.md 9.4) -----------------
-  double s_ref = 0.8;  //!< (*) reference of the slippage indicator S-bar_a, in (0, 1)
+  //! (*) reference of the slippage indicator S-bar_a, in (0, 1); default 0.7 (paper: 0.8): the
+  //! reserve 1/S_ref - 1 of the standing force carries a load rise of ~40 % during the reaction
+  //! latency (docs/controller.md §6)
+  double s_ref = 0.7;
   double k_p = 4.0;    //!< (*) [N] proportional gain (e > 0 raises the force), > 0
   double k_i = 10.0;   //!< (*) [N/s] integral gain, > 0
   bool anti_windup = true;  //!< (*) back-calculation I = f_ns,clipped - k_p e when clipped
@@ -115,7 +118,7 @@ struct GraspControllerSettings {
   double feedforward_horizon = 0.03;
   //! (*) [-] the extrapolated load is used only when its static force exceeds that of the
   //! period's mean load by more than this fraction (a trend, not sensor noise). >= 0, finite.
-  double feedforward_trend = 0.3;
+  double feedforward_trend = 0.5;
   //! (*) [s] default 0.03; 0 = off (paper). Time constant of the gripper's force lag assumed by the
   //! reaction: when the feed-forward or the reflex lifts the static part above the force the
   //! gripper is estimated to apply, the command overshoots the target by the lag's shortfall over

@@ -44,6 +44,7 @@ _BOOL_FIELDS = tuple(name for name, kind, _doc in _core.GraspControllerSettings.
 #: no feed-forward, no slip reflex, the PI on S itself, no dead band on C_d. Pass them to compare
 #: with lugrip's defaults: ``GraspController(params, **PAPER_SETTINGS)``.
 PAPER_SETTINGS: dict[str, Any] = {
+    "s_ref": 0.8,
     "slope_gain": False,
     "feedforward": False,
     "slip_reflex": False,
