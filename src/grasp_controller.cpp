@@ -364,7 +364,7 @@ Status GraspController::step(const GraspControllerInput& in, GraspControllerOutp
     else
       pivot_count_ = 0;
     if (pivot_count_ >= s_.pivot_end_samples &&
-        static_cast<double>(pivot_count_) * dt_ >= s_.pivot_end_hold)
+        (static_cast<double>(pivot_count_) + 0.5) * dt_ >= s_.pivot_end_hold)  // nearest sample
       end_pivot(PivotEnd::CorThreshold, out);
     else if (static_cast<double>(pivot_samples_) * dt_ >= s_.pivot_timeout)
       end_pivot(PivotEnd::Timeout, out);

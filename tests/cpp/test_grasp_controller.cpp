@@ -29,6 +29,8 @@ GraspControllerSettings paper_law(GraspControllerSettings s = {}) {
   s.feedforward = false;
   s.slip_reflex = false;
   s.average_slippage = false;
+  s.pivot_end_hold = 0.0;  // the paper's pivot end: pivot_end_samples from the first sample
+  s.pivot_end_at_floor = false;
   return s;
 }
 
