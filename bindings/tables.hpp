@@ -126,7 +126,9 @@ struct Table<GraspControllerSettings> {
       field("pivot_floor_factor", &S::pivot_floor_factor, "pivoting floor factor on f_t / mu [-]"),
       field("pivot_end_c_tilde", &S::pivot_end_c_tilde, "pivoting ends above this mean |c~| [-]"),
       field("pivot_end_samples", &S::pivot_end_samples, "consecutive samples above the threshold"),
-      field("pivot_timeout", &S::pivot_timeout, "pivoting timeout (inf: off) [s]"));
+      field("pivot_timeout", &S::pivot_timeout, "pivoting timeout (inf: off) [s]"),
+      field("pivot_end_hold", &S::pivot_end_hold, "pivoting end criterion held this long [s]"),
+      field("pivot_end_at_floor", &S::pivot_end_at_floor, "pivot end counts only at the floor"));
 };
 
 template <>

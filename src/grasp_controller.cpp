@@ -15,6 +15,7 @@ namespace {
 // state finite: the C_d filter is stable and the PI error bounded).
 constexpr double kMaxSlippage = 1.0e3;
 constexpr double kMaxInput = 1.0e6;
+constexpr int kCountMax = 1 << 30;  // saturation of the pivot end counter
 
 // Shortest of %.15g / %.17g that reads back exactly.
 std::string fmt(double v) { return detail::format_number(v); }
@@ -57,6 +58,7 @@ bool validate(const GraspControllerSettings& s, std::string* message) {
   constexpr double kPoleMin = 1.0e-9, kCornerMax = 1.0e12;  // [rad/s] p_cd, z_cd
   constexpr double kForceMin = 1.0e-6, kForceMax = 1.0e6;   // [N] f_min, f_max, gain_schedule_force
   constexpr double kPivotMax = 1.0e3;                    // s_pivot (slippage inputs are <= 1e3)
+  constexpr double kHoldMax = 1.0e6;                     // [s] pivot_end_hold
   constexpr double kSlippageMin = 1.0e-3;                // s_ref, feedforward_slippage, reflex_slippage
   std::string msg;
   auto bad = [&](const char* name, double v, const std::string& rule) {
@@ -103,6 +105,8 @@ bool validate(const GraspControllerSettings& s, std::string* message) {
   positive("pivot_end_c_tilde", s.pivot_end_c_tilde);
   if (!(s.pivot_end_samples >= 1)) bad("pivot_end_samples", s.pivot_end_samples, "must be >= 1");
   positive_or_inf("pivot_timeout", s.pivot_timeout);
+  if (!(std::isfinite(s.pivot_end_hold) && s.pivot_end_hold >= 0.0 && s.pivot_end_hold <= kHoldMax))
+    bad("pivot_end_hold", s.pivot_end_hold, "must be finite, >= 0 and <= 1e6");
   within("loop_gain_p", s.loop_gain_p, 0.0, true, kGainMax, " [-]");
   within("loop_gain_i", s.loop_gain_i, 0.0, true, kGainMax, " [1/s]");
   if (s.slope_gain && s.gain_schedule_force > 0.0)
@@ -141,7 +145,8 @@ std::string to_string(const GraspControllerSettings& s) {
          ", pivot_floor_factor=" + num(s.pivot_floor_factor) +
          ", pivot_end_c_tilde=" + num(s.pivot_end_c_tilde) +
          ", pivot_end_samples=" + std::to_string(s.pivot_end_samples) +
-         ", pivot_timeout=" + num(s.pivot_timeout) + ", slope_gain=" + flag(s.slope_gain) +
+         ", pivot_timeout=" + num(s.pivot_timeout) + ", pivot_end_hold=" + num(s.pivot_end_hold) +
+         ", pivot_end_at_floor=" + flag(s.pivot_end_at_floor) + ", slope_gain=" + flag(s.slope_gain) +
          ", loop_gain_p=" + num(s.loop_gain_p) + ", loop_gain_i=" + num(s.loop_gain_i) +
          ", feedforward=" + flag(s.feedforward) + ", feedforward_slippage=" + num(s.feedforward_slippage) +
          ", slip_reflex=" + flag(s.slip_reflex) + ", reflex_slippage=" + num(s.reflex_slippage) +
@@ -204,6 +209,7 @@ void GraspController::reset(double current_force) noexcept {
   pivot_state_ = command_;
   pivot_samples_ = 0;
   pivot_count_ = 0;
+  pivot_at_floor_ = false;
   last_f_t_ = 0.0;
   last_kp_ = last_e_ = 0.0;
   clear_period();
@@ -282,6 +288,7 @@ Status GraspController::step(const GraspControllerInput& in, GraspControllerOutp
     init_static_ = true;  // the filter starts from the last command
     pivot_samples_ = 0;
     pivot_count_ = 0;
+    pivot_at_floor_ = false;
     peak_ = 0.0;
   } else if (request_ == Request::Avoid && mode_ == ControllerMode::Pivoting) {
     end_pivot(PivotEnd::Requested, out);
@@ -360,11 +367,15 @@ Status GraspController::step(const GraspControllerInput& in, GraspControllerOutp
   // End of the pivoting manoeuvre, tested at every sensor sample.
   if (mode_ == ControllerMode::Pivoting) {
     ++pivot_samples_;
-    if (valid && out.mean_c_tilde > s_.pivot_end_c_tilde)
-      ++pivot_count_;
+    // With pivot_end_at_floor the criterion counts only once the force cannot fall further: a
+    // swing through the vertical passes |c~| > 1 while the torque reverses (docs/controller.md).
+    const bool settled = !s_.pivot_end_at_floor || pivot_at_floor_;
+    if (valid && settled && out.mean_c_tilde > s_.pivot_end_c_tilde)
+      pivot_count_ = pivot_count_ < kCountMax ? pivot_count_ + 1 : pivot_count_;
     else
       pivot_count_ = 0;
-    if (pivot_count_ >= s_.pivot_end_samples)
+    if (pivot_count_ >= s_.pivot_end_samples &&
+        (static_cast<double>(pivot_count_) + 0.5) * dt_ >= s_.pivot_end_hold)  // nearest sample
       end_pivot(PivotEnd::CorThreshold, out);
     else if (static_cast<double>(pivot_samples_) * dt_ >= s_.pivot_timeout)
       end_pivot(PivotEnd::Timeout, out);
@@ -516,6 +527,7 @@ void GraspController::issue_command(bool valid, double slip) noexcept {
     pivot_state_ = clamp(pivot_state_, floor, s_.f_max);
     f_ns = pivot_state_;
     pivot_state_ = pivot_decay_ * pivot_state_ + (1.0 - pivot_decay_) * s_.k_f * e;
+    pivot_at_floor_ = pivot_state_ <= floor;  // the filter wants to go below the floor
     pivot_state_ = clamp(pivot_state_, floor, s_.f_max);
   }
   peak_ = 0.0;

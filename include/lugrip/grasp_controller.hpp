@@ -149,6 +149,12 @@ struct GraspControllerSettings {
   double pivot_end_c_tilde = 1.0;   //!< (*) pivoting ends when mean |c~_i| exceeds this, > 0
   int pivot_end_samples = 3;        //!< (*) ... on this many consecutive samples, >= 1
   double pivot_timeout = 10.0;      //!< (*) [s] pivoting ends after this time, > 0 (inf: never)
+  //! (*) [s] the end criterion must also hold this long without a break, >= 0, finite
+  //! (0: pivot_end_samples alone, the paper's law)
+  double pivot_end_hold = 0.2;
+  //! (*) the end criterion counts only while the pivoting filter is held at its floor, i.e. the
+  //! force cannot fall further (false: from the first pivoting sample, the paper's law)
+  bool pivot_end_at_floor = true;
 };
 
 //! Checks every field; one line per bad field ("k_p = -1: must be finite and > 0") in *message
@@ -298,7 +304,9 @@ class StaticForceSolver {
 //! * Pivoting: f_nd = 0; tau_p df/dt = -f + k_f (S - s_pivot), exact discretisation at the
 //!   command rate, started from the last command; floor max(f_min, factor max_i |f_t,i| / mu)
 //!   on the output and the filter state; ends on mean |c~_i| > pivot_end_c_tilde for
-//!   pivot_end_samples consecutive sensor samples, on timeout or on request, then returns to
+//!   pivot_end_samples consecutive sensor samples and pivot_end_hold seconds (counted, with
+//!   pivot_end_at_floor, only while the filter is held at the floor), on timeout or on
+//!   request, then returns to
 //!   slipping avoidance bumplessly (I = last command - k_p e at the next command, C_d reset).
 //! * Two fingers (docs/model.md 9.8): S = max_i S_i, f_nd from max_i |C_d omega_hat_i|, pivot end on
 //!   the mean of |c~_i|; absent fingers are ignored.
@@ -377,6 +385,7 @@ class GraspController {
   double peak_ = 0.0;         // running peak of max_i |C_d omega_i| [N]
   long pivot_samples_ = 0;    // samples since pivoting started
   int pivot_count_ = 0;       // consecutive samples with mean |c~| above the threshold
+  bool pivot_at_floor_ = false;  // the last pivoting command wanted to go below the floor
   double last_f_t_ = 0.0;     // last valid max_i |f_t,i| [N] (pivot floor)
   double last_kp_ = 0.0;      // k_p of the last command [N] (bumpless gain change)
   double last_e_ = 0.0;       // proportional error of the last command [-]

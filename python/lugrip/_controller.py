@@ -54,6 +54,8 @@ PAPER_SETTINGS: dict[str, Any] = {
     "feedforward_horizon": 0.0,
     "reaction_lag": 0.0,
     "react_when_invalid": False,
+    "pivot_end_hold": 0.0,
+    "pivot_end_at_floor": False,
 }
 
 
@@ -168,7 +170,8 @@ class GraspController:
     * Static part: PI on e = S - s_ref (e > 0 raises the force), forward Euler at the command
       rate, clipped to [f_min, f_max] with back-calculation anti-windup, bumpless starts.
     * Pivoting: f_nd = 0, tau_p df/dt = -f + k_f (S - s_pivot) (exact discretisation), floor
-      max(f_min, 1.1 f_t / mu); ends when the mean |c~_i| exceeds 1 on 3 consecutive samples,
+      max(f_min, 1.1 f_t / mu); ends when the mean |c~_i| exceeds 1 for 0.2 s (and 3 samples)
+      while the force sits at that floor (the paper: 3 samples from the start, PAPER_SETTINGS),
       on timeout or on request, then returns bumplessly to slipping avoidance.
     * step() at the sensor rate (500 Hz); a command every ``command_ratio`` calls (50 Hz), held.
     * Two fingers: S = max_i S_i, f_nd from max_i |C_d omega_hat_i|, pivot end on the mean |c~_i|.
@@ -191,7 +194,7 @@ class GraspController:
             range (f_min, f_max [N]), rate
             limits (max_rate_up, max_rate_down [N/s], inf = off), invalid_raise_step [N], pivoting
             (s_pivot, tau_pivot [s], k_f [N], pivot_floor_factor, pivot_end_c_tilde,
-            pivot_end_samples, pivot_timeout [s]).
+            pivot_end_samples, pivot_timeout [s], pivot_end_hold [s], pivot_end_at_floor).
 
     Raises:
         ValueError: unknown or invalid setting (one line per bad field) or invalid params.

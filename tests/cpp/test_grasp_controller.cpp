@@ -33,6 +33,8 @@ GraspControllerSettings paper_law(GraspControllerSettings s = {}) {
   s.feedforward_horizon = 0.0;
   s.reaction_lag = 0.0;
   s.react_when_invalid = false;
+  s.pivot_end_hold = 0.0;  // the paper's pivot end: pivot_end_samples from the first sample
+  s.pivot_end_at_floor = false;
   return s;
 }
 

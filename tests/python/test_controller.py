@@ -16,7 +16,8 @@ CAN = lugrip.ContactParams.preset("aluminium_can")
 #: The paper's static law (constant gains, S of the sample, no feed-forward, no reflex); the
 #: dead band (omega_deadband) keeps its default here.
 PAPER_PI = {k: lugrip.PAPER_SETTINGS[k]
-            for k in ("slope_gain", "feedforward", "slip_reflex", "average_slippage", "s_ref")}
+            for k in ("slope_gain", "feedforward", "slip_reflex", "average_slippage", "s_ref",
+                      "pivot_end_hold", "pivot_end_at_floor")}
 T_SENSOR = 1.0 / 500.0
 T_CMD = 10 * T_SENSOR
 
