@@ -11,9 +11,13 @@ from the presets the scenes are built with:
    its defaults (staged identification, observer block included): ``objects/mujoco/pad.yaml``.
 2. **Each object** (the paper's Table 2 procedure): rubbing data of the pad on that object's
    friction (the scene's mu), fitted by ``lugrip identify --free mu --params0 pad.yaml``
-   from the limit-surface stage on that object's gross-sliding wrench (``--start data
-   --no-refine``; beta_A only where the data carry it: ``--object-free mu,beta_a``):
-   ``objects/mujoco/<object>.yaml``.
+   from the limit-surface stage on that object's gross-sliding wrench with the pad's delta
+   and gamma held (``--start data --no-refine``; beta_A only where the data carry it:
+   ``--object-free mu,beta_a``): ``objects/mujoco/<object>.yaml``.
+
+The pad's sigma_z is not significant on the loading runs, which bound it near zero; the
+identification then gives the observer the sigma_z that damps its stick mode critically
+(docs/identification.md, stage (b)), and the file's note says so.
 
 Every data set is drawn from a fixed seed, so the files are reproducible; the logs are cached
 under ``build/mujoco_ident/`` (regenerated with ``--force``). A summary of identified against
@@ -57,18 +61,18 @@ SCENARIO_OBJECT = {v: k for k, v in OBJECTS.items()} | {"exp4_aluminium_can_full
 PAD_SCENE = "exp2_small_resin_block"
 PAD_SEED = 0  #: the pad data set's seed; object k uses PAD_SEED + 101 + k
 PAD_MANEUVERS = 160
-OBJECT_MANEUVERS = 40
-#: the pad fit holds the pressure exponent at its lower bound 0.5: with k free, identify's
-#: limit-surface stage ends there and fails the fit, because MuJoCo's elliptic cone is more
-#: elliptic than any pressure profile of the model's family (validation/mujoco/README.md);
-#: 0.5 is the family's closest member, so it is held there and reported
-PAD_K = 0.5
+OBJECT_MANEUVERS = 80  #: per object (58-71 of them reach gross sliding)
+#: the pad fit's limit-surface shape: identify's default ('free': the pressure family and the
+#: elliptic limit surface both fitted, the lower RMS distance kept; on MuJoCo's elliptic cone
+#: that is the ellipse, k = 0)
+PAD_K = "free"
 #: the object refits free mu only: MuJoCo's friction is Coulomb, the pad fit finds no speed
 #: dependence (beta_A "not observable"), and freeing beta_A as well lets the velocity-error
 #: cost trade mu for a large beta_A (mu 0.05-0.46 for true 0.6-0.9, validation/mujoco/README.md)
 OBJECT_FREE = "mu"
 #: identify's options of the object refits: mu from the limit-surface stage on the object's
-#: gross-sliding wrench (the other parameters from pad.yaml), without the eq. 32 refinement,
+#: gross-sliding wrench with pad.yaml's delta and gamma held (the other parameters from
+#: pad.yaml too), without the eq. 32 refinement,
 #: whose velocity-error cost cannot see mu when the speed is unobservable (it drifts to
 #: 1.1-1.9 for true 0.85-0.9; validation/mujoco/README.md); --object-refine adds it back
 OBJECT_OPTIONS = ("--start", "data", "--no-refine")
@@ -189,7 +193,8 @@ def main(argv=None) -> int:
     ap.add_argument(
         "--pad-k",
         default=str(PAD_K),
-        help="identify's --k for the pad fit ('free': identify's default, k identified)",
+        help="identify's --k for the pad fit (default 'free': identify's default, the shape "
+        "identified; a number holds k there)",
     )
     ap.add_argument("--out-dir", type=Path, default=ROOT / "objects" / "mujoco")
     ap.add_argument("--cache", type=Path, default=ROOT / "build" / "mujoco_ident")
@@ -229,7 +234,7 @@ def main(argv=None) -> int:
             scene = OBJECTS[name]
             mu = load_scenario(scene).params.mu
             rig = pad_rig(mu, scene)
-            seed = args.seed + 101 + i
+            seed = args.seed + 101 + list(OBJECTS).index(name)
             d = args.cache / f"{name}_n{args.object_maneuvers}_s{seed}"
             print(f"{name}: {args.object_maneuvers} maneuvers, seed {seed}, mu {mu}")
             rubbing_data(rig, args.object_maneuvers, seed, d, args.force)
