@@ -118,6 +118,12 @@ bool validate(const GraspControllerSettings& s, std::string* message) {
   if (!(s.reflex_samples >= 1)) bad("reflex_samples", s.reflex_samples, "must be >= 1");
   if (!(std::isfinite(s.reflex_factor) && s.reflex_factor > 1.0 && s.reflex_factor <= kPivotMax))
     bad("reflex_factor", s.reflex_factor, "must be finite, > 1 and <= 1000");
+  if (!(std::isfinite(s.feedforward_horizon) && s.feedforward_horizon >= 0.0 && s.feedforward_horizon <= 1.0e3))
+    bad("feedforward_horizon", s.feedforward_horizon, "must be finite, >= 0 and <= 1000 [s]");
+  if (!(std::isfinite(s.feedforward_trend) && s.feedforward_trend >= 0.0 && s.feedforward_trend <= 1.0e3))
+    bad("feedforward_trend", s.feedforward_trend, "must be finite, >= 0 and <= 1000");
+  if (!(std::isfinite(s.reaction_lag) && s.reaction_lag >= 0.0 && s.reaction_lag <= 1.0e3))
+    bad("reaction_lag", s.reaction_lag, "must be finite, >= 0 and <= 1000 [s]");
   if (message) *message = msg;
   return msg.empty();
 }
@@ -144,7 +150,9 @@ std::string to_string(const GraspControllerSettings& s) {
          ", loop_gain_p=" + num(s.loop_gain_p) + ", loop_gain_i=" + num(s.loop_gain_i) +
          ", feedforward=" + flag(s.feedforward) + ", feedforward_slippage=" + num(s.feedforward_slippage) +
          ", slip_reflex=" + flag(s.slip_reflex) + ", reflex_slippage=" + num(s.reflex_slippage) +
-         ", reflex_samples=" + std::to_string(s.reflex_samples) + ", reflex_factor=" + num(s.reflex_factor) + ", average_slippage=" + flag(s.average_slippage) + ")";
+         ", reflex_samples=" + std::to_string(s.reflex_samples) + ", reflex_factor=" + num(s.reflex_factor) + ", average_slippage=" + flag(s.average_slippage) +
+         ", feedforward_horizon=" + num(s.feedforward_horizon) + ", feedforward_trend=" + num(s.feedforward_trend) +
+         ", reaction_lag=" + num(s.reaction_lag) + ", react_when_invalid=" + flag(s.react_when_invalid) + ")";
 }
 
 const char* to_string(ControllerMode m) noexcept {
@@ -204,11 +212,9 @@ void GraspController::reset(double current_force) noexcept {
   pivot_at_floor_ = false;
   last_f_t_ = 0.0;
   last_kp_ = last_e_ = 0.0;
-  sum_f_t_.fill(0.0);
-  sum_tau_.fill(0.0);
-  n_load_.fill(0);
-  peak_s_ = sum_s_ = 0.0;
-  n_s_ = run_s_ = 0;
+  clear_period();
+  f_est_ = command_;
+  run_s_ = 0;
   reflex_armed_ = false;
   reset_dynamic();
   last_ = GraspControllerOutput();
@@ -319,8 +325,13 @@ Status GraspController::step(const GraspControllerInput& in, GraspControllerOutp
     f_t_max = std::max(f_t_max, std::fabs(f.f_t));
     ++n_valid;
     if (std::isfinite(f.tau) && std::fabs(f.tau) <= kMaxInput) {  // load for the static floor
+      const double k = n_load_[i];
       sum_f_t_[i] += std::fabs(f.f_t);
       sum_tau_[i] += f.tau;
+      sum_kf_[i] += k * std::fabs(f.f_t);
+      sum_kt_[i] += k * f.tau;
+      sum_k_[i] += k;
+      sum_kk_[i] += k * k;
       ++n_load_[i];
     }
     if (dynamic) {
@@ -411,8 +422,24 @@ void GraspController::issue_command(bool valid, double slip) noexcept {
   c.feedforward_force = 0.0;
   c.peak_slippage = peak_s_;
 
+  const double lag = s_.reaction_lag > 0.0 ? std::exp(-t_cmd_ / s_.reaction_lag) : 0.0;
   if (!valid) {  // safe command: hold (or raise), never below the floor; restart bumplessly
-    command_ = clamp(std::max(command_ + s_.invalid_raise_step, floor), s_.f_min, s_.f_max);
+    double f = std::max(command_ + s_.invalid_raise_step, floor);
+    if (s_.react_when_invalid && mode_ == ControllerMode::SlippingAvoidance) {
+      // Raise-only reactions from the valid fingers' samples of the period.
+      double n_slope = 1.0;
+      double lift = static_floor(n_slope);
+      c.feedforward_force = lift;
+      if (s_.slip_reflex && reflex_armed_) {
+        lift = std::max(lift, s_.reflex_factor * std::min(last_.static_force, command_));
+        c.reflex = true;
+      }
+      lift = std::min(lift, s_.f_max);
+      if (lift > f_est_ && lag > 0.0) lift += (lift - f_est_) * lag / (1.0 - lag);
+      f = std::max(f, std::min(lift, command_ + s_.max_rate_up * t_cmd_));
+    }
+    command_ = clamp(f, s_.f_min, s_.f_max);
+    f_est_ = command_ + (f_est_ - command_) * lag;
     init_static_ = true;
     peak_ = 0.0;
     clear_period();
@@ -423,6 +450,7 @@ void GraspController::issue_command(bool valid, double slip) noexcept {
   c.held = false;
 
   double f_ns, f_nd = 0.0, e;
+  bool reacting = false;  // the feed-forward or the reflex lifted the static part
   if (mode_ == ControllerMode::SlippingAvoidance) {
     // Floor of the static part: feed-forward of the measured load and the slip reflex.
     double n_slope = 1.0;
@@ -469,6 +497,7 @@ void GraspController::issue_command(bool valid, double slip) noexcept {
     f_ns = clamp(u, lo, s_.f_max);
     if (f_ns != u) {
       if (u < lo && lo > s_.f_min) {
+        reacting = true;
         integrator_ = f_ns - k_p * e;  // the floor lifted the PI: restart it there
       } else {
         c.saturated = true;
@@ -503,11 +532,14 @@ void GraspController::issue_command(bool valid, double slip) noexcept {
   }
   peak_ = 0.0;
 
-  const double target = f_ns + f_nd;
+  double target = f_ns + f_nd;
+  // Reaction through the gripper's lag: overshoot so the force reaches the target in one period.
+  if (reacting && lag > 0.0 && target > f_est_) target += (std::min(target, s_.f_max) - f_est_) * lag / (1.0 - lag);
   double f = clamp(target, command_ - s_.max_rate_down * t_cmd_, command_ + s_.max_rate_up * t_cmd_);
   c.rate_limited = f != target;
   f = clamp(std::max(f, floor), s_.f_min, s_.f_max);
   command_ = f;
+  f_est_ = command_ + (f_est_ - command_) * lag;
 
   c.force = f;
   c.static_force = f_ns;
@@ -520,6 +552,10 @@ void GraspController::issue_command(bool valid, double slip) noexcept {
 void GraspController::clear_period() noexcept {
   sum_f_t_.fill(0.0);
   sum_tau_.fill(0.0);
+  sum_kf_.fill(0.0);
+  sum_kt_.fill(0.0);
+  sum_k_.fill(0.0);
+  sum_kk_.fill(0.0);
   n_load_.fill(0);
   peak_s_ = sum_s_ = 0.0;
   n_s_ = 0;
@@ -534,9 +570,22 @@ double GraspController::static_floor(double& slope_exponent) noexcept {
   slope_exponent = 1.0;
   for (int i = 0; i < kMaxFingers; ++i) {
     if (n_load_[i] == 0) continue;
-    const double ft = sum_f_t_[i] / n_load_[i], tau = sum_tau_[i] / n_load_[i];
+    const double n = n_load_[i];
+    const double ft = sum_f_t_[i] / n, tau = sum_tau_[i] / n;
     if (s_.feedforward) {
-      const double f = solver_.solve(ft, tau, s_.feedforward_slippage).force;
+      double f = solver_.solve(ft, tau, s_.feedforward_slippage).force;
+      const double den = n * sum_kk_[i] - sum_k_[i] * sum_k_[i];
+      if (s_.feedforward_horizon > 0.0 && n_load_[i] >= 3 && den > 0.0 && std::isfinite(f)) {
+        // Least-squares trend of the period's load, extrapolated from the last sample's index
+        // by the horizon.
+        const double k_mean = sum_k_[i] / n;
+        const double ahead = (n - 1.0 - k_mean) + s_.feedforward_horizon / dt_;
+        const double slope_f = (n * sum_kf_[i] - sum_k_[i] * sum_f_t_[i]) / den;
+        const double slope_t = (n * sum_kt_[i] - sum_k_[i] * sum_tau_[i]) / den;
+        const double fx = solver_.solve(std::max(0.0, ft + slope_f * ahead), tau + slope_t * ahead,
+                                        s_.feedforward_slippage).force;
+        if (std::isfinite(fx) && fx > (1.0 + s_.feedforward_trend) * f) f = fx;
+      }
       if (std::isfinite(f)) force = std::max(force, f);
     }
     if (s_.slope_gain) {

@@ -29,7 +29,10 @@ struct GraspControllerSettings {
   bool dynamic_enabled = true;  //!< (*) dynamic part active in slipping avoidance
 
   // --- static part in slipping avoidance: PI on e = S - s_ref (docs/model.md 9.4) -----------------
-  double s_ref = 0.8;  //!< (*) reference of the slippage indicator S-bar_a, in (0, 1)
+  //! (*) reference of the slippage indicator S-bar_a, in (0, 1); default 0.7 (paper: 0.8): the
+  //! reserve 1/S_ref - 1 of the standing force carries a load rise of ~40 % during the reaction
+  //! latency (docs/controller.md §6)
+  double s_ref = 0.7;
   double k_p = 4.0;    //!< (*) [N] proportional gain (e > 0 raises the force), > 0
   double k_i = 10.0;   //!< (*) [N/s] integral gain, > 0
   bool anti_windup = true;  //!< (*) back-calculation I = f_ns,clipped - k_p e when clipped
@@ -105,6 +108,29 @@ struct GraspControllerSettings {
   //! within one command period.
   int reflex_samples = 3;
   double reflex_factor = 1.25;  //!< (*) [-] raise of the static part per period of detected slip, > 1
+
+  // --- reaction to fast load changes (not in the paper; docs/controller.md §6) ----------------
+  //! (*) [s] default 0.03; 0 = off (paper: the load of the period only). The feed-forward also
+  //! evaluates the load extrapolated this far ahead along its trend over the last command period
+  //! (least-squares slope of each finger's f_t and tau), so a load still rising at the command
+  //! (a pulse's edge) is met with the force it will need when the command has reached the
+  //! fingers. >= 0, finite.
+  double feedforward_horizon = 0.03;
+  //! (*) [-] the extrapolated load is used only when its static force exceeds that of the
+  //! period's mean load by more than this fraction (a trend, not sensor noise). >= 0, finite.
+  double feedforward_trend = 0.5;
+  //! (*) [s] default 0.03; 0 = off (paper). Time constant of the gripper's force lag assumed by the
+  //! reaction: when the feed-forward or the reflex lifts the static part above the force the
+  //! gripper is estimated to apply, the command overshoots the target by the lag's shortfall over
+  //! one command period, (target - f_est) exp(-T/tau) / (1 - exp(-T/tau)), so the force reaches
+  //! the target within one period instead of ~3 tau; f_est follows the issued commands through
+  //! that lag. >= 0, finite.
+  double reaction_lag = 0.03;
+  //! (*) default true; false = hold only (the earlier behaviour). A command due while a present
+  //! finger's input is invalid (NoContact while its pad loses contact as the object slides out,
+  //! InvalidSample, SensorFault) still takes the raise-only reactions computed from the valid
+  //! fingers' samples of the period (feed-forward, armed reflex); it never lowers the command.
+  bool react_when_invalid = true;
 
   // --- force range and rate limits (docs/model.md 9.5) --------------------------------------------
   double f_min = 0.1;   //!< [N] minimum force (keeps contact), > 0
@@ -365,6 +391,10 @@ class GraspController {
   double last_e_ = 0.0;       // proportional error of the last command [-]
   std::array<double, kMaxFingers> sum_f_t_{}, sum_tau_{};  // valid samples since the last command
   std::array<int, kMaxFingers> n_load_{};
+  std::array<double, kMaxFingers> sum_kf_{}, sum_kt_{};  // sums of k f_t, k tau (k: sample index in the period)
+  std::array<double, kMaxFingers> sum_k_{}, sum_kk_{};   // sums of k, k^2 over those samples
+  std::array<int, kMaxFingers> k_load_{};                // sample index in the period
+  double f_est_ = 0.0;        // gripper force estimated through reaction_lag [N]
   double peak_s_ = 0.0;       // peak of max_i S_i since the last command
   double sum_s_ = 0.0;        // sum of max_i S_i over the valid samples since the last command
   int n_s_ = 0;

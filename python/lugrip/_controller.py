@@ -44,12 +44,16 @@ _BOOL_FIELDS = tuple(name for name, kind, _doc in _core.GraspControllerSettings.
 #: no feed-forward, no slip reflex, the PI on S itself, no dead band on C_d. Pass them to compare
 #: with lugrip's defaults: ``GraspController(params, **PAPER_SETTINGS)``.
 PAPER_SETTINGS: dict[str, Any] = {
+    "s_ref": 0.8,
     "slope_gain": False,
     "feedforward": False,
     "slip_reflex": False,
     "average_slippage": False,
     "static_equivalent_slippage": False,
     "omega_deadband": 0.0,
+    "feedforward_horizon": 0.0,
+    "reaction_lag": 0.0,
+    "react_when_invalid": False,
     "pivot_end_hold": 0.0,
     "pivot_end_at_floor": False,
 }

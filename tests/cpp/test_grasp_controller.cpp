@@ -29,6 +29,10 @@ GraspControllerSettings paper_law(GraspControllerSettings s = {}) {
   s.feedforward = false;
   s.slip_reflex = false;
   s.average_slippage = false;
+  s.s_ref = 0.8;
+  s.feedforward_horizon = 0.0;
+  s.reaction_lag = 0.0;
+  s.react_when_invalid = false;
   s.pivot_end_hold = 0.0;  // the paper's pivot end: pivot_end_samples from the first sample
   s.pivot_end_at_floor = false;
   return s;
@@ -74,7 +78,7 @@ TEST(ControllerSettings, DefaultsAreValidAndMatchThePaper) {
   EXPECT_EQ(s.z_cd, 250.0);
   EXPECT_EQ(s.k_p, 4.0);
   EXPECT_EQ(s.k_i, 10.0);
-  EXPECT_EQ(s.s_ref, 0.8);
+  EXPECT_EQ(s.s_ref, 0.7);  // paper 0.8: a larger reserve for the reaction latency
   EXPECT_EQ(s.sensor_rate / s.command_ratio, 50.0);
   EXPECT_NE(to_string(s).find("k_p=4"), std::string::npos);
 }
@@ -935,6 +939,7 @@ TEST(ControllerSlopeGain, LoopGainIsTheSameAtEveryForce) {
       const ContactParams p = can();
       StaticForceSolver solver(p);
       GraspControllerSettings s;
+      s.s_ref = 0.8;  // the operating point of the inputs below
       s.max_rate_up = s.max_rate_down = kInf;
       GraspController c(p, s);
       const double f = solver.solve(ft, tau).force;
@@ -965,7 +970,7 @@ TEST(ControllerSlopeGain, NoLimitCycleAnywhereInTheForceRange) {
   GraspControllerSettings s;
   s.f_max = 40.0;
   for (const double ft : {0.09, 0.3, 1.0, 3.0, 7.0}) {
-    const double f = solver.solve(ft, 0.0).force;
+    const double f = solver.solve(ft, 0.0, s.s_ref).force;
     const auto r = lagged_loop(p, ft, 0.0, s, 20.0, 3.0);
     EXPECT_LT(r.second - r.first, 0.005 * f) << "ft " << ft << " f " << f;
     EXPECT_NEAR(0.5 * (r.first + r.second), f, 0.01 * f) << ft;
@@ -979,6 +984,8 @@ TEST(ControllerFeedForward, StaticGraspForceOfTheMeanLoadAtTheNextCommand) {
   StaticForceSolver solver(p);
   GraspControllerSettings s;
   s.max_rate_up = s.max_rate_down = kInf;
+  s.feedforward_horizon = 0.0;  // the period's mean load only (the trend: ControllerReaction.*)
+  s.reaction_lag = 0.0;
   GraspController c(p, s);
   c.reset(0.1);
   GraspControllerOutput out;
@@ -1059,6 +1066,8 @@ TEST(ControllerReflex, RaisesWithinOneCommandPeriodWhenTheSpeedIsUnobservable) {
   // on three consecutive samples inside a period.
   GraspControllerSettings s;
   s.feedforward = false;
+  s.s_ref = 0.8;          // the set point of the inputs below
+  s.reaction_lag = 0.0;   // the raise itself (the lag compensation: ControllerReaction.*)
   s.max_rate_up = s.max_rate_down = kInf;
   GraspController c(can(), s);
   c.reset(2.0);
