@@ -3,7 +3,7 @@
 Independent-plant tests (the data come from MuJoCo's contact solver, not lugrip's model): the
 shipped fits are not at a bound and their mu and torsional capacity tau_max(f_n) match the MuJoCo
 pad's true ones; regenerating the pad fit on a small seeded data set lands near the shipped
-values; a short MuJoCo closed loop runs with the identified file. Consistency tests (lugrip
+values; a short MuJoCo closed loop holds a block with the identified file. Consistency tests (lugrip
 against itself): the rubbing rig carries the scene's pad, every MuJoCo scenario names its file.
 """
 
@@ -73,8 +73,10 @@ def test_rig_for_scene_carries_the_scene_pad():
 @pytest.mark.parametrize("name", ["pad", *IP.OBJECTS])
 def test_shipped_fit_loads_is_not_at_a_bound_and_matches_mujoco(name):
     """Independent plant: each shipped file loads, its fit did not fail, no free parameter sits
-    at a bound, and mu and tau_max(f_n) at 1-10 N are within 5 % of the MuJoCo pad's (the
-    scene's mu; tau_max = mu xi(4) 1.8e-3 f_n^1.254). k is held at 0.5 (the elliptic cone)."""
+    at a bound, mu is within 5 % and tau_max(f_n) at 1-10 N within 3 % of the MuJoCo pad's (the
+    scene's mu; tau_max = mu xi(4) 1.8e-3 f_n^1.254). The identification chose the elliptic
+    limit surface (k = 0, MuJoCo's elliptic cone), and sigma_z, not significant on the loading
+    runs, is fixed by the stated rule (the observer's stick mode critically damped)."""
     path = FITS / f"{name}.yaml"
     p = ContactParams.from_yaml(path)
     st = IP.fit_status(path)
@@ -82,12 +84,19 @@ def test_shipped_fit_loads_is_not_at_a_bound_and_matches_mujoco(name):
     assert st["at_bound"] == []
     doc = yaml.safe_load(path.read_text())
     assert "observer" in doc
-    assert p.k == 0.5 and not doc["contact"]["k"].get("free", False)
+    assert p.k == 0.0  # the ellipse
+    sz = doc["contact"]["sigma_z"]
+    if name == "pad":
+        assert not sz["free"] and "critically damped" in sz["note"]
+        # the rule at the stage sigma0 (the refinement moves sigma0 by < 1 %)
+        assert p.sigma_z == pytest.approx(2.0 * math.sqrt(p.sigma0 / 1e7), rel=0.02)
+        stages = " ".join(doc["identification"]["stages"]["report"])
+        assert "the ellipse is kept" in stages
     mu_true = 0.7 if name == "pad" else sc.load_scenario(IP.OBJECTS[name]).params.mu
     assert p.mu == pytest.approx(mu_true, rel=0.05)
     true = IP.pad_rig(mu_true).pad
     for f in (1.0, 4.0, 10.0):
-        assert _tau_max(p, f) == pytest.approx(float(true.tau_max(f)), rel=0.05)
+        assert _tau_max(p, f) == pytest.approx(float(true.tau_max(f)), rel=0.03)
     if name != "pad":  # only mu refitted: the rest is the pad file's
         pad = ContactParams.from_yaml(FITS / "pad.yaml")
         assert (p.sigma0, p.sigma_z, p.delta, p.gamma, p.beta_a) == (
@@ -100,37 +109,31 @@ def test_shipped_fit_loads_is_not_at_a_bound_and_matches_mujoco(name):
 
 
 def test_every_mujoco_scenario_has_its_identified_file():
-    """Consistency: every scenario's object has a shipped fit next to the presets (the scenes
-    still run the preset sigma_z by default: with the identified files they drop objects,
-    validation/mujoco/README.md), and its scenario file names it."""
+    """Consistency: every scenario's MuJoCo estimator is its object's identified file."""
     names = sc.list_scenarios(suite="all")
     assert len(names) == len(IP.SCENARIO_OBJECT)
     for n in names:
         s = sc.load_scenario(n)
         path = data_dir("objects") / "mujoco" / f"{IP.SCENARIO_OBJECT[n]}.yaml"
         assert ContactParams.from_yaml(path) != s.params
-        assert f"mujoco/{IP.SCENARIO_OBJECT[n]}.yaml" in s.source.read_text()
+        assert s.estimator_for("mujoco").resolve() == path.resolve()
 
 
 def test_missing_estimator_file_is_a_clear_error(tmp_path):
     """A scenario naming a parameter file that does not exist fails at load, naming it."""
     src = (ROOT / "scenarios" / "unseen" / "box_heavy.yaml").read_text()
     bad = tmp_path / "box.yaml"
-    assert "  mujoco: {sigma_z: 3.3e-3}" in src
-    bad.write_text(src.replace("  mujoco: {sigma_z: 3.3e-3}", "  mujoco: mujoco/nothing_here.yaml"))
+    assert "mujoco: mujoco/box.yaml" in src
+    bad.write_text(src.replace("mujoco: mujoco/box.yaml", "mujoco: mujoco/nothing_here.yaml"))
     with pytest.raises(ValueError, match="nothing_here.yaml"):
         sc.load_scenario(bad)
 
 
-@pytest.mark.xfail(strict=True, reason="known defect: with the identified pad/object file (its "
-                   "sigma_z and the small beta_A set when the speed is unobservable) the current "
-                   "controller drops exp 2's block on MuJoCo; the scenarios keep the preset "
-                   "sigma_z (validation/mujoco/README.md)")
-def test_short_mujoco_loop_runs_with_the_identified_file():
+def test_short_mujoco_loop_holds_with_the_identified_file():
     """Independent plant: 3 s of exp 2's block on MuJoCo (lift 0.5-1.5 s) with the identified
     small_resin_block file runs, stays finite and in range, keeps both pads on the block and
-    does not drop it. The hold criteria (1 mm, 1 deg) are not asserted: with these parameters
-    the block turns on the pads (validation/mujoco/README.md reports by how much)."""
+    holds it from the lift start on: slip <= 1 mm and rotation <= 1 deg (the scenarios'
+    hold criteria)."""
     block = {
         "model": "patch",
         "contact": "small_resin_block",
@@ -152,13 +155,16 @@ def test_short_mujoco_loop_runs_with_the_identified_file():
     i0 = r.index(0.5)
     assert np.all((r["command"] >= 0.1) & (r["command"] <= 20.0))
     assert r["gripper_y"][-1] == pytest.approx(0.05, abs=1e-3)
-    assert np.mean(r["command"][i0:]) > 2.0  # it grips (more than the 1.2 N per pad of weight)
+    slip = np.asarray(r["slip"][i0:]) - r["slip"][i0]
+    rot = np.asarray(r["rotation"][i0:]) - r["rotation"][i0]
+    assert np.max(np.abs(slip)) <= 1e-3
+    assert np.degrees(np.max(np.abs(rot))) <= 1.0
 
 
 def test_regenerated_pad_fit_is_near_the_shipped_one(tmp_path):
     """Independent plant: the pad fit regenerated by the script on 24 maneuvers (seed 0)
     lands within 5 % of the shipped mu and tau_max(1-10 N) and within 15 % of its sigma0
-    (sigma_z is not compared: 0.059 here against 0.095 shipped, see the README)."""
+    (sigma_z follows from sigma0 by the stage rule when the loading runs leave it open)."""
     rc = IP.main(
         [
             "--only",

@@ -57,12 +57,11 @@ SCENARIO_OBJECT = {v: k for k, v in OBJECTS.items()} | {"exp4_aluminium_can_full
 PAD_SCENE = "exp2_small_resin_block"
 PAD_SEED = 0  #: the pad data set's seed; object k uses PAD_SEED + 101 + k
 PAD_MANEUVERS = 160
-OBJECT_MANEUVERS = 40
-#: the pad fit holds the pressure exponent at its lower bound 0.5: with k free, identify's
-#: limit-surface stage ends there and fails the fit, because MuJoCo's elliptic cone is more
-#: elliptic than any pressure profile of the model's family (validation/mujoco/README.md);
-#: 0.5 is the family's closest member, so it is held there and reported
-PAD_K = 0.5
+OBJECT_MANEUVERS = 80  #: 40 left mu and delta confounded (CoRs |c~| <= 0.65 only)
+#: the pad fit's limit-surface shape: identify's default ('free': the pressure family and the
+#: elliptic limit surface both fitted, the lower RMS distance kept; on MuJoCo's elliptic cone
+#: that is the ellipse, k = 0)
+PAD_K = "free"
 #: the object refits free mu only: MuJoCo's friction is Coulomb, the pad fit finds no speed
 #: dependence (beta_A "not observable"), and freeing beta_A as well lets the velocity-error
 #: cost trade mu for a large beta_A (mu 0.05-0.46 for true 0.6-0.9, validation/mujoco/README.md)
@@ -189,7 +188,8 @@ def main(argv=None) -> int:
     ap.add_argument(
         "--pad-k",
         default=str(PAD_K),
-        help="identify's --k for the pad fit ('free': identify's default, k identified)",
+        help="identify's --k for the pad fit (default 'free': identify's default, the shape "
+        "identified; a number holds k there)",
     )
     ap.add_argument("--out-dir", type=Path, default=ROOT / "objects" / "mujoco")
     ap.add_argument("--cache", type=Path, default=ROOT / "build" / "mujoco_ident")
@@ -229,7 +229,7 @@ def main(argv=None) -> int:
             scene = OBJECTS[name]
             mu = load_scenario(scene).params.mu
             rig = pad_rig(mu, scene)
-            seed = args.seed + 101 + i
+            seed = args.seed + 101 + list(OBJECTS).index(name)
             d = args.cache / f"{name}_n{args.object_maneuvers}_s{seed}"
             print(f"{name}: {args.object_maneuvers} maneuvers, seed {seed}, mu {mu}")
             rubbing_data(rig, args.object_maneuvers, seed, d, args.force)

@@ -156,7 +156,28 @@ def identify(
     guess_notes: dict[str, str] = {n: "params0" for n in PARAMETERS}
     if staged:
         kk = k if k is not None else (p_given.k if p_given is not None else None)
-        stage = staged_estimate(mans, k=kk, c_max=cm, fix_gamma=fix_gamma)
+        o_given = (
+            {n: v for n, v in observer.items() if v is not None}
+            if isinstance(observer, Mapping)
+            else observer
+        )
+        p_any = p_given if p_given is not None else ContactParams(0.5, 1e6, 1.0, 0.01, 1e-3, 0.25)
+        _, od = _observer_settings(o_given, p_any)  # the settings only: any valid parameters
+        # the largest gain the observer may use: its gain_max in bandwidth mode, else its gain
+        l_max = float(od["gain_max"] if od.get("gain_mode") == "bandwidth" else od["gain"])
+        # an object refit from the fingertip's parameters (params0, delta and gamma not
+        # free): the limit surface is fitted with the fingertip's delta and gamma held, so
+        # that mu is the one that fits this object's sliding wrench with them (the paper's
+        # Table 2 step); with delta free the stage would split mu delta differently
+        hold = p_given is not None and "delta" not in free_list and "gamma" not in free_list
+        stage = staged_estimate(
+            mans,
+            k=kk,
+            c_max=cm,
+            fix_gamma=p_given.gamma if hold else fix_gamma,
+            fix_delta=p_given.delta if hold else None,
+            gain_max=l_max,
+        )
         base = stage.params if p_given is None else p_given.replace(k=stage.params.k)
         p0 = base.replace(**{n: getattr(stage.params, n) for n in free})
         guess_notes = {n: "stages" for n in PARAMETERS}

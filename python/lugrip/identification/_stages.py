@@ -225,21 +225,28 @@ _HI = {
 
 
 def fit_limit_surface(
-    pts: SlidingPoints, *, gamma: float | None = None, k: float | None = None, viscous: bool = True
+    pts: SlidingPoints,
+    *,
+    gamma: float | None = None,
+    k: float | None = None,
+    viscous: bool = True,
+    delta: float | None = None,
 ) -> LimitSurfaceFit:
-    """Fit stage (a) (and (c) with ``viscous``) to the sliding points. ``gamma`` / ``k``
-    given: held at that value (k = 0: the elliptic limit surface)."""
+    """Fit stage (a) (and (c) with ``viscous``) to the sliding points. ``gamma`` / ``k`` /
+    ``delta`` given: held at that value (k = 0: the elliptic limit surface)."""
     if len(pts) < 3:
         raise ValueError("fewer than 3 gross-sliding points")
     elliptic = k is not None and k == ELLIPSE_K
     curves = (lambda _ik: _ellipse_curves()) if elliptic else _curves
     names = (
-        ["mu", "delta"]
+        ["mu"]
+        + (["delta"] if delta is None else [])
         + (["gamma"] if gamma is None else [])
         + (["inv_k"] if k is None else [])
         + (["kappa"] if viscous else [])
     )
     fixed = {
+        "delta": delta,
         "gamma": gamma,
         "inv_k": None if k is None else (math.nan if elliptic else (0.0 if math.isinf(k) else 1.0 / k)),
         "kappa": 0.0,
@@ -249,7 +256,7 @@ def fit_limit_surface(
     def unpack(x):
         d = dict(zip(names, x))
         mu = math.exp(d["mu"])
-        delta = math.exp(d["delta"])
+        delta = math.exp(d["delta"]) if "delta" in d else fixed["delta"]
         g_ = d.get("gamma", fixed["gamma"])
         ik = d.get("inv_k", fixed["inv_k"])
         kap = d.get("kappa", fixed["kappa"])
@@ -430,10 +437,10 @@ def fit_presliding(
             zd = W[:, n] - s0 * np.abs(W[:, n]) * z / Gm[:, n]
             zd_all[:, n] = zd
             out[:, n] = s0 * z + sz * zd + S1[:, n] * W[:, n]
-        return out
+        return out, zd_all
 
     def resid(x):
-        out = model(math.exp(x[0]), x[1])
+        out, _ = model(math.exp(x[0]), x[1])
         return ((Y - out) / Gm)[mask]
 
     # start: the stiffness that builds the capacity g over the slip angle of the loading
@@ -456,7 +463,11 @@ def fit_presliding(
             )
             if best is None or r.cost < best.cost:
                 best = r
-    J, res = best.jac, best.fun
+    J, res = np.array(best.jac), best.fun
+    # sigma_z enters linearly: its column exactly (a relative finite-difference step is
+    # zero at sigma_z = 0, the bound where a contact without micro-damping ends)
+    _, zd = model(math.exp(best.x[0]), best.x[1])
+    J[:, 1] = -(zd / Gm)[mask]
     cl = np.broadcast_to(cluster[:, None], (R, L))[mask]
     bread = np.linalg.pinv(J.T @ J)
     meat = np.zeros((2, 2))

@@ -88,9 +88,12 @@ def staged_estimate(
     k: float | None,
     c_max: float,
     fix_gamma: float | None,
+    fix_delta: float | None = None,
     resolution_max: float = RESOLUTION_MAX,
+    gain_max: float = 1.0e7,
 ) -> StageEstimate:
-    """Run stages (a)-(c) and (b) on the maneuvers.
+    """Run stages (a)-(c) and (b) on the maneuvers (``gain_max``: the largest observer gain
+    l [1/(kg m^2)], for the stick-mode damping of a sigma_z the loading runs leave open).
 
     Raises:
         IdentificationError: no gross sliding found, or sliding in fewer than three maneuvers
@@ -128,8 +131,10 @@ def staged_estimate(
         )
     pts = sliding_points(mans, phases)
     # first pass at k = 4 (or the given k): it only has to find sigma0 for the second pass
-    ls = fit_limit_surface(pts, gamma=fix_gamma, k=K_DEFAULT if k is None else k, viscous=True)
-    lines.append(_ls_line(ls, pts, fix_gamma))
+    ls = fit_limit_surface(
+        pts, gamma=fix_gamma, k=K_DEFAULT if k is None else k, viscous=True, delta=fix_delta
+    )
+    lines.append(_ls_line(ls, pts, fix_gamma, fix_delta))
     # (c) viscous shear: significance and observability
     tn = noise.torque if math.isfinite(noise.torque) else 1.0e-5
     _, resolution, observable, beta, line = _viscous(ls, pts, tn, c_max, resolution_max)
@@ -161,8 +166,8 @@ def staged_estimate(
                 f"would leave gross sliding in {m2} maneuver(s): the first pass is kept"
             )
     if k is None and not second:  # no second pass: decide about k on the first one's points
-        ls = _fit_ls(pts, fix_gamma, k, lines)
-        lines.append(_ls_line(ls, pts, fix_gamma))
+        ls = _fit_ls(pts, fix_gamma, k, lines, fix_delta)
+        lines.append(_ls_line(ls, pts, fix_gamma, fix_delta))
         _, resolution, observable, beta, line = _viscous(ls, pts, tn, c_max, resolution_max)
         lines.append(line)
         probe = probe.replace(mu=ls.mu, delta=ls.delta, gamma=ls.gamma, k=ls.k)
@@ -170,8 +175,8 @@ def staged_estimate(
         pre = fit_presliding(mans, phases, p_ls)
     if pre is not None and second:
         pts = sliding_points(mans, phases)
-        ls = _fit_ls(pts, fix_gamma, k, lines)
-        lines.append(_ls_line(ls, pts, fix_gamma))
+        ls = _fit_ls(pts, fix_gamma, k, lines, fix_delta)
+        lines.append(_ls_line(ls, pts, fix_gamma, fix_delta))
         _, resolution, observable, beta, line = _viscous(ls, pts, tn, c_max, resolution_max)
         lines.append(line)
         probe = probe.replace(mu=ls.mu, delta=ls.delta, gamma=ls.gamma, k=ls.k)
@@ -186,12 +191,16 @@ def staged_estimate(
     else:
         sigma0 = pre.sigma0
         sz_sig = pre.stderr["sigma_z"] > 0 and pre.sigma_z >= 2.0 * pre.stderr["sigma_z"]
-        # without measurable micro-damping keep the observer's stick mode damped at a bristle
-        # time constant sigma_z / sigma0 of 10 ms (shorter than the loading runs, which show
-        # no damping). Not the fit's upper 2-sigma value: where the loading runs leave sigma_z
-        # undetermined its standard error is huge, and so heavy a damping stops the observer's
-        # bristle from reaching its sliding bound (S stays low in gross sliding).
-        sigma_z = pre.sigma_z if sz_sig else SIGMA_Z_TIME * sigma0
+        # without measurable micro-damping (docs/identification.md, stage (b)): where the
+        # loading runs bound sigma_z (upper two-sigma value below a bristle time constant
+        # sigma_z / sigma0 of 10 ms), the smallest sigma_z that damps the observer's stick mode
+        # critically at its largest gain, (sigma_z + sigma_1) sqrt(l / sigma0) / 2 = 1 with
+        # sigma_1 -> 0, kept inside that bound; where they leave it open, the 10 ms value
+        sz_upper = max(pre.sigma_z, 0.0) + 2.0 * pre.stderr["sigma_z"]
+        sz_rule = SIGMA_Z_TIME * sigma0
+        sz_damp = 2.0 * math.sqrt(sigma0 / gain_max)
+        bounded = not sz_sig and sz_upper < sz_rule
+        sigma_z = pre.sigma_z if sz_sig else (min(sz_damp, sz_upper) if bounded else sz_rule)
         lines.append(
             f"(b) presliding from {pre.runs} loading runs ({pre.samples} samples): sigma0 "
             f"{sigma0:.4g} +- {pre.stderr['sigma0']:.2g} N m/rad, sigma_z "
@@ -199,6 +208,10 @@ def staged_estimate(
             + (
                 ""
                 if sz_sig
+                else f" (not significant, at most {sz_upper:.3g} at two sigma: set to "
+                f"{sigma_z:.3g}, the observer's stick mode critically damped at its gain "
+                f"{gain_max:.3g})"
+                if bounded
                 else f" (not significant: set to {sigma_z:.3g}, a bristle time constant of "
                 f"{1e3 * SIGMA_Z_TIME:g} ms)"
             )
@@ -212,6 +225,12 @@ def staged_estimate(
             sigma_z,
             max(pre.stderr["sigma_z"] / max(sigma_z, 1e-300), misfit, 0.5) if sz_sig else 1.0,
         )
+        if bounded:  # the eq. 32 cost would move it for omega_hat's noise, not for the data
+            fixed["sigma_z"] = (
+                f"not significant on the loading runs (at most {sz_upper:.3g} at two sigma); "
+                "the observer's stick mode critically damped at its largest gain "
+                f"{gain_max:.3g} (a bristle time constant of {1e3 * sigma_z / sigma0:.2g} ms)"
+            )
     params = p_ls.replace(sigma0=sigma0, sigma_z=sigma_z)
     if not observable:
         fixed["beta_a"] = "sliding speed not observable on these data"
@@ -235,15 +254,15 @@ K_DEFAULT = 4.0  # pressure exponent held when the data do not determine k (the 
 K_GAIN = 0.95  # a free k must lower the RMS distance to the surface below this fraction
 
 
-def _fit_ls(pts, fix_gamma, k, lines: list) -> LimitSurfaceFit:
+def _fit_ls(pts, fix_gamma, k, lines: list, fix_delta=None) -> LimitSurfaceFit:
     """Stage (a)+(c), choosing the limit-surface shape. In the pressure family k is free and
     kept only when it lowers the RMS distance to the surface by more than 5 % against k = 4
     (else k is not determined by the data and held at 4). The elliptic limit surface (no
     shape parameter) is fitted too; the shape with the lower RMS distance is kept."""
     if k is not None:
-        return fit_limit_surface(pts, gamma=fix_gamma, k=k, viscous=True)
-    free = fit_limit_surface(pts, gamma=fix_gamma, k=None, viscous=True)
-    held = fit_limit_surface(pts, gamma=fix_gamma, k=K_DEFAULT, viscous=True)
+        return fit_limit_surface(pts, gamma=fix_gamma, k=k, viscous=True, delta=fix_delta)
+    free = fit_limit_surface(pts, gamma=fix_gamma, k=None, viscous=True, delta=fix_delta)
+    held = fit_limit_surface(pts, gamma=fix_gamma, k=K_DEFAULT, viscous=True, delta=fix_delta)
     pressure = free
     if not free.residual_rms < K_GAIN * held.residual_rms:
         lines.append(
@@ -252,7 +271,7 @@ def _fit_ls(pts, fix_gamma, k, lines: list) -> LimitSurfaceFit:
             f"held at {K_DEFAULT:g}"
         )
         pressure = held
-    ellipse = fit_limit_surface(pts, gamma=fix_gamma, k=ELLIPSE_K, viscous=True)
+    ellipse = fit_limit_surface(pts, gamma=fix_gamma, k=ELLIPSE_K, viscous=True, delta=fix_delta)
     keep = ellipse if ellipse.residual_rms < pressure.residual_rms else pressure
     rms = {"pressure": pressure.residual_rms, "ellipse": ellipse.residual_rms}
     bound = f" (at its bound: {', '.join(pressure.at_bound)})" if pressure.at_bound else ""
@@ -270,14 +289,15 @@ def _k_text(k: float) -> str:
     return "inf" if math.isinf(k) else f"{k:.3g}"
 
 
-def _ls_line(ls: LimitSurfaceFit, pts, fix_gamma) -> str:
+def _ls_line(ls: LimitSurfaceFit, pts, fix_gamma, fix_delta=None) -> str:
     kk = _k_text(ls.k)
     return (
         f"(a) limit surface from {len(pts)} sliding points ({int(pts.samples.sum())} samples, "
         f"{np.unique(pts.maneuver).size} maneuvers, |c~| {np.min(ls.c_abs):.2g}-"
         f"{np.max(ls.c_abs):.2g}, f_n {pts.f_n.min():.3g}-{pts.f_n.max():.3g} N): "
-        f"mu {ls.mu:.4g} +- {ls.stderr['mu']:.2g}, delta {ls.delta:.4g} +- "
-        f"{ls.stderr['delta']:.2g}, gamma {ls.gamma:.4g}"
+        f"mu {ls.mu:.4g} +- {ls.stderr['mu']:.2g}, delta {ls.delta:.4g}"
+        + (f" +- {ls.stderr['delta']:.2g}" if fix_delta is None else " (fixed)")
+        + f", gamma {ls.gamma:.4g}"
         + ("" if fix_gamma is None else " (fixed)")
         + f", k {kk}; RMS distance to the surface {ls.residual_rms:.3g} (normalised)"
     )
