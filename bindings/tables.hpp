@@ -127,8 +127,9 @@ struct Table<GraspControllerSettings> {
       field("pivot_end_c_tilde", &S::pivot_end_c_tilde, "pivoting ends above this mean |c~| [-]"),
       field("pivot_end_samples", &S::pivot_end_samples, "consecutive samples above the threshold"),
       field("pivot_timeout", &S::pivot_timeout, "pivoting timeout (inf: off) [s]"),
-      field("pivot_end_hold", &S::pivot_end_hold, "pivoting end criterion held this long [s]"),
-      field("pivot_end_at_floor", &S::pivot_end_at_floor, "pivot end counts only at the floor"));
+      field("pivot_end_filter", &S::pivot_end_filter, "low-pass time constant on mean |c~| of the pivot end [s]"),
+      field("pivot_end_at_floor", &S::pivot_end_at_floor, "pivot end counts only at the floor"),
+      field("pivot_floor_time", &S::pivot_floor_time, "pivoting ends after this long at the floor (inf: off) [s]"));
 };
 
 template <>

@@ -58,7 +58,7 @@ bool validate(const GraspControllerSettings& s, std::string* message) {
   constexpr double kPoleMin = 1.0e-9, kCornerMax = 1.0e12;  // [rad/s] p_cd, z_cd
   constexpr double kForceMin = 1.0e-6, kForceMax = 1.0e6;   // [N] f_min, f_max, gain_schedule_force
   constexpr double kPivotMax = 1.0e3;                    // s_pivot (slippage inputs are <= 1e3)
-  constexpr double kHoldMax = 1.0e6;                     // [s] pivot_end_hold
+  constexpr double kHoldMax = 1.0e6;                     // [s] pivot_end_filter
   constexpr double kSlippageMin = 1.0e-3;                // s_ref, feedforward_slippage, reflex_slippage
   std::string msg;
   auto bad = [&](const char* name, double v, const std::string& rule) {
@@ -105,8 +105,9 @@ bool validate(const GraspControllerSettings& s, std::string* message) {
   positive("pivot_end_c_tilde", s.pivot_end_c_tilde);
   if (!(s.pivot_end_samples >= 1)) bad("pivot_end_samples", s.pivot_end_samples, "must be >= 1");
   positive_or_inf("pivot_timeout", s.pivot_timeout);
-  if (!(std::isfinite(s.pivot_end_hold) && s.pivot_end_hold >= 0.0 && s.pivot_end_hold <= kHoldMax))
-    bad("pivot_end_hold", s.pivot_end_hold, "must be finite, >= 0 and <= 1e6");
+  positive_or_inf("pivot_floor_time", s.pivot_floor_time);
+  if (!(std::isfinite(s.pivot_end_filter) && s.pivot_end_filter >= 0.0 && s.pivot_end_filter <= kHoldMax))
+    bad("pivot_end_filter", s.pivot_end_filter, "must be finite, >= 0 and <= 1e6");
   within("loop_gain_p", s.loop_gain_p, 0.0, true, kGainMax, " [-]");
   within("loop_gain_i", s.loop_gain_i, 0.0, true, kGainMax, " [1/s]");
   if (s.slope_gain && s.gain_schedule_force > 0.0)
@@ -145,8 +146,9 @@ std::string to_string(const GraspControllerSettings& s) {
          ", pivot_floor_factor=" + num(s.pivot_floor_factor) +
          ", pivot_end_c_tilde=" + num(s.pivot_end_c_tilde) +
          ", pivot_end_samples=" + std::to_string(s.pivot_end_samples) +
-         ", pivot_timeout=" + num(s.pivot_timeout) + ", pivot_end_hold=" + num(s.pivot_end_hold) +
-         ", pivot_end_at_floor=" + flag(s.pivot_end_at_floor) + ", slope_gain=" + flag(s.slope_gain) +
+         ", pivot_timeout=" + num(s.pivot_timeout) + ", pivot_end_filter=" + num(s.pivot_end_filter) +
+         ", pivot_end_at_floor=" + flag(s.pivot_end_at_floor) +
+         ", pivot_floor_time=" + num(s.pivot_floor_time) + ", slope_gain=" + flag(s.slope_gain) +
          ", loop_gain_p=" + num(s.loop_gain_p) + ", loop_gain_i=" + num(s.loop_gain_i) +
          ", feedforward=" + flag(s.feedforward) + ", feedforward_slippage=" + num(s.feedforward_slippage) +
          ", slip_reflex=" + flag(s.slip_reflex) + ", reflex_slippage=" + num(s.reflex_slippage) +
@@ -169,6 +171,7 @@ const char* to_string(PivotEnd e) noexcept {
     case PivotEnd::CorThreshold: return "mean |c~| above the threshold";
     case PivotEnd::Timeout: return "timeout";
     case PivotEnd::Requested: return "slipping avoidance requested";
+    case PivotEnd::AtFloor: return "held at the floor";
   }
   return "unknown";
 }
@@ -195,6 +198,7 @@ GraspController::GraspController(const ContactModel& model, const GraspControlle
   dt_ = 1.0 / s_.sensor_rate;
   t_cmd_ = s_.command_ratio * dt_;
   pivot_decay_ = std::exp(-t_cmd_ / s_.tau_pivot);
+  pivot_c_alpha_ = s_.pivot_end_filter > 0.0 ? 1.0 - std::exp(-dt_ / s_.pivot_end_filter) : 1.0;
   for (auto& f : cd_) f = LagFilter(s_.k_cd, s_.z_cd, s_.p_cd, dt_);
   reset(s_.f_min);
 }
@@ -210,6 +214,8 @@ void GraspController::reset(double current_force) noexcept {
   pivot_samples_ = 0;
   pivot_count_ = 0;
   pivot_at_floor_ = false;
+  pivot_floor_samples_ = 0;
+  pivot_c_init_ = true;
   last_f_t_ = 0.0;
   last_kp_ = last_e_ = 0.0;
   clear_period();
@@ -249,6 +255,7 @@ void GraspController::set_settings(const GraspControllerSettings& settings) {
   s_ = next;
   set_dynamic_enabled(dynamic);
   pivot_decay_ = std::exp(-t_cmd_ / s_.tau_pivot);
+  pivot_c_alpha_ = s_.pivot_end_filter > 0.0 ? 1.0 - std::exp(-dt_ / s_.pivot_end_filter) : 1.0;
   command_ = clamp(command_, s_.f_min, s_.f_max);
   last_.force = command_;
 }
@@ -289,6 +296,8 @@ Status GraspController::step(const GraspControllerInput& in, GraspControllerOutp
     pivot_samples_ = 0;
     pivot_count_ = 0;
     pivot_at_floor_ = false;
+    pivot_floor_samples_ = 0;
+    pivot_c_init_ = true;
     peak_ = 0.0;
   } else if (request_ == Request::Avoid && mode_ == ControllerMode::Pivoting) {
     end_pivot(PivotEnd::Requested, out);
@@ -367,16 +376,24 @@ Status GraspController::step(const GraspControllerInput& in, GraspControllerOutp
   // End of the pivoting manoeuvre, tested at every sensor sample.
   if (mode_ == ControllerMode::Pivoting) {
     ++pivot_samples_;
-    // With pivot_end_at_floor the criterion counts only once the force cannot fall further: a
-    // swing through the vertical passes |c~| > 1 while the torque reverses (docs/controller.md).
+    // With pivot_end_at_floor the criterion counts only once the force cannot fall further, on
+    // the low-passed mean |c~|: a swing through the vertical passes |c~| > 1 for a few samples
+    // while the torque reverses (docs/controller.md).
+    if (valid) {
+      pivot_c_filtered_ = pivot_c_init_ ? out.mean_c_tilde
+                                        : pivot_c_filtered_ + pivot_c_alpha_ * (out.mean_c_tilde - pivot_c_filtered_);
+      pivot_c_init_ = false;
+    }
     const bool settled = !s_.pivot_end_at_floor || pivot_at_floor_;
-    if (valid && settled && out.mean_c_tilde > s_.pivot_end_c_tilde)
+    if (valid && settled && pivot_c_filtered_ > s_.pivot_end_c_tilde)
       pivot_count_ = pivot_count_ < kCountMax ? pivot_count_ + 1 : pivot_count_;
     else
       pivot_count_ = 0;
-    if (pivot_count_ >= s_.pivot_end_samples &&
-        (static_cast<double>(pivot_count_) + 0.5) * dt_ >= s_.pivot_end_hold)  // nearest sample
+    pivot_floor_samples_ = pivot_at_floor_ && pivot_floor_samples_ < kCountMax ? pivot_floor_samples_ + 1 : 0;
+    if (pivot_count_ >= s_.pivot_end_samples)
       end_pivot(PivotEnd::CorThreshold, out);
+    else if (static_cast<double>(pivot_floor_samples_) * dt_ >= s_.pivot_floor_time)
+      end_pivot(PivotEnd::AtFloor, out);
     else if (static_cast<double>(pivot_samples_) * dt_ >= s_.pivot_timeout)
       end_pivot(PivotEnd::Timeout, out);
   }

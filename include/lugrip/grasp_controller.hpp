@@ -146,12 +146,15 @@ struct GraspControllerSettings {
   double pivot_end_c_tilde = 1.0;   //!< (*) pivoting ends when mean |c~_i| exceeds this, > 0
   int pivot_end_samples = 3;        //!< (*) ... on this many consecutive samples, >= 1
   double pivot_timeout = 10.0;      //!< (*) [s] pivoting ends after this time, > 0 (inf: never)
-  //! (*) [s] the end criterion must also hold this long without a break, >= 0, finite
-  //! (0: pivot_end_samples alone, the paper's law)
-  double pivot_end_hold = 0.2;
+  //! (*) [s] time constant of the first-order low-pass on the mean |c~_i| that the end test
+  //! compares, >= 0, finite (0: the sample itself, the paper's law)
+  double pivot_end_filter = 0.2;
   //! (*) the end criterion counts only while the pivoting filter is held at its floor, i.e. the
   //! force cannot fall further (false: from the first pivoting sample, the paper's law)
   bool pivot_end_at_floor = true;
+  //! (*) [s] pivoting also ends once the filter has been held at its floor this long, > 0
+  //! (inf: never, the paper's law)
+  double pivot_floor_time = 1.0;
 };
 
 //! Checks every field; one line per bad field ("k_p = -1: must be finite and > 0") in *message
@@ -173,6 +176,7 @@ enum class PivotEnd : int {
   CorThreshold = 1,  //!< mean |c~| > pivot_end_c_tilde on pivot_end_samples consecutive samples
   Timeout = 2,       //!< pivot_timeout elapsed
   Requested = 3,     //!< request_slipping_avoidance() while pivoting
+  AtFloor = 4,       //!< the pivoting filter was held at its floor for pivot_floor_time
 };
 
 const char* to_string(ControllerMode m) noexcept;
@@ -301,9 +305,10 @@ class StaticForceSolver {
 //! * Pivoting: f_nd = 0; tau_p df/dt = -f + k_f (S - s_pivot), exact discretisation at the
 //!   command rate, started from the last command; floor max(f_min, factor max_i |f_t,i| / mu)
 //!   on the output and the filter state; ends on mean |c~_i| > pivot_end_c_tilde for
-//!   pivot_end_samples consecutive sensor samples and pivot_end_hold seconds (counted, with
-//!   pivot_end_at_floor, only while the filter is held at the floor), on timeout or on
-//!   request, then returns to
+//!   pivot_end_samples consecutive sensor samples (mean |c~_i| low-passed with the time
+//!   constant pivot_end_filter; counted, with pivot_end_at_floor, only while the pivoting filter
+//!   is held at the floor), after pivot_floor_time at the floor, on timeout or on request,
+//!   then returns to
 //!   slipping avoidance bumplessly (I = last command - k_p e at the next command, C_d reset).
 //! * Two fingers (docs/model.md 9.8): S = max_i S_i, f_nd from max_i |C_d omega_hat_i|, pivot end on
 //!   the mean of |c~_i|; absent fingers are ignored.
@@ -383,6 +388,10 @@ class GraspController {
   long pivot_samples_ = 0;    // samples since pivoting started
   int pivot_count_ = 0;       // consecutive samples with mean |c~| above the threshold
   bool pivot_at_floor_ = false;  // the last pivoting command wanted to go below the floor
+  long pivot_floor_samples_ = 0;  // consecutive samples with the filter held at the floor
+  bool pivot_c_init_ = true;     // the low-pass on mean |c~| starts at the next valid sample
+  double pivot_c_filtered_ = 0.0;  // low-passed mean |c~| of the pivot end test [-]
+  double pivot_c_alpha_ = 1.0;     // its coefficient 1 - exp(-dt / pivot_end_filter)
   double last_f_t_ = 0.0;     // last valid max_i |f_t,i| [N] (pivot floor)
   double last_kp_ = 0.0;      // k_p of the last command [N] (bumpless gain change)
   double last_e_ = 0.0;       // proportional error of the last command [-]

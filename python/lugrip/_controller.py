@@ -7,6 +7,7 @@ Thin layer over the C++ ``lugrip::GraspController`` and ``lugrip::StaticForceSol
 from __future__ import annotations
 
 import enum
+import math
 from dataclasses import make_dataclass
 from typing import Any
 
@@ -54,8 +55,9 @@ PAPER_SETTINGS: dict[str, Any] = {
     "feedforward_horizon": 0.0,
     "reaction_lag": 0.0,
     "react_when_invalid": False,
-    "pivot_end_hold": 0.0,
+    "pivot_end_filter": 0.0,
     "pivot_end_at_floor": False,
+    "pivot_floor_time": math.inf,
 }
 
 
@@ -73,6 +75,7 @@ class PivotEnd(enum.IntEnum):
     COR_THRESHOLD = 1  #: mean |c~| > pivot_end_c_tilde on pivot_end_samples consecutive samples
     TIMEOUT = 2
     REQUESTED = 3
+    AT_FLOOR = 4  #: the pivoting filter held at its floor for pivot_floor_time
 
 
 def _code(e) -> int:
@@ -194,7 +197,8 @@ class GraspController:
             range (f_min, f_max [N]), rate
             limits (max_rate_up, max_rate_down [N/s], inf = off), invalid_raise_step [N], pivoting
             (s_pivot, tau_pivot [s], k_f [N], pivot_floor_factor, pivot_end_c_tilde,
-            pivot_end_samples, pivot_timeout [s], pivot_end_hold [s], pivot_end_at_floor).
+            pivot_end_samples, pivot_timeout [s], pivot_end_filter [s], pivot_end_at_floor,
+            pivot_floor_time [s]).
 
     Raises:
         ValueError: unknown or invalid setting (one line per bad field) or invalid params.

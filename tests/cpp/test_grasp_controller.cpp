@@ -33,8 +33,9 @@ GraspControllerSettings paper_law(GraspControllerSettings s = {}) {
   s.feedforward_horizon = 0.0;
   s.reaction_lag = 0.0;
   s.react_when_invalid = false;
-  s.pivot_end_hold = 0.0;  // the paper's pivot end: pivot_end_samples from the first sample
+  s.pivot_end_filter = 0.0;  // the paper's pivot end: pivot_end_samples from the first sample
   s.pivot_end_at_floor = false;
+  s.pivot_floor_time = kInf;
   return s;
 }
 

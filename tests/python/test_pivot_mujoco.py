@@ -50,7 +50,7 @@ def test_default_pivot_hangs_the_bottle_within_5_deg_of_vertical():
 
 
 def test_paper_pivot_end_stops_at_the_turning_point():
-    paper = {k: PAPER_SETTINGS[k] for k in ("pivot_end_hold", "pivot_end_at_floor")}
+    paper = {k: PAPER_SETTINGS[k] for k in ("pivot_end_filter", "pivot_end_at_floor")}
     m = _bottle(paper)
     assert not m["dropped"]
     assert m["returned_to_avoidance"]
