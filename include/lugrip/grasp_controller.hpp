@@ -158,6 +158,9 @@ struct GraspControllerSettings {
   //! (*) [s] pivoting also ends once the filter has been held at its floor this long, > 0
   //! (inf: never, the paper's law)
   double pivot_floor_time = 1.0;
+  //! (*) [-] the end test counts only while max_i S_i is below this, > 0 (S at the projection
+  //! bound 1 means the contact slides: the object is still turning); inf: off, the paper's law
+  double pivot_end_slippage = 0.99;
 };
 
 //! Checks every field; one line per bad field ("k_p = -1: must be finite and > 0") in *message

@@ -58,6 +58,7 @@ PAPER_SETTINGS: dict[str, Any] = {
     "pivot_end_filter": 0.0,
     "pivot_end_at_floor": False,
     "pivot_floor_time": math.inf,
+    "pivot_end_slippage": math.inf,
 }
 
 
@@ -198,7 +199,7 @@ class GraspController:
             limits (max_rate_up, max_rate_down [N/s], inf = off), invalid_raise_step [N], pivoting
             (s_pivot, tau_pivot [s], k_f [N], pivot_floor_factor, pivot_end_c_tilde,
             pivot_end_samples, pivot_timeout [s], pivot_end_filter [s], pivot_end_at_floor,
-            pivot_floor_time [s]).
+            pivot_floor_time [s], pivot_end_slippage).
 
     Raises:
         ValueError: unknown or invalid setting (one line per bad field) or invalid params.
