@@ -179,7 +179,7 @@ enum class ControllerMode : int {
 //! Why pivoting ended (reported in the call where it ends). Stable integer values.
 enum class PivotEnd : int {
   None = 0,          //!< pivoting did not end in this call
-  CorThreshold = 1,  //!< mean |c~| > pivot_end_c_tilde on pivot_end_samples consecutive samples
+  CorThreshold = 1,  //!< (low-passed) mean |c~| > pivot_end_c_tilde on pivot_end_samples samples
   Timeout = 2,       //!< pivot_timeout elapsed
   Requested = 3,     //!< request_slipping_avoidance() while pivoting
   AtFloor = 4,       //!< the pivoting filter was held at its floor for pivot_floor_time
@@ -313,7 +313,8 @@ class StaticForceSolver {
 //!   on the output and the filter state; ends on mean |c~_i| > pivot_end_c_tilde for
 //!   pivot_end_samples consecutive sensor samples (mean |c~_i| low-passed with the time
 //!   constant pivot_end_filter; counted, with pivot_end_at_floor, only while the pivoting filter
-//!   is held at the floor), after pivot_floor_time at the floor, on timeout or on request,
+//!   is held at the floor, and only while max_i S_i < pivot_end_slippage), after
+//!   pivot_floor_time at the floor, on timeout or on request,
 //!   then returns to
 //!   slipping avoidance bumplessly (I = last command - k_p e at the next command, C_d reset).
 //! * Two fingers (docs/model.md 9.8): S = max_i S_i, f_nd from max_i |C_d omega_hat_i|, pivot end on
