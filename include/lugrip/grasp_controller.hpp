@@ -29,10 +29,7 @@ struct GraspControllerSettings {
   bool dynamic_enabled = true;  //!< (*) dynamic part active in slipping avoidance
 
   // --- static part in slipping avoidance: PI on e = S - s_ref (docs/model.md 9.4) -----------------
-  //! (*) reference of the slippage indicator S-bar_a, in (0, 1); default 0.7 (paper: 0.8): the
-  //! reserve 1/S_ref - 1 of the standing force carries a load rise of ~40 % during the reaction
-  //! latency (docs/controller.md §6)
-  double s_ref = 0.7;
+  double s_ref = 0.8;  //!< (*) reference of the slippage indicator S-bar_a, in (0, 1)
   double k_p = 4.0;    //!< (*) [N] proportional gain (e > 0 raises the force), > 0
   double k_i = 10.0;   //!< (*) [N/s] integral gain, > 0
   bool anti_windup = true;  //!< (*) back-calculation I = f_ns,clipped - k_p e when clipped

@@ -80,7 +80,7 @@ TEST(ControllerSettings, DefaultsAreValidAndMatchThePaper) {
   EXPECT_EQ(s.z_cd, 250.0);
   EXPECT_EQ(s.k_p, 4.0);
   EXPECT_EQ(s.k_i, 10.0);
-  EXPECT_EQ(s.s_ref, 0.7);  // paper 0.8: a larger reserve for the reaction latency
+  EXPECT_EQ(s.s_ref, 0.8);
   EXPECT_EQ(s.sensor_rate / s.command_ratio, 50.0);
   EXPECT_NE(to_string(s).find("k_p=4"), std::string::npos);
 }

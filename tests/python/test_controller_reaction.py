@@ -36,14 +36,17 @@ def _cup_down_pulse(over):
 def test_cup_holds_a_pulse_twice_its_weight():
     """Defaults: the command rises at the command after the edge (trend feed-forward, overshoot
     for the gripper's lag, the reflex even on samples where a pad briefly loses contact); the cup
-    slides < 1 mm and the force is back below 2x its pre-pulse value 0.3 s after the pulse."""
+    stays in the grasp (it slides ~1 mm on the standing reserve of S_ref = 0.8 before the force
+    arrives); 0.3 s after the pulse the PI (loop_gain_i = 2/s) has drained the command below 60 %
+    of its peak."""
     run, slip = _cup_down_pulse({})
     assert run.scene["status"] == "ok"
-    assert slip < 1e-3
+    assert slip < 1.5e-3
     t, cmd = run["t"], run["command"]
     before = float(np.mean(cmd[(t > 3.2) & (t < 3.5)]))
-    assert float(np.max(cmd[(t > 3.5) & (t < 3.56)])) > 1.5 * before  # within the edge + 2 commands
-    assert float(np.mean(cmd[(t > 4.0 - 0.1)])) < 2.0 * before
+    peak = float(np.max(cmd[(t > 3.5) & (t < 3.56)]))
+    assert peak > 1.5 * before  # within the edge + 2 commands
+    assert float(np.mean(cmd[(t > 4.0 - 0.1)])) < 0.6 * peak
 
 
 def test_cup_falls_out_without_the_fast_reaction():

@@ -11,9 +11,13 @@ from the presets the scenes are built with:
    its defaults (staged identification, observer block included): ``objects/mujoco/pad.yaml``.
 2. **Each object** (the paper's Table 2 procedure): rubbing data of the pad on that object's
    friction (the scene's mu), fitted by ``lugrip identify --free mu --params0 pad.yaml``
-   from the limit-surface stage on that object's gross-sliding wrench (``--start data
-   --no-refine``; beta_A only where the data carry it: ``--object-free mu,beta_a``):
-   ``objects/mujoco/<object>.yaml``.
+   from the limit-surface stage on that object's gross-sliding wrench with the pad's delta
+   and gamma held (``--start data --no-refine``; beta_A only where the data carry it:
+   ``--object-free mu,beta_a``): ``objects/mujoco/<object>.yaml``.
+
+The pad's sigma_z is not significant on the loading runs, which bound it near zero; the
+identification then gives the observer the sigma_z that damps its stick mode critically
+(docs/identification.md, stage (b)), and the file's note says so.
 
 Every data set is drawn from a fixed seed, so the files are reproducible; the logs are cached
 under ``build/mujoco_ident/`` (regenerated with ``--force``). A summary of identified against
@@ -57,7 +61,7 @@ SCENARIO_OBJECT = {v: k for k, v in OBJECTS.items()} | {"exp4_aluminium_can_full
 PAD_SCENE = "exp2_small_resin_block"
 PAD_SEED = 0  #: the pad data set's seed; object k uses PAD_SEED + 101 + k
 PAD_MANEUVERS = 160
-OBJECT_MANEUVERS = 80  #: 40 left mu and delta confounded (CoRs |c~| <= 0.65 only)
+OBJECT_MANEUVERS = 80  #: per object (58-71 of them reach gross sliding)
 #: the pad fit's limit-surface shape: identify's default ('free': the pressure family and the
 #: elliptic limit surface both fitted, the lower RMS distance kept; on MuJoCo's elliptic cone
 #: that is the ellipse, k = 0)
@@ -67,7 +71,8 @@ PAD_K = "free"
 #: cost trade mu for a large beta_A (mu 0.05-0.46 for true 0.6-0.9, validation/mujoco/README.md)
 OBJECT_FREE = "mu"
 #: identify's options of the object refits: mu from the limit-surface stage on the object's
-#: gross-sliding wrench (the other parameters from pad.yaml), without the eq. 32 refinement,
+#: gross-sliding wrench with pad.yaml's delta and gamma held (the other parameters from
+#: pad.yaml too), without the eq. 32 refinement,
 #: whose velocity-error cost cannot see mu when the speed is unobservable (it drifts to
 #: 1.1-1.9 for true 0.85-0.9; validation/mujoco/README.md); --object-refine adds it back
 OBJECT_OPTIONS = ("--start", "data", "--no-refine")
