@@ -129,7 +129,8 @@ struct Table<GraspControllerSettings> {
       field("pivot_timeout", &S::pivot_timeout, "pivoting timeout (inf: off) [s]"),
       field("pivot_end_filter", &S::pivot_end_filter, "low-pass time constant on mean |c~| of the pivot end [s]"),
       field("pivot_end_at_floor", &S::pivot_end_at_floor, "pivot end counts only at the floor"),
-      field("pivot_floor_time", &S::pivot_floor_time, "pivoting ends after this long at the floor (inf: off) [s]"));
+      field("pivot_floor_time", &S::pivot_floor_time, "pivoting ends after this long at the floor (inf: off) [s]"),
+      field("pivot_end_slippage", &S::pivot_end_slippage, "pivot end counts only below this S (inf: off) [-]"));
 };
 
 template <>

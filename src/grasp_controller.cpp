@@ -106,6 +106,7 @@ bool validate(const GraspControllerSettings& s, std::string* message) {
   if (!(s.pivot_end_samples >= 1)) bad("pivot_end_samples", s.pivot_end_samples, "must be >= 1");
   positive_or_inf("pivot_timeout", s.pivot_timeout);
   positive_or_inf("pivot_floor_time", s.pivot_floor_time);
+  positive_or_inf("pivot_end_slippage", s.pivot_end_slippage);
   if (!(std::isfinite(s.pivot_end_filter) && s.pivot_end_filter >= 0.0 && s.pivot_end_filter <= kHoldMax))
     bad("pivot_end_filter", s.pivot_end_filter, "must be finite, >= 0 and <= 1e6");
   within("loop_gain_p", s.loop_gain_p, 0.0, true, kGainMax, " [-]");
@@ -148,7 +149,8 @@ std::string to_string(const GraspControllerSettings& s) {
          ", pivot_end_samples=" + std::to_string(s.pivot_end_samples) +
          ", pivot_timeout=" + num(s.pivot_timeout) + ", pivot_end_filter=" + num(s.pivot_end_filter) +
          ", pivot_end_at_floor=" + flag(s.pivot_end_at_floor) +
-         ", pivot_floor_time=" + num(s.pivot_floor_time) + ", slope_gain=" + flag(s.slope_gain) +
+         ", pivot_floor_time=" + num(s.pivot_floor_time) +
+         ", pivot_end_slippage=" + num(s.pivot_end_slippage) + ", slope_gain=" + flag(s.slope_gain) +
          ", loop_gain_p=" + num(s.loop_gain_p) + ", loop_gain_i=" + num(s.loop_gain_i) +
          ", feedforward=" + flag(s.feedforward) + ", feedforward_slippage=" + num(s.feedforward_slippage) +
          ", slip_reflex=" + flag(s.slip_reflex) + ", reflex_slippage=" + num(s.reflex_slippage) +
@@ -384,7 +386,7 @@ Status GraspController::step(const GraspControllerInput& in, GraspControllerOutp
                                         : pivot_c_filtered_ + pivot_c_alpha_ * (out.mean_c_tilde - pivot_c_filtered_);
       pivot_c_init_ = false;
     }
-    const bool settled = !s_.pivot_end_at_floor || pivot_at_floor_;
+    const bool settled = (!s_.pivot_end_at_floor || pivot_at_floor_) && slip < s_.pivot_end_slippage;
     if (valid && settled && pivot_c_filtered_ > s_.pivot_end_c_tilde)
       pivot_count_ = pivot_count_ < kCountMax ? pivot_count_ + 1 : pivot_count_;
     else

@@ -155,6 +155,9 @@ struct GraspControllerSettings {
   //! (*) [s] pivoting also ends once the filter has been held at its floor this long, > 0
   //! (inf: never, the paper's law)
   double pivot_floor_time = 1.0;
+  //! (*) [-] the end test counts only while max_i S_i is below this, > 0 (S at the projection
+  //! bound 1 means the contact slides: the object is still turning); inf: off, the paper's law
+  double pivot_end_slippage = 0.99;
 };
 
 //! Checks every field; one line per bad field ("k_p = -1: must be finite and > 0") in *message
@@ -173,7 +176,7 @@ enum class ControllerMode : int {
 //! Why pivoting ended (reported in the call where it ends). Stable integer values.
 enum class PivotEnd : int {
   None = 0,          //!< pivoting did not end in this call
-  CorThreshold = 1,  //!< mean |c~| > pivot_end_c_tilde on pivot_end_samples consecutive samples
+  CorThreshold = 1,  //!< (low-passed) mean |c~| > pivot_end_c_tilde on pivot_end_samples samples
   Timeout = 2,       //!< pivot_timeout elapsed
   Requested = 3,     //!< request_slipping_avoidance() while pivoting
   AtFloor = 4,       //!< the pivoting filter was held at its floor for pivot_floor_time
@@ -307,7 +310,8 @@ class StaticForceSolver {
 //!   on the output and the filter state; ends on mean |c~_i| > pivot_end_c_tilde for
 //!   pivot_end_samples consecutive sensor samples (mean |c~_i| low-passed with the time
 //!   constant pivot_end_filter; counted, with pivot_end_at_floor, only while the pivoting filter
-//!   is held at the floor), after pivot_floor_time at the floor, on timeout or on request,
+//!   is held at the floor, and only while max_i S_i < pivot_end_slippage), after
+//!   pivot_floor_time at the floor, on timeout or on request,
 //!   then returns to
 //!   slipping avoidance bumplessly (I = last command - k_p e at the next command, C_d reset).
 //! * Two fingers (docs/model.md 9.8): S = max_i S_i, f_nd from max_i |C_d omega_hat_i|, pivot end on

@@ -36,6 +36,7 @@ GraspControllerSettings paper_law(GraspControllerSettings s = {}) {
   s.pivot_end_filter = 0.0;  // the paper's pivot end: pivot_end_samples from the first sample
   s.pivot_end_at_floor = false;
   s.pivot_floor_time = kInf;
+  s.pivot_end_slippage = kInf;
   return s;
 }
 

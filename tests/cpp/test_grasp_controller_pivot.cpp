@@ -20,6 +20,7 @@ constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 constexpr double kInf = std::numeric_limits<double>::infinity();
 constexpr double kDt = 0.002;   // default sensor period [s]
 constexpr double kTcmd = 0.02;  // default command period [s]
+constexpr double kS = 0.95;     // slippage of a contact at rest near its limit (below 0.99)
 
 ContactParams can() { return object_params("aluminium_can"); }  // mu = 0.75
 
@@ -37,11 +38,11 @@ GraspControllerSettings free_rates() {
   return s;
 }
 
-// Time [s] at which the pivoting filter, started from f0 with S = 1 and the default
+// Time [s] at which the pivoting filter, started from f0 with S = kS and the default
 // tau_p = 2 s, k_f = 4, s_pivot = 1.3, first computes an update below `floor`: the commands
-// output f0, f1, ... with f_{n+1} = a f_n + (1 - a) (-1.2); command n happens at n T_cmd.
+// output f0, f1, ... with f_{n+1} = a f_n + (1 - a) k_f (kS - 1.3); command n at n T_cmd.
 double first_command_wanting_below(double f0, double floor) {
-  const double a = std::exp(-kTcmd / 2.0), target = 4.0 * (1.0 - 1.3);
+  const double a = std::exp(-kTcmd / 2.0), target = 4.0 * (kS - 1.3);
   double f = f0;
   for (int n = 0; n < 100000; ++n) {
     const double next = a * f + (1.0 - a) * target;
@@ -105,11 +106,11 @@ TEST(PivotEnd, WaitsForTheFloor) {
   c.reset(6.0);  // the first call after reset computes a command: the pivot starts with it
   GraspControllerOutput out;
   c.request_pivoting();
-  const auto in = one(1.0, 1.4, 0.2);
+  const auto in = one(kS, 1.4, 0.2);
   const double floor = 1.1 * 0.2 / 0.75;
   const double t_floor = first_command_wanting_below(6.0, floor);
-  ASSERT_GT(t_floor, 3.0);  // -1.2 + 7.2 exp(-t / 2) = floor at t = 3.15 s
-  ASSERT_LT(t_floor, 3.3);
+  ASSERT_GT(t_floor, 2.7);  // -1.4 + 7.4 exp(-t / 2) = floor at t = 2.9 s
+  ASSERT_LT(t_floor, 3.1);
   long n = 0;
   double before_end = 0.0;
   do {
@@ -155,7 +156,7 @@ TEST(PivotEnd, ATurningPointAtTheFloorDoesNotEndIt) {
   auto seq = [](int n) { return n < 500 ? 0.4 : n < 550 ? 1.3 : n < 551 ? 0.7 : 1.3; };
   int n = 0;
   do {
-    c.step(one(1.0, n >= 500 && n < 550 ? -seq(n) : seq(n), 0.2), out);  // |c~| is used
+    c.step(one(kS, n >= 500 && n < 550 ? -seq(n) : seq(n), 0.2), out);  // |c~| is used
     ++n;
     if (n <= 551) ASSERT_FALSE(out.pivot_finished) << n;
   } while (!out.pivot_finished && n < 5000);
@@ -176,7 +177,7 @@ TEST(PivotEnd, WithoutTheFloorConditionTheLowPassAloneCounts) {
   auto seq = [](int n) { return n < 100 ? 0.5 : 1.2; };
   int n = 0;
   do {
-    c.step(one(1.0, seq(n), 0.2), out);
+    c.step(one(kS, seq(n), 0.2), out);
     ++n;
   } while (!out.pivot_finished && n < 1000);
   EXPECT_EQ(n, samples_to_end(seq, 0.05));
@@ -189,18 +190,18 @@ TEST(PivotEnd, InvalidSamplesRestartTheCount) {
   c.reset(0.3);  // at the floor (0.293 N) from the first command
   c.request_pivoting();
   GraspControllerOutput out;
-  c.step(one(1.0, 1.3, 0.2), out);  // the command: the filter wants to go below the floor
-  c.step(one(1.0, 1.3, 0.2), out);
-  c.step(one(1.0, 1.3, 0.2), out);
+  c.step(one(kS, 1.3, 0.2), out);  // the command: the filter wants to go below the floor
+  c.step(one(kS, 1.3, 0.2), out);
+  c.step(one(kS, 1.3, 0.2), out);
   EXPECT_FALSE(out.pivot_finished);  // two samples counted
-  GraspControllerInput bad = one(1.0, 1.3, 0.2);
+  GraspControllerInput bad = one(kS, 1.3, 0.2);
   bad.fingers[0].status = Status::SensorFault;
   c.step(bad, out);
   EXPECT_FALSE(out.pivot_finished);
-  c.step(one(1.0, 1.3, 0.2), out);
-  c.step(one(1.0, 1.3, 0.2), out);
+  c.step(one(kS, 1.3, 0.2), out);
+  c.step(one(kS, 1.3, 0.2), out);
   EXPECT_FALSE(out.pivot_finished);
-  c.step(one(1.0, 1.3, 0.2), out);
+  c.step(one(kS, 1.3, 0.2), out);
   EXPECT_TRUE(out.pivot_finished);
   EXPECT_EQ(out.pivot_end, PivotEnd::CorThreshold);
 }
@@ -217,7 +218,7 @@ TEST(PivotEnd, EndsAfterTheTimeAtTheFloorWhenTheCoRStaysIn) {
   GraspControllerOutput out;
   long n = 0;
   do {
-    c.step(one(1.0, 0.9, 0.2), out);
+    c.step(one(kS, 0.9, 0.2), out);
     ++n;
   } while (!out.pivot_finished && n < 100000);
   EXPECT_EQ(out.pivot_end, PivotEnd::AtFloor);
@@ -229,7 +230,7 @@ TEST(PivotEnd, EndsAfterTheTimeAtTheFloorWhenTheCoRStaysIn) {
   d.request_pivoting();
   n = 0;
   do {
-    d.step(one(1.0, 0.9, n < 400 ? 0.2 : 0.4), out);
+    d.step(one(kS, 0.9, n < 400 ? 0.2 : 0.4), out);
     ++n;
   } while (!out.pivot_finished && n < 100000);
   EXPECT_EQ(out.pivot_end, PivotEnd::AtFloor);
@@ -242,7 +243,7 @@ TEST(PivotEnd, EndsAfterTheTimeAtTheFloorWhenTheCoRStaysIn) {
   p.request_pivoting();
   n = 0;
   do {
-    p.step(one(1.0, 0.9, 0.2), out);
+    p.step(one(kS, 0.9, 0.2), out);
     ++n;
   } while (!out.pivot_finished && n < 100000);
   EXPECT_EQ(out.pivot_end, PivotEnd::Timeout);
@@ -274,8 +275,35 @@ TEST(PivotEnd, BumplessReturnAtTheFloorAndTheNextPivotStartsAfresh) {
   c.reset(6.0);
   c.request_pivoting();
   for (int i = 0; i < 500; ++i) {
-    c.step(one(1.0, 1.4, 0.3), out);
+    c.step(one(kS, 1.4, 0.3), out);
     ASSERT_FALSE(out.pivot_finished) << i;
   }
   EXPECT_EQ(out.mode, ControllerMode::Pivoting);
+}
+
+TEST(PivotEnd, ASlidingContactDoesNotEndItOnTheCoR) {
+  // S at the projection bound (1: the contact slides, the object still turns) blocks the CoR
+  // test even at the floor with |c~| = 1.4; the time at the floor ends it.
+  GraspController c(can(), free_rates());
+  c.reset(0.3);
+  c.request_pivoting();
+  GraspControllerOutput out;
+  long n = 0;
+  do {
+    c.step(one(1.0, 1.4, 0.2), out);
+    ++n;
+  } while (!out.pivot_finished && n < 100000);
+  EXPECT_EQ(out.pivot_end, PivotEnd::AtFloor);
+  EXPECT_NEAR(n * kDt, 1.0 + kDt, 1e-9);
+  // below the bound the same input ends it after three samples at the floor
+  GraspController d(can(), free_rates());
+  d.reset(0.3);
+  d.request_pivoting();
+  n = 0;
+  do {
+    d.step(one(0.98, 1.4, 0.2), out);
+    ++n;
+  } while (!out.pivot_finished && n < 100000);
+  EXPECT_EQ(out.pivot_end, PivotEnd::CorThreshold);
+  EXPECT_EQ(n, 4);
 }

@@ -17,7 +17,8 @@ CAN = lugrip.ContactParams.preset("aluminium_can")
 #: dead band (omega_deadband) keeps its default here.
 PAPER_PI = {k: lugrip.PAPER_SETTINGS[k]
             for k in ("slope_gain", "feedforward", "slip_reflex", "average_slippage", "s_ref",
-                      "pivot_end_filter", "pivot_end_at_floor", "pivot_floor_time")}
+                      "pivot_end_filter", "pivot_end_at_floor", "pivot_floor_time",
+                      "pivot_end_slippage")}
 T_SENSOR = 1.0 / 500.0
 T_CMD = 10 * T_SENSOR
 
