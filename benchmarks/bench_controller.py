@@ -39,6 +39,9 @@ SINGLE_OFF = {
     "no_feedforward": {"feedforward": False},
     "no_slip_reflex": {"slip_reflex": False},
     "no_average_S": {"average_slippage": False},
+    # the reaction to loads faster than one command (trend feed-forward, lag overshoot, reactions
+    # on samples with an invalid finger) off together: the controller before it
+    "no_fast_reaction": {"feedforward_horizon": 0.0, "reaction_lag": 0.0, "react_when_invalid": False},
 }
 VARIANTS = {"default": {}, "paper": dict(lugrip.PAPER_SETTINGS), **SINGLE_OFF}
 HELD_OUT_SEEDS = (1001, 1002, 1003, 1004, 1005, 1006, 1007)

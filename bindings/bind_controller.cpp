@@ -20,7 +20,8 @@ void bind_controller(nb::module_& m) {
       .value("None_", PivotEnd::None)
       .value("CorThreshold", PivotEnd::CorThreshold)
       .value("Timeout", PivotEnd::Timeout)
-      .value("Requested", PivotEnd::Requested);
+      .value("Requested", PivotEnd::Requested)
+      .value("AtFloor", PivotEnd::AtFloor);
 
   nb::class_<GraspControllerSettings> settings(m, "GraspControllerSettings");
   settings.def(nb::init<>()).def("__repr__", [](const GraspControllerSettings& s) { return to_string(s); });

@@ -111,6 +111,10 @@ struct Table<GraspControllerSettings> {
       field("reflex_slippage", &S::reflex_slippage, "reflex threshold on S [-]"),
       field("reflex_samples", &S::reflex_samples, "consecutive samples at or above the threshold"),
       field("reflex_factor", &S::reflex_factor, "static-part raise per period of detected slip [-]"),
+      field("feedforward_horizon", &S::feedforward_horizon, "feed-forward extrapolates the load's trend this far [s]"),
+      field("feedforward_trend", &S::feedforward_trend, "relative force rise that counts as a trend [-]"),
+      field("reaction_lag", &S::reaction_lag, "gripper lag the reaction overshoots for (0: off) [s]"),
+      field("react_when_invalid", &S::react_when_invalid, "raise-only reactions on invalid samples"),
       field("f_min", &S::f_min, "minimum force [N]"),
       field("f_max", &S::f_max, "maximum force [N]"),
       field("max_rate_up", &S::max_rate_up, "command increase limit (inf: off) [N/s]"),
@@ -122,7 +126,11 @@ struct Table<GraspControllerSettings> {
       field("pivot_floor_factor", &S::pivot_floor_factor, "pivoting floor factor on f_t / mu [-]"),
       field("pivot_end_c_tilde", &S::pivot_end_c_tilde, "pivoting ends above this mean |c~| [-]"),
       field("pivot_end_samples", &S::pivot_end_samples, "consecutive samples above the threshold"),
-      field("pivot_timeout", &S::pivot_timeout, "pivoting timeout (inf: off) [s]"));
+      field("pivot_timeout", &S::pivot_timeout, "pivoting timeout (inf: off) [s]"),
+      field("pivot_end_filter", &S::pivot_end_filter, "low-pass time constant on mean |c~| of the pivot end [s]"),
+      field("pivot_end_at_floor", &S::pivot_end_at_floor, "pivot end counts only at the floor"),
+      field("pivot_floor_time", &S::pivot_floor_time, "pivoting ends after this long at the floor (inf: off) [s]"),
+      field("pivot_end_slippage", &S::pivot_end_slippage, "pivot end counts only below this S (inf: off) [-]"));
 };
 
 template <>

@@ -15,6 +15,7 @@ namespace {
 // state finite: the C_d filter is stable and the PI error bounded).
 constexpr double kMaxSlippage = 1.0e3;
 constexpr double kMaxInput = 1.0e6;
+constexpr int kCountMax = 1 << 30;  // saturation of the pivot end counter
 
 // Shortest of %.15g / %.17g that reads back exactly.
 std::string fmt(double v) { return detail::format_number(v); }
@@ -57,6 +58,7 @@ bool validate(const GraspControllerSettings& s, std::string* message) {
   constexpr double kPoleMin = 1.0e-9, kCornerMax = 1.0e12;  // [rad/s] p_cd, z_cd
   constexpr double kForceMin = 1.0e-6, kForceMax = 1.0e6;   // [N] f_min, f_max, gain_schedule_force
   constexpr double kPivotMax = 1.0e3;                    // s_pivot (slippage inputs are <= 1e3)
+  constexpr double kHoldMax = 1.0e6;                     // [s] pivot_end_filter
   constexpr double kSlippageMin = 1.0e-3;                // s_ref, feedforward_slippage, reflex_slippage
   std::string msg;
   auto bad = [&](const char* name, double v, const std::string& rule) {
@@ -103,6 +105,10 @@ bool validate(const GraspControllerSettings& s, std::string* message) {
   positive("pivot_end_c_tilde", s.pivot_end_c_tilde);
   if (!(s.pivot_end_samples >= 1)) bad("pivot_end_samples", s.pivot_end_samples, "must be >= 1");
   positive_or_inf("pivot_timeout", s.pivot_timeout);
+  positive_or_inf("pivot_floor_time", s.pivot_floor_time);
+  positive_or_inf("pivot_end_slippage", s.pivot_end_slippage);
+  if (!(std::isfinite(s.pivot_end_filter) && s.pivot_end_filter >= 0.0 && s.pivot_end_filter <= kHoldMax))
+    bad("pivot_end_filter", s.pivot_end_filter, "must be finite, >= 0 and <= 1e6");
   within("loop_gain_p", s.loop_gain_p, 0.0, true, kGainMax, " [-]");
   within("loop_gain_i", s.loop_gain_i, 0.0, true, kGainMax, " [1/s]");
   if (s.slope_gain && s.gain_schedule_force > 0.0)
@@ -114,6 +120,12 @@ bool validate(const GraspControllerSettings& s, std::string* message) {
   if (!(s.reflex_samples >= 1)) bad("reflex_samples", s.reflex_samples, "must be >= 1");
   if (!(std::isfinite(s.reflex_factor) && s.reflex_factor > 1.0 && s.reflex_factor <= kPivotMax))
     bad("reflex_factor", s.reflex_factor, "must be finite, > 1 and <= 1000");
+  if (!(std::isfinite(s.feedforward_horizon) && s.feedforward_horizon >= 0.0 && s.feedforward_horizon <= 1.0e3))
+    bad("feedforward_horizon", s.feedforward_horizon, "must be finite, >= 0 and <= 1000 [s]");
+  if (!(std::isfinite(s.feedforward_trend) && s.feedforward_trend >= 0.0 && s.feedforward_trend <= 1.0e3))
+    bad("feedforward_trend", s.feedforward_trend, "must be finite, >= 0 and <= 1000");
+  if (!(std::isfinite(s.reaction_lag) && s.reaction_lag >= 0.0 && s.reaction_lag <= 1.0e3))
+    bad("reaction_lag", s.reaction_lag, "must be finite, >= 0 and <= 1000 [s]");
   if (message) *message = msg;
   return msg.empty();
 }
@@ -135,11 +147,16 @@ std::string to_string(const GraspControllerSettings& s) {
          ", pivot_floor_factor=" + num(s.pivot_floor_factor) +
          ", pivot_end_c_tilde=" + num(s.pivot_end_c_tilde) +
          ", pivot_end_samples=" + std::to_string(s.pivot_end_samples) +
-         ", pivot_timeout=" + num(s.pivot_timeout) + ", slope_gain=" + flag(s.slope_gain) +
+         ", pivot_timeout=" + num(s.pivot_timeout) + ", pivot_end_filter=" + num(s.pivot_end_filter) +
+         ", pivot_end_at_floor=" + flag(s.pivot_end_at_floor) +
+         ", pivot_floor_time=" + num(s.pivot_floor_time) +
+         ", pivot_end_slippage=" + num(s.pivot_end_slippage) + ", slope_gain=" + flag(s.slope_gain) +
          ", loop_gain_p=" + num(s.loop_gain_p) + ", loop_gain_i=" + num(s.loop_gain_i) +
          ", feedforward=" + flag(s.feedforward) + ", feedforward_slippage=" + num(s.feedforward_slippage) +
          ", slip_reflex=" + flag(s.slip_reflex) + ", reflex_slippage=" + num(s.reflex_slippage) +
-         ", reflex_samples=" + std::to_string(s.reflex_samples) + ", reflex_factor=" + num(s.reflex_factor) + ", average_slippage=" + flag(s.average_slippage) + ")";
+         ", reflex_samples=" + std::to_string(s.reflex_samples) + ", reflex_factor=" + num(s.reflex_factor) + ", average_slippage=" + flag(s.average_slippage) +
+         ", feedforward_horizon=" + num(s.feedforward_horizon) + ", feedforward_trend=" + num(s.feedforward_trend) +
+         ", reaction_lag=" + num(s.reaction_lag) + ", react_when_invalid=" + flag(s.react_when_invalid) + ")";
 }
 
 const char* to_string(ControllerMode m) noexcept {
@@ -156,6 +173,7 @@ const char* to_string(PivotEnd e) noexcept {
     case PivotEnd::CorThreshold: return "mean |c~| above the threshold";
     case PivotEnd::Timeout: return "timeout";
     case PivotEnd::Requested: return "slipping avoidance requested";
+    case PivotEnd::AtFloor: return "held at the floor";
   }
   return "unknown";
 }
@@ -182,6 +200,7 @@ GraspController::GraspController(const ContactModel& model, const GraspControlle
   dt_ = 1.0 / s_.sensor_rate;
   t_cmd_ = s_.command_ratio * dt_;
   pivot_decay_ = std::exp(-t_cmd_ / s_.tau_pivot);
+  pivot_c_alpha_ = s_.pivot_end_filter > 0.0 ? 1.0 - std::exp(-dt_ / s_.pivot_end_filter) : 1.0;
   for (auto& f : cd_) f = LagFilter(s_.k_cd, s_.z_cd, s_.p_cd, dt_);
   reset(s_.f_min);
 }
@@ -196,13 +215,14 @@ void GraspController::reset(double current_force) noexcept {
   pivot_state_ = command_;
   pivot_samples_ = 0;
   pivot_count_ = 0;
+  pivot_at_floor_ = false;
+  pivot_floor_samples_ = 0;
+  pivot_c_init_ = true;
   last_f_t_ = 0.0;
   last_kp_ = last_e_ = 0.0;
-  sum_f_t_.fill(0.0);
-  sum_tau_.fill(0.0);
-  n_load_.fill(0);
-  peak_s_ = sum_s_ = 0.0;
-  n_s_ = run_s_ = 0;
+  clear_period();
+  f_est_ = command_;
+  run_s_ = 0;
   reflex_armed_ = false;
   reset_dynamic();
   last_ = GraspControllerOutput();
@@ -237,6 +257,7 @@ void GraspController::set_settings(const GraspControllerSettings& settings) {
   s_ = next;
   set_dynamic_enabled(dynamic);
   pivot_decay_ = std::exp(-t_cmd_ / s_.tau_pivot);
+  pivot_c_alpha_ = s_.pivot_end_filter > 0.0 ? 1.0 - std::exp(-dt_ / s_.pivot_end_filter) : 1.0;
   command_ = clamp(command_, s_.f_min, s_.f_max);
   last_.force = command_;
 }
@@ -276,6 +297,9 @@ Status GraspController::step(const GraspControllerInput& in, GraspControllerOutp
     init_static_ = true;  // the filter starts from the last command
     pivot_samples_ = 0;
     pivot_count_ = 0;
+    pivot_at_floor_ = false;
+    pivot_floor_samples_ = 0;
+    pivot_c_init_ = true;
     peak_ = 0.0;
   } else if (request_ == Request::Avoid && mode_ == ControllerMode::Pivoting) {
     end_pivot(PivotEnd::Requested, out);
@@ -312,8 +336,13 @@ Status GraspController::step(const GraspControllerInput& in, GraspControllerOutp
     f_t_max = std::max(f_t_max, std::fabs(f.f_t));
     ++n_valid;
     if (std::isfinite(f.tau) && std::fabs(f.tau) <= kMaxInput) {  // load for the static floor
+      const double k = n_load_[i];
       sum_f_t_[i] += std::fabs(f.f_t);
       sum_tau_[i] += f.tau;
+      sum_kf_[i] += k * std::fabs(f.f_t);
+      sum_kt_[i] += k * f.tau;
+      sum_k_[i] += k;
+      sum_kk_[i] += k * k;
       ++n_load_[i];
     }
     if (dynamic) {
@@ -349,12 +378,24 @@ Status GraspController::step(const GraspControllerInput& in, GraspControllerOutp
   // End of the pivoting manoeuvre, tested at every sensor sample.
   if (mode_ == ControllerMode::Pivoting) {
     ++pivot_samples_;
-    if (valid && out.mean_c_tilde > s_.pivot_end_c_tilde)
-      ++pivot_count_;
+    // With pivot_end_at_floor the criterion counts only once the force cannot fall further, on
+    // the low-passed mean |c~|: a swing through the vertical passes |c~| > 1 for a few samples
+    // while the torque reverses (docs/controller.md).
+    if (valid) {
+      pivot_c_filtered_ = pivot_c_init_ ? out.mean_c_tilde
+                                        : pivot_c_filtered_ + pivot_c_alpha_ * (out.mean_c_tilde - pivot_c_filtered_);
+      pivot_c_init_ = false;
+    }
+    const bool settled = (!s_.pivot_end_at_floor || pivot_at_floor_) && slip < s_.pivot_end_slippage;
+    if (valid && settled && pivot_c_filtered_ > s_.pivot_end_c_tilde)
+      pivot_count_ = pivot_count_ < kCountMax ? pivot_count_ + 1 : pivot_count_;
     else
       pivot_count_ = 0;
+    pivot_floor_samples_ = pivot_at_floor_ && pivot_floor_samples_ < kCountMax ? pivot_floor_samples_ + 1 : 0;
     if (pivot_count_ >= s_.pivot_end_samples)
       end_pivot(PivotEnd::CorThreshold, out);
+    else if (static_cast<double>(pivot_floor_samples_) * dt_ >= s_.pivot_floor_time)
+      end_pivot(PivotEnd::AtFloor, out);
     else if (static_cast<double>(pivot_samples_) * dt_ >= s_.pivot_timeout)
       end_pivot(PivotEnd::Timeout, out);
   }
@@ -400,8 +441,24 @@ void GraspController::issue_command(bool valid, double slip) noexcept {
   c.feedforward_force = 0.0;
   c.peak_slippage = peak_s_;
 
+  const double lag = s_.reaction_lag > 0.0 ? std::exp(-t_cmd_ / s_.reaction_lag) : 0.0;
   if (!valid) {  // safe command: hold (or raise), never below the floor; restart bumplessly
-    command_ = clamp(std::max(command_ + s_.invalid_raise_step, floor), s_.f_min, s_.f_max);
+    double f = std::max(command_ + s_.invalid_raise_step, floor);
+    if (s_.react_when_invalid && mode_ == ControllerMode::SlippingAvoidance) {
+      // Raise-only reactions from the valid fingers' samples of the period.
+      double n_slope = 1.0;
+      double lift = static_floor(n_slope);
+      c.feedforward_force = lift;
+      if (s_.slip_reflex && reflex_armed_) {
+        lift = std::max(lift, s_.reflex_factor * std::min(last_.static_force, command_));
+        c.reflex = true;
+      }
+      lift = std::min(lift, s_.f_max);
+      if (lift > f_est_ && lag > 0.0) lift += (lift - f_est_) * lag / (1.0 - lag);
+      f = std::max(f, std::min(lift, command_ + s_.max_rate_up * t_cmd_));
+    }
+    command_ = clamp(f, s_.f_min, s_.f_max);
+    f_est_ = command_ + (f_est_ - command_) * lag;
     init_static_ = true;
     peak_ = 0.0;
     clear_period();
@@ -412,6 +469,7 @@ void GraspController::issue_command(bool valid, double slip) noexcept {
   c.held = false;
 
   double f_ns, f_nd = 0.0, e;
+  bool reacting = false;  // the feed-forward or the reflex lifted the static part
   if (mode_ == ControllerMode::SlippingAvoidance) {
     // Floor of the static part: feed-forward of the measured load and the slip reflex.
     double n_slope = 1.0;
@@ -458,6 +516,7 @@ void GraspController::issue_command(bool valid, double slip) noexcept {
     f_ns = clamp(u, lo, s_.f_max);
     if (f_ns != u) {
       if (u < lo && lo > s_.f_min) {
+        reacting = true;
         integrator_ = f_ns - k_p * e;  // the floor lifted the PI: restart it there
       } else {
         c.saturated = true;
@@ -487,15 +546,19 @@ void GraspController::issue_command(bool valid, double slip) noexcept {
     pivot_state_ = clamp(pivot_state_, floor, s_.f_max);
     f_ns = pivot_state_;
     pivot_state_ = pivot_decay_ * pivot_state_ + (1.0 - pivot_decay_) * s_.k_f * e;
+    pivot_at_floor_ = pivot_state_ <= floor;  // the filter wants to go below the floor
     pivot_state_ = clamp(pivot_state_, floor, s_.f_max);
   }
   peak_ = 0.0;
 
-  const double target = f_ns + f_nd;
+  double target = f_ns + f_nd;
+  // Reaction through the gripper's lag: overshoot so the force reaches the target in one period.
+  if (reacting && lag > 0.0 && target > f_est_) target += (std::min(target, s_.f_max) - f_est_) * lag / (1.0 - lag);
   double f = clamp(target, command_ - s_.max_rate_down * t_cmd_, command_ + s_.max_rate_up * t_cmd_);
   c.rate_limited = f != target;
   f = clamp(std::max(f, floor), s_.f_min, s_.f_max);
   command_ = f;
+  f_est_ = command_ + (f_est_ - command_) * lag;
 
   c.force = f;
   c.static_force = f_ns;
@@ -508,6 +571,10 @@ void GraspController::issue_command(bool valid, double slip) noexcept {
 void GraspController::clear_period() noexcept {
   sum_f_t_.fill(0.0);
   sum_tau_.fill(0.0);
+  sum_kf_.fill(0.0);
+  sum_kt_.fill(0.0);
+  sum_k_.fill(0.0);
+  sum_kk_.fill(0.0);
   n_load_.fill(0);
   peak_s_ = sum_s_ = 0.0;
   n_s_ = 0;
@@ -522,9 +589,22 @@ double GraspController::static_floor(double& slope_exponent) noexcept {
   slope_exponent = 1.0;
   for (int i = 0; i < kMaxFingers; ++i) {
     if (n_load_[i] == 0) continue;
-    const double ft = sum_f_t_[i] / n_load_[i], tau = sum_tau_[i] / n_load_[i];
+    const double n = n_load_[i];
+    const double ft = sum_f_t_[i] / n, tau = sum_tau_[i] / n;
     if (s_.feedforward) {
-      const double f = solver_.solve(ft, tau, s_.feedforward_slippage).force;
+      double f = solver_.solve(ft, tau, s_.feedforward_slippage).force;
+      const double den = n * sum_kk_[i] - sum_k_[i] * sum_k_[i];
+      if (s_.feedforward_horizon > 0.0 && n_load_[i] >= 3 && den > 0.0 && std::isfinite(f)) {
+        // Least-squares trend of the period's load, extrapolated from the last sample's index
+        // by the horizon.
+        const double k_mean = sum_k_[i] / n;
+        const double ahead = (n - 1.0 - k_mean) + s_.feedforward_horizon / dt_;
+        const double slope_f = (n * sum_kf_[i] - sum_k_[i] * sum_f_t_[i]) / den;
+        const double slope_t = (n * sum_kt_[i] - sum_k_[i] * sum_tau_[i]) / den;
+        const double fx = solver_.solve(std::max(0.0, ft + slope_f * ahead), tau + slope_t * ahead,
+                                        s_.feedforward_slippage).force;
+        if (std::isfinite(fx) && fx > (1.0 + s_.feedforward_trend) * f) f = fx;
+      }
       if (std::isfinite(f)) force = std::max(force, f);
     }
     if (s_.slope_gain) {

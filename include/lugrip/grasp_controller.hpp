@@ -106,6 +106,29 @@ struct GraspControllerSettings {
   int reflex_samples = 3;
   double reflex_factor = 1.25;  //!< (*) [-] raise of the static part per period of detected slip, > 1
 
+  // --- reaction to fast load changes (not in the paper; docs/controller.md §6) ----------------
+  //! (*) [s] default 0.03; 0 = off (paper: the load of the period only). The feed-forward also
+  //! evaluates the load extrapolated this far ahead along its trend over the last command period
+  //! (least-squares slope of each finger's f_t and tau), so a load still rising at the command
+  //! (a pulse's edge) is met with the force it will need when the command has reached the
+  //! fingers. >= 0, finite.
+  double feedforward_horizon = 0.03;
+  //! (*) [-] the extrapolated load is used only when its static force exceeds that of the
+  //! period's mean load by more than this fraction (a trend, not sensor noise). >= 0, finite.
+  double feedforward_trend = 0.5;
+  //! (*) [s] default 0.03; 0 = off (paper). Time constant of the gripper's force lag assumed by the
+  //! reaction: when the feed-forward or the reflex lifts the static part above the force the
+  //! gripper is estimated to apply, the command overshoots the target by the lag's shortfall over
+  //! one command period, (target - f_est) exp(-T/tau) / (1 - exp(-T/tau)), so the force reaches
+  //! the target within one period instead of ~3 tau; f_est follows the issued commands through
+  //! that lag. >= 0, finite.
+  double reaction_lag = 0.03;
+  //! (*) default true; false = hold only (the earlier behaviour). A command due while a present
+  //! finger's input is invalid (NoContact while its pad loses contact as the object slides out,
+  //! InvalidSample, SensorFault) still takes the raise-only reactions computed from the valid
+  //! fingers' samples of the period (feed-forward, armed reflex); it never lowers the command.
+  bool react_when_invalid = true;
+
   // --- force range and rate limits (docs/model.md 9.5) --------------------------------------------
   double f_min = 0.1;   //!< [N] minimum force (keeps contact), > 0
   double f_max = 20.0;  //!< [N] maximum force (gripper limit), > f_min
@@ -123,6 +146,18 @@ struct GraspControllerSettings {
   double pivot_end_c_tilde = 1.0;   //!< (*) pivoting ends when mean |c~_i| exceeds this, > 0
   int pivot_end_samples = 3;        //!< (*) ... on this many consecutive samples, >= 1
   double pivot_timeout = 10.0;      //!< (*) [s] pivoting ends after this time, > 0 (inf: never)
+  //! (*) [s] time constant of the first-order low-pass on the mean |c~_i| that the end test
+  //! compares, >= 0, finite (0: the sample itself, the paper's law)
+  double pivot_end_filter = 0.2;
+  //! (*) the end criterion counts only while the pivoting filter is held at its floor, i.e. the
+  //! force cannot fall further (false: from the first pivoting sample, the paper's law)
+  bool pivot_end_at_floor = true;
+  //! (*) [s] pivoting also ends once the filter has been held at its floor this long, > 0
+  //! (inf: never, the paper's law)
+  double pivot_floor_time = 1.0;
+  //! (*) [-] the end test counts only while max_i S_i is below this, > 0 (S at the projection
+  //! bound 1 means the contact slides: the object is still turning); inf: off, the paper's law
+  double pivot_end_slippage = 0.99;
 };
 
 //! Checks every field; one line per bad field ("k_p = -1: must be finite and > 0") in *message
@@ -141,9 +176,10 @@ enum class ControllerMode : int {
 //! Why pivoting ended (reported in the call where it ends). Stable integer values.
 enum class PivotEnd : int {
   None = 0,          //!< pivoting did not end in this call
-  CorThreshold = 1,  //!< mean |c~| > pivot_end_c_tilde on pivot_end_samples consecutive samples
+  CorThreshold = 1,  //!< (low-passed) mean |c~| > pivot_end_c_tilde on pivot_end_samples samples
   Timeout = 2,       //!< pivot_timeout elapsed
   Requested = 3,     //!< request_slipping_avoidance() while pivoting
+  AtFloor = 4,       //!< the pivoting filter was held at its floor for pivot_floor_time
 };
 
 const char* to_string(ControllerMode m) noexcept;
@@ -272,7 +308,11 @@ class StaticForceSolver {
 //! * Pivoting: f_nd = 0; tau_p df/dt = -f + k_f (S - s_pivot), exact discretisation at the
 //!   command rate, started from the last command; floor max(f_min, factor max_i |f_t,i| / mu)
 //!   on the output and the filter state; ends on mean |c~_i| > pivot_end_c_tilde for
-//!   pivot_end_samples consecutive sensor samples, on timeout or on request, then returns to
+//!   pivot_end_samples consecutive sensor samples (mean |c~_i| low-passed with the time
+//!   constant pivot_end_filter; counted, with pivot_end_at_floor, only while the pivoting filter
+//!   is held at the floor, and only while max_i S_i < pivot_end_slippage), after
+//!   pivot_floor_time at the floor, on timeout or on request,
+//!   then returns to
 //!   slipping avoidance bumplessly (I = last command - k_p e at the next command, C_d reset).
 //! * Two fingers (docs/model.md 9.8): S = max_i S_i, f_nd from max_i |C_d omega_hat_i|, pivot end on
 //!   the mean of |c~_i|; absent fingers are ignored.
@@ -351,11 +391,20 @@ class GraspController {
   double peak_ = 0.0;         // running peak of max_i |C_d omega_i| [N]
   long pivot_samples_ = 0;    // samples since pivoting started
   int pivot_count_ = 0;       // consecutive samples with mean |c~| above the threshold
+  bool pivot_at_floor_ = false;  // the last pivoting command wanted to go below the floor
+  long pivot_floor_samples_ = 0;  // consecutive samples with the filter held at the floor
+  bool pivot_c_init_ = true;     // the low-pass on mean |c~| starts at the next valid sample
+  double pivot_c_filtered_ = 0.0;  // low-passed mean |c~| of the pivot end test [-]
+  double pivot_c_alpha_ = 1.0;     // its coefficient 1 - exp(-dt / pivot_end_filter)
   double last_f_t_ = 0.0;     // last valid max_i |f_t,i| [N] (pivot floor)
   double last_kp_ = 0.0;      // k_p of the last command [N] (bumpless gain change)
   double last_e_ = 0.0;       // proportional error of the last command [-]
   std::array<double, kMaxFingers> sum_f_t_{}, sum_tau_{};  // valid samples since the last command
   std::array<int, kMaxFingers> n_load_{};
+  std::array<double, kMaxFingers> sum_kf_{}, sum_kt_{};  // sums of k f_t, k tau (k: sample index in the period)
+  std::array<double, kMaxFingers> sum_k_{}, sum_kk_{};   // sums of k, k^2 over those samples
+  std::array<int, kMaxFingers> k_load_{};                // sample index in the period
+  double f_est_ = 0.0;        // gripper force estimated through reaction_lag [N]
   double peak_s_ = 0.0;       // peak of max_i S_i since the last command
   double sum_s_ = 0.0;        // sum of max_i S_i over the valid samples since the last command
   int n_s_ = 0;

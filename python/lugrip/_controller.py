@@ -7,6 +7,7 @@ Thin layer over the C++ ``lugrip::GraspController`` and ``lugrip::StaticForceSol
 from __future__ import annotations
 
 import enum
+import math
 from dataclasses import make_dataclass
 from typing import Any
 
@@ -44,12 +45,20 @@ _BOOL_FIELDS = tuple(name for name, kind, _doc in _core.GraspControllerSettings.
 #: no feed-forward, no slip reflex, the PI on S itself, no dead band on C_d. Pass them to compare
 #: with lugrip's defaults: ``GraspController(params, **PAPER_SETTINGS)``.
 PAPER_SETTINGS: dict[str, Any] = {
+    "s_ref": 0.8,
     "slope_gain": False,
     "feedforward": False,
     "slip_reflex": False,
     "average_slippage": False,
     "static_equivalent_slippage": False,
     "omega_deadband": 0.0,
+    "feedforward_horizon": 0.0,
+    "reaction_lag": 0.0,
+    "react_when_invalid": False,
+    "pivot_end_filter": 0.0,
+    "pivot_end_at_floor": False,
+    "pivot_floor_time": math.inf,
+    "pivot_end_slippage": math.inf,
 }
 
 
@@ -64,9 +73,10 @@ class PivotEnd(enum.IntEnum):
     """Why pivoting ended; values equal the C++ lugrip::PivotEnd."""
 
     NONE = 0
-    COR_THRESHOLD = 1  #: mean |c~| > pivot_end_c_tilde on pivot_end_samples consecutive samples
+    COR_THRESHOLD = 1  #: (low-passed) mean |c~| > pivot_end_c_tilde on pivot_end_samples samples
     TIMEOUT = 2
     REQUESTED = 3
+    AT_FLOOR = 4  #: the pivoting filter held at its floor for pivot_floor_time
 
 
 def _code(e) -> int:
@@ -164,8 +174,10 @@ class GraspController:
     * Static part: PI on e = S - s_ref (e > 0 raises the force), forward Euler at the command
       rate, clipped to [f_min, f_max] with back-calculation anti-windup, bumpless starts.
     * Pivoting: f_nd = 0, tau_p df/dt = -f + k_f (S - s_pivot) (exact discretisation), floor
-      max(f_min, 1.1 f_t / mu); ends when the mean |c~_i| exceeds 1 on 3 consecutive samples,
-      on timeout or on request, then returns bumplessly to slipping avoidance.
+      max(f_min, 1.1 f_t / mu); ends when a 0.2 s low-pass of the mean |c~_i| exceeds 1 on 3
+      samples while the force sits at that floor and S < 0.99 (the paper: the sample's mean
+      |c~_i| on 3 samples from the start, PAPER_SETTINGS), after 1 s at the floor, on timeout
+      or on request, then returns bumplessly to slipping avoidance.
     * step() at the sensor rate (500 Hz); a command every ``command_ratio`` calls (50 Hz), held.
     * Two fingers: S = max_i S_i, f_nd from max_i |C_d omega_hat_i|, pivot end on the mean |c~_i|.
     * Invalid input (NaN/Inf, Status INVALID_SAMPLE / SENSOR_FAULT / NO_CONTACT on a present
@@ -187,7 +199,8 @@ class GraspController:
             range (f_min, f_max [N]), rate
             limits (max_rate_up, max_rate_down [N/s], inf = off), invalid_raise_step [N], pivoting
             (s_pivot, tau_pivot [s], k_f [N], pivot_floor_factor, pivot_end_c_tilde,
-            pivot_end_samples, pivot_timeout [s]).
+            pivot_end_samples, pivot_timeout [s], pivot_end_filter [s], pivot_end_at_floor,
+            pivot_floor_time [s], pivot_end_slippage).
 
     Raises:
         ValueError: unknown or invalid setting (one line per bad field) or invalid params.

@@ -176,9 +176,9 @@ TEST(ClosedLoop, SteadyForceMatchesTheStaticGraspForce) {
     tau /= n;
     S /= n;
     EXPECT_NEAR(ft, 0.5 * 0.4 * kG, 0.01) << "each finger carries half the weight";
-    const double expected = static_grasp_force(c.plant.contact, ft, tau, 0.8);
+    const double expected = static_grasp_force(c.plant.contact, ft, tau, c.controller.s_ref);
     const double steady = mean_command(log, 7.0, 9.0);
-    EXPECT_NEAR(S, 0.8, 0.02) << "cog_x=" << cog_x;
+    EXPECT_NEAR(S, c.controller.s_ref, 0.02) << "cog_x=" << cog_x;
     EXPECT_NEAR(steady / expected, 1.0, 0.03) << "cog_x=" << cog_x << " steady=" << steady << " static=" << expected;
     EXPECT_FALSE(log.back().dropped);
   }
@@ -313,6 +313,6 @@ TEST(ClosedLoop, LumpedPlantRunsTheSameLoop) {
       ++n;
     }
   }
-  EXPECT_NEAR(S / n, 0.8, 0.03);
+  EXPECT_NEAR(S / n, c.controller.s_ref, 0.03);
   EXPECT_EQ(log.back().slip_x, 0.0);  // the lumped plant does not translate
 }

@@ -225,6 +225,7 @@ TEST(Faults, HealthyFingerFallbackLetsTheOtherFingerCommand) {
   // Finger 1 dead from t = 2 s, then a downward push: holding the command cannot answer the
   // push; with the fallback finger 0's estimate raises the force while finger 1 stays flagged.
   ClosedLoopConfig c = hold_config();
+  c.controller.react_when_invalid = false;  // the hold-only policy the fallback is compared with
   c.plant.disturbances.push_back(Disturbance{2.5, 0.5, PulseShape::HalfSine, 0.0, -3.0, 0.0, 0.0, 0.0});
   c.faults.push_back(fault(FaultKind::Dead, 2.0, 1e300, 1));
   double peak[2] = {0.0, 0.0};

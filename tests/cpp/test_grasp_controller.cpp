@@ -29,6 +29,14 @@ GraspControllerSettings paper_law(GraspControllerSettings s = {}) {
   s.feedforward = false;
   s.slip_reflex = false;
   s.average_slippage = false;
+  s.s_ref = 0.8;
+  s.feedforward_horizon = 0.0;
+  s.reaction_lag = 0.0;
+  s.react_when_invalid = false;
+  s.pivot_end_filter = 0.0;  // the paper's pivot end: pivot_end_samples from the first sample
+  s.pivot_end_at_floor = false;
+  s.pivot_floor_time = kInf;
+  s.pivot_end_slippage = kInf;
   return s;
 }
 
@@ -933,6 +941,7 @@ TEST(ControllerSlopeGain, LoopGainIsTheSameAtEveryForce) {
       const ContactParams p = can();
       StaticForceSolver solver(p);
       GraspControllerSettings s;
+      s.s_ref = 0.8;  // the operating point of the inputs below
       s.max_rate_up = s.max_rate_down = kInf;
       GraspController c(p, s);
       const double f = solver.solve(ft, tau).force;
@@ -963,7 +972,7 @@ TEST(ControllerSlopeGain, NoLimitCycleAnywhereInTheForceRange) {
   GraspControllerSettings s;
   s.f_max = 40.0;
   for (const double ft : {0.09, 0.3, 1.0, 3.0, 7.0}) {
-    const double f = solver.solve(ft, 0.0).force;
+    const double f = solver.solve(ft, 0.0, s.s_ref).force;
     const auto r = lagged_loop(p, ft, 0.0, s, 20.0, 3.0);
     EXPECT_LT(r.second - r.first, 0.005 * f) << "ft " << ft << " f " << f;
     EXPECT_NEAR(0.5 * (r.first + r.second), f, 0.01 * f) << ft;
@@ -977,6 +986,8 @@ TEST(ControllerFeedForward, StaticGraspForceOfTheMeanLoadAtTheNextCommand) {
   StaticForceSolver solver(p);
   GraspControllerSettings s;
   s.max_rate_up = s.max_rate_down = kInf;
+  s.feedforward_horizon = 0.0;  // the period's mean load only (the trend: ControllerReaction.*)
+  s.reaction_lag = 0.0;
   GraspController c(p, s);
   c.reset(0.1);
   GraspControllerOutput out;
@@ -1057,6 +1068,8 @@ TEST(ControllerReflex, RaisesWithinOneCommandPeriodWhenTheSpeedIsUnobservable) {
   // on three consecutive samples inside a period.
   GraspControllerSettings s;
   s.feedforward = false;
+  s.s_ref = 0.8;          // the set point of the inputs below
+  s.reaction_lag = 0.0;   // the raise itself (the lag compensation: ControllerReaction.*)
   s.max_rate_up = s.max_rate_down = kInf;
   GraspController c(can(), s);
   c.reset(2.0);

@@ -58,7 +58,7 @@ TEST(SlipControl, SettlesWhereTheStaticForceSolverSays) {
   SlipControl sc(can());
   QuasiStaticGrip grip;
   const SlipControlOutput out = settle(sc, grip, 3000);  // 6 s
-  const double expected = static_grasp_force(can(), grip.f_t, grip.tau, 0.8);
+  const double expected = static_grasp_force(can(), grip.f_t, grip.tau, GraspControllerSettings{}.s_ref);
   EXPECT_NEAR(out.force, expected, 0.02 * expected);
   EXPECT_EQ(out.status, Status::Ok);
   EXPECT_GT(out.force, 2.0 * sc.settings().controller.f_min);
@@ -184,7 +184,7 @@ TEST(SlipControl, OneFingerIgnoresTheSecondWrench) {
     grip.follow(out.force);
   }
   EXPECT_EQ(out.status, Status::Ok);
-  EXPECT_NEAR(out.force, static_grasp_force(can(), grip.f_t, grip.tau, 0.8), 0.02 * out.force);
+  EXPECT_NEAR(out.force, static_grasp_force(can(), grip.f_t, grip.tau, GraspControllerSettings{}.s_ref), 0.02 * out.force);
 }
 
 TEST(SlipControl, RatesAndFingerCountCheckedAtConstruction) {
@@ -255,7 +255,7 @@ TEST(SlipControl, SetMuChangesObserversAndControllerKeepsTheCommand) {
   const double after = settle(sc, grip, 4000).force;
   ContactParams half = can();
   half.mu *= 0.5;
-  EXPECT_NEAR(after, static_grasp_force(half, grip.f_t, grip.tau, 0.8), 0.02 * after);
+  EXPECT_NEAR(after, static_grasp_force(half, grip.f_t, grip.tau, GraspControllerSettings{}.s_ref), 0.02 * after);
   EXPECT_GT(after, 1.5 * before);
   EXPECT_THROW(sc.set_mu(0.0), std::invalid_argument);
   EXPECT_EQ(sc.params().mu, 0.5 * can().mu);

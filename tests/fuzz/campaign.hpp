@@ -309,7 +309,11 @@ class Campaign {
                   LUGRIP_FUZZ_REAL(G, max_rate_down), LUGRIP_FUZZ_REAL(G, invalid_raise_step),
                   LUGRIP_FUZZ_REAL(G, s_pivot),       LUGRIP_FUZZ_REAL(G, tau_pivot),
                   LUGRIP_FUZZ_REAL(G, k_f),           LUGRIP_FUZZ_REAL(G, pivot_floor_factor),
-                  LUGRIP_FUZZ_REAL(G, pivot_end_c_tilde), LUGRIP_FUZZ_REAL(G, pivot_timeout)};
+                  LUGRIP_FUZZ_REAL(G, pivot_end_c_tilde), LUGRIP_FUZZ_REAL(G, pivot_timeout),
+                  LUGRIP_FUZZ_REAL(G, pivot_end_filter), LUGRIP_FUZZ_REAL(G, pivot_floor_time),
+                  LUGRIP_FUZZ_REAL(G, pivot_end_slippage),
+                  LUGRIP_FUZZ_REAL(G, feedforward_horizon), LUGRIP_FUZZ_REAL(G, feedforward_trend),
+                  LUGRIP_FUZZ_REAL(G, reaction_lag)};
     ctl_.ints = {LUGRIP_FUZZ_INT(G, command_ratio), LUGRIP_FUZZ_INT(G, pivot_end_samples)};
     ctl_.init([](const G& s) { return validate(s, nullptr); });
   }

@@ -16,7 +16,9 @@ CAN = lugrip.ContactParams.preset("aluminium_can")
 #: The paper's static law (constant gains, S of the sample, no feed-forward, no reflex); the
 #: dead band (omega_deadband) keeps its default here.
 PAPER_PI = {k: lugrip.PAPER_SETTINGS[k]
-            for k in ("slope_gain", "feedforward", "slip_reflex", "average_slippage")}
+            for k in ("slope_gain", "feedforward", "slip_reflex", "average_slippage", "s_ref",
+                      "pivot_end_filter", "pivot_end_at_floor", "pivot_floor_time",
+                      "pivot_end_slippage")}
 T_SENSOR = 1.0 / 500.0
 T_CMD = 10 * T_SENSOR
 
@@ -66,7 +68,7 @@ def test_cd_step_response_through_the_controller():
 
 def test_peak_of_the_last_command_period_reaches_the_command():
     """A one-sample slip spike between commands is not lost: f_nd = max |C_d omega_hat|."""
-    ctrl = GraspController(CAN, max_rate_up=math.inf, max_rate_down=math.inf)
+    ctrl = GraspController(CAN, s_ref=0.8, max_rate_up=math.inf, max_rate_down=math.inf)
     ctrl.reset(2.0)
     w = np.zeros(11)
     w[4] = -0.1
@@ -295,7 +297,7 @@ def test_closed_loop_settles_at_the_static_force(obj, ft, tau):
         S, c = lugrip.static_slippage(obj, ctrl.command, ft, tau)
         run = ctrl.run(np.zeros(per_cmd), np.full(per_cmd, min(float(S), 1.0)), float(c), ft)
         forces.append(run.force[-1])
-    f_static = lugrip.static_grasp_force(obj, ft, tau)
+    f_static = lugrip.static_grasp_force(obj, ft, tau, ctrl.settings["s_ref"])
     tail = np.array(forces[-250:])  # last 5 s
     assert np.all(np.abs(tail / f_static - 1) < 0.01)
 

@@ -42,6 +42,10 @@ class QuasiStaticGrip:
         return np.array([[self.force, self.f_t, 0.0, self.tau]] * 2)
 
 
+#: the controller's default reference of S
+S_REF = lugrip.controller_settings()["s_ref"]
+
+
 def settle(ctrl, grip: QuasiStaticGrip, n: int):
     out = None
     for _ in range(n):
@@ -54,10 +58,10 @@ def test_settles_at_the_static_grasp_force():
     ctrl = lugrip.SlipControl(CAN)
     grip = QuasiStaticGrip()
     out = settle(ctrl, grip, 3000)
-    expected = lugrip.static_grasp_force(CAN, grip.f_t, grip.tau)
+    expected = lugrip.static_grasp_force(CAN, grip.f_t, grip.tau, S_REF)
     assert out.force == pytest.approx(expected, rel=0.02)
     assert out.status == _core.Status.Ok
-    assert out.fingers[0].S == pytest.approx(0.8, abs=0.02)
+    assert out.fingers[0].S == pytest.approx(S_REF, abs=0.02)
 
 
 def test_contact_loss_holds_the_command_for_0_2_s():
@@ -206,7 +210,7 @@ def test_one_finger_ignores_the_second_row():
     for _ in range(3000):
         out = ctrl.step(grip.wrenches()[0])  # shape (4,)
         grip.follow(out.force)
-    assert out.force == pytest.approx(lugrip.static_grasp_force(CAN, grip.f_t, grip.tau), rel=0.02)
+    assert out.force == pytest.approx(lugrip.static_grasp_force(CAN, grip.f_t, grip.tau, S_REF), rel=0.02)
     bad = np.array([grip.wrenches()[0], [np.nan] * 4])
     assert ctrl.step(bad).status == _core.Status.Ok
     with pytest.raises(ValueError, match="expected 4 values"):
@@ -221,7 +225,7 @@ def test_set_mu_reset_and_settings_at_run_time():
     assert ctrl.command == before and ctrl.mu == 0.375 and ctrl.params.mu == 0.375
     after = settle(ctrl, grip, 4000).force
     half = lugrip.ContactParams.preset(CAN).replace(mu=0.375)
-    assert after == pytest.approx(lugrip.static_grasp_force(half, grip.f_t, grip.tau), rel=0.02)
+    assert after == pytest.approx(lugrip.static_grasp_force(half, grip.f_t, grip.tau, S_REF), rel=0.02)
     with pytest.raises(ValueError, match="mu"):
         ctrl.set_mu(-1.0)
     assert ctrl.mu == 0.375

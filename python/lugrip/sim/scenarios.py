@@ -539,14 +539,17 @@ def compute_metrics(
             pivot_start=p0,
             pivot_end=p1 if math.isfinite(p1) else None,
             pivot_duration=(p1 - p0) if math.isfinite(p1) else None,
-            pivot_end_reason={0: "none", 1: "cor_threshold", 2: "timeout", 3: "requested"}[reason],
+            pivot_end_reason={
+                0: "none", 1: "cor_threshold", 2: "timeout", 3: "requested", 4: "at_floor"
+            }[reason],
             pivot_rotation_deg=float(np.degrees(run["theta"][-1] - run["theta"][run.index(p0)])),
             final_hang_deg=float(abs(run.hang_deg[i_hang])),
             final_hang_time=float(t[i_hang]),
             final_axis_deg=float(abs(axis[-1])),
             initial_axis_deg=float(abs(axis[run.index(p0)])),
             final_mode="slipping_avoidance" if int(run["mode"][-1]) == 0 else "pivoting",
-            returned_to_avoidance=bool(fin.size and reason == 1 and int(run["mode"][-1]) == 0),
+            # ended by itself (hanging: c~ criterion, or held at the floor), then avoiding again
+            returned_to_avoidance=bool(fin.size and reason in (1, 4) and int(run["mode"][-1]) == 0),
         )
     hold_slip, hold_rot = _hold_increment(run, phases, lumped)
     lift_slip, lift_rot = _hold_increment(run, [(scenario.lift_start, scenario.lift_end)], lumped)

@@ -1,0 +1,195 @@
+// Reaction of the grasp-force controller to loads that change faster than one command period:
+// the feed-forward of the load's trend (feedforward_horizon, feedforward_trend), the command
+// overshoot that compensates the gripper's lag (reaction_lag) and the raise-only reactions on a
+// command sample with an invalid finger (react_when_invalid).
+//
+// Consistency tests of the law: the inputs are synthetic observer values; the gripper of
+// LagCompensation.* is an independent first-order lag integrated here at 1 kHz (not the
+// controller's own estimate). Closed loops on MuJoCo: tests/python/test_controller_reaction.py.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <string>
+
+#include "lugrip/grasp_controller.hpp"
+#include "lugrip/params.hpp"
+
+using namespace lugrip;
+
+namespace {
+
+constexpr double kInf = std::numeric_limits<double>::infinity();
+constexpr double kDt = 0.002;  // default sensor period [s]
+
+ContactParams box() {
+  ContactParams p = object_params("small_resin_block");
+  p.mu = 0.6;
+  return p;
+}
+
+FingerInput finger(double S, double f_t, double tau = 0.0, Status st = Status::Ok) {
+  FingerInput f;
+  f.slippage = S;
+  f.c_tilde = 1.5;
+  f.f_t = f_t;
+  f.tau = tau;
+  f.status = st;
+  return f;
+}
+
+GraspControllerInput two(const FingerInput& a, const FingerInput& b) {
+  GraspControllerInput in;
+  in.fingers[0] = a;
+  in.fingers[1] = b;
+  return in;
+}
+
+GraspControllerSettings fast(GraspControllerSettings s = {}) {
+  s.max_rate_up = s.max_rate_down = kInf;
+  s.slip_reflex = false;
+  s.dynamic_enabled = false;
+  return s;
+}
+
+}  // namespace
+
+TEST(ControllerReaction, FeedForwardExtrapolatesTheLoadRisingDuringThePeriod) {
+  // f_t rises linearly from 2.2 N to 3.7 N over the ten samples of a period (a pulse's edge).
+  // The least-squares trend of an exact ramp is the ramp: the feed-forward evaluates the load
+  // horizon / dt samples after the last one, f_t = 3.7 + 1.5 / 9 * 15 = 6.2 N.
+  const ContactParams p = box();
+  StaticForceSolver solver(p);
+  for (const double horizon : {0.0, 0.03}) {
+    GraspControllerSettings s = fast();
+    s.feedforward_horizon = horizon;
+    s.reaction_lag = 0.0;
+    GraspController c(p, s);
+    c.reset(5.0);
+    GraspControllerOutput out;
+    c.step(two(finger(0.7, 2.2), finger(0.7, 2.2)), out);  // command at the steady load
+    double sum = 0.0;
+    for (int k = 0; k < 10; ++k) {
+      const double ft = 2.2 + 1.5 * k / 9.0;
+      sum += ft;
+      c.step(two(finger(0.7, ft), finger(0.7, ft)), out);
+      EXPECT_EQ(out.command_issued, k == 9) << k;
+    }
+    const double mean_force = solver.solve(sum / 10.0, 0.0, s.feedforward_slippage).force;
+    const double ramp_force = solver.solve(3.7 + 1.5 / 9.0 * (horizon / kDt), 0.0, s.feedforward_slippage).force;
+    if (horizon == 0.0) {
+      EXPECT_NEAR(out.feedforward_force, mean_force, 1e-9 * mean_force);
+    } else {
+      EXPECT_NEAR(out.feedforward_force, ramp_force, 1e-6 * ramp_force);
+      EXPECT_GT(out.feedforward_force, 1.8 * mean_force);  // the trend, not the mean
+      EXPECT_GE(out.static_force, out.feedforward_force - 1e-12);
+    }
+  }
+}
+
+TEST(ControllerReaction, NoiseBelowTheTrendThresholdKeepsTheMeanLoad) {
+  // A steady load with +-3 % alternating noise: its extrapolated force differs from the mean's
+  // by less than feedforward_trend, so the feed-forward is that of the mean load.
+  const ContactParams p = box();
+  StaticForceSolver solver(p);
+  GraspControllerSettings s = fast();
+  GraspController c(p, s);
+  c.reset(5.0);
+  GraspControllerOutput out;
+  c.step(two(finger(0.7, 2.2), finger(0.7, 2.2)), out);
+  double sum = 0.0;
+  for (int k = 0; k < 10; ++k) {
+    const double ft = 2.2 * (1.0 + (k % 2 ? 0.03 : -0.03));
+    sum += ft;
+    c.step(two(finger(0.7, ft), finger(0.7, ft)), out);
+  }
+  ASSERT_TRUE(out.command_issued);
+  const double mean_force = solver.solve(sum / 10.0, 0.0, s.feedforward_slippage).force;
+  EXPECT_NEAR(out.feedforward_force, mean_force, 1e-9 * mean_force);
+}
+
+TEST(ControllerReaction, LagCompensationReachesTheTargetWithinOneCommand) {
+  // Gripper: tau_g df/dt = u - f, tau_g = 30 ms, integrated at 1 kHz. The load steps at a
+  // command; the next command's feed-forward target is f*; without compensation the gripper
+  // has covered 1 - exp(-20/30) = 49 % of the step one period later, with it >= 97 %.
+  const ContactParams p = box();
+  StaticForceSolver solver(p);
+  const double tau_g = 0.03;
+  double reached[2] = {0.0, 0.0};
+  for (const int comp : {0, 1}) {
+    GraspControllerSettings s = fast();
+    s.reaction_lag = comp ? tau_g : 0.0;
+    GraspController c(p, s);
+    const double f0 = solver.solve(2.2, 0.0, s.s_ref).force;
+    c.reset(f0);
+    GraspControllerOutput out;
+    double f = f0, target = 0.0;
+    int t_issue = -1;
+    for (int k = 0; k < 60; ++k) {  // 120 ms
+      const double ft = k <= 10 ? 2.2 : 3.7;  // load step right after the command at 20 ms
+      c.step(two(finger(0.7, ft), finger(0.7, ft)), out);
+      if (out.command_issued && k >= 20 && t_issue < 0) {
+        t_issue = k;
+        target = out.static_force;
+      }
+      for (int j = 0; j < 2; ++j) f += (out.force - f) * (1.0 - std::exp(-0.001 / tau_g));
+      if (t_issue >= 0 && k == t_issue + 9) reached[comp] = (f - f0) / (target - f0);
+    }
+    ASSERT_GT(target, f0 * 1.25);
+    EXPECT_LE(out.force, s.f_max);
+  }
+  EXPECT_NEAR(reached[0], 1.0 - std::exp(-0.02 / tau_g), 0.03);
+  EXPECT_GT(reached[1], 0.97);
+  EXPECT_LT(reached[1], 1.03);
+}
+
+TEST(ControllerReaction, ReflexActsOnACommandSampleWithALostPad) {
+  // Finger 0 reads S at the projection bound on three samples (the object slides); at the
+  // command sample finger 1 reports NoContact (its pad left the object). The command is flagged
+  // held and the status is NoContact; with react_when_invalid it is still raised by the reflex,
+  // without it held. Never lowered.
+  for (const bool react : {false, true}) {
+    GraspControllerSettings s;
+    s.max_rate_up = s.max_rate_down = kInf;
+    s.feedforward = false;
+    s.reaction_lag = 0.0;
+    s.react_when_invalid = react;
+    GraspController c(box(), s);
+    c.reset(4.0);
+    GraspControllerOutput out;
+    c.step(two(finger(0.7, 2.2), finger(0.7, 2.2)), out);
+    const double f0 = out.force;
+    for (int k = 0; k < 9; ++k) {
+      const double S = k >= 5 && k < 8 ? 1.0 : 0.7;
+      c.step(two(finger(S, 2.2), finger(S, 2.2)), out);
+    }
+    c.step(two(finger(0.7, 2.2), finger(0.0, 0.0, 0.0, Status::NoContact)), out);
+    ASSERT_TRUE(out.command_issued);
+    EXPECT_EQ(out.status, Status::NoContact);
+    EXPECT_TRUE(out.held);
+    EXPECT_TRUE(std::isfinite(out.force));
+    if (react) {
+      EXPECT_TRUE(out.reflex);
+      EXPECT_NEAR(out.force, s.reflex_factor * f0, 1e-9 * f0);
+    } else {
+      EXPECT_EQ(out.force, f0);
+    }
+    // The pad stays lost with no slip on the other: the command is held, never lowered.
+    for (int k = 0; k < 50; ++k) c.step(two(finger(0.1, 0.5), finger(0.0, 0.0, 0.0, Status::NoContact)), out);
+    EXPECT_EQ(out.status, Status::NoContact);
+    EXPECT_GE(out.force, react ? s.reflex_factor * f0 - 1e-9 : f0);
+  }
+}
+
+TEST(ControllerReaction, SettingsValidated) {
+  for (auto bad : {+[](GraspControllerSettings& s) { s.feedforward_horizon = -1e-3; },
+                   +[](GraspControllerSettings& s) { s.feedforward_trend = std::nan(""); },
+                   +[](GraspControllerSettings& s) { s.reaction_lag = kInf; }}) {
+    GraspControllerSettings s;
+    bad(s);
+    std::string msg;
+    EXPECT_FALSE(validate(s, &msg));
+    EXPECT_THROW(GraspController(box(), s), std::invalid_argument);
+  }
+}
