@@ -25,6 +25,7 @@ true mu and tau_max goes to ``build/mujoco_ident/summary.json`` and is printed a
 
     python validation/mujoco/identify_pad.py                 # both steps (make identify-mujoco)
     python validation/mujoco/identify_pad.py --only pad --maneuvers 24 --out-dir /tmp/fit
+    python validation/mujoco/identify_pad.py --only pad --observer-check 0.0115,0.048,0.095
 """
 
 from __future__ import annotations
@@ -180,6 +181,50 @@ def compare(rig: MujocoRubbingRig, fitted: Path) -> dict:
     return row
 
 
+def observer_check(fitted: Path, data: RubbingData, sigma_z: list[float]) -> list[dict]:
+    """The online observer of `fitted` (its observer block) on the fit's held-out maneuvers of
+    `data`, once per sigma_z value (the other parameters the file's), against the rig's truth:
+    the share of gross-sliding samples with S >= 0.9, of stick samples below 0.7 of the
+    friction limit with S >= 0.9, and the delay from each maneuver's first gross-sliding
+    sample to S >= 0.9 (median and 90 % quantile [s]; 0: S was there first)."""
+    import yaml
+    from lugrip import Observer
+    from lugrip.identification import read_observer_settings
+
+    doc = yaml.safe_load(fitted.read_text())
+    held = sorted(int(str(m).rsplit("#", 1)[1])
+                  for m in doc["identification"]["validation_maneuvers"])
+    d = data.select_maneuvers(held)
+    log, p0, kw = d.log, ContactParams.from_yaml(fitted), read_observer_settings(fitted)
+    rows = []
+    for sz in sigma_z:
+        p = p0.replace(sigma_z=float(sz))
+        S = np.empty(len(log))
+        delays = []
+        for m in np.unique(log.maneuver):
+            sel = np.flatnonzero(log.maneuver == m)
+            run = Observer(p, **kw).run(
+                {"t": log.t[sel], "f_n": log.f_n[sel], "f_t": log.f_t[sel], "tau": log.tau[sel]}
+            )
+            S[sel] = np.asarray(run.S)
+            gross = np.flatnonzero(d.phase[sel] == 2)
+            if gross.size:
+                i0 = int(gross[0])
+                hit = np.flatnonzero(S[sel][i0:] >= 0.9)
+                delays.append(log.t[sel][i0 + hit[0]] - log.t[sel][i0] if hit.size else np.inf)
+        delays = np.asarray(delays)
+        stick = d.stick_below(0.7)
+        rows.append({
+            "sigma_z": float(sz),
+            "S_sliding": float(np.mean(S[d.gross_sliding] >= 0.9)),
+            "S_stick": float(np.mean(S[stick] >= 0.9)),
+            "delay_median": float(np.median(delays)),
+            "delay_p90": float(np.quantile(delays, 0.9)),
+            "maneuvers": int(delays.size),
+        })
+    return rows
+
+
 def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument(
@@ -210,6 +255,13 @@ def main(argv=None) -> int:
         "eq. 32 refinement from pad.yaml (default: the limit-surface stage alone)",
     )
     ap.add_argument("--report", action="store_true", help="identify's report per fit")
+    ap.add_argument(
+        "--observer-check",
+        default="",
+        metavar="SIGMA_Z,...",
+        help="after the pad fit: S of its observer on the held-out maneuvers against the rig's "
+        "truth with the file's sigma_z and with each of these values",
+    )
     ap.add_argument("--force", action="store_true", help="regenerate cached data sets")
     args = ap.parse_args(argv)
     args.out_dir.mkdir(parents=True, exist_ok=True)
@@ -227,6 +279,18 @@ def main(argv=None) -> int:
             failed.append(("pad", rc))
         if pad_file.is_file():
             summary["pad"] = compare(rig, pad_file) | {"exit": rc}
+            if args.observer_check:
+                own = ContactParams.from_yaml(pad_file).sigma_z
+                values = [own] + [float(v) for v in args.observer_check.split(",") if v]
+                rows = observer_check(pad_file, RubbingData.load(d), values)
+                summary["pad"]["observer_check"] = rows
+                print("| sigma_z [N m s/rad] | S >= 0.9 sliding | S >= 0.9 stick < 0.7 "
+                      "| delay to S >= 0.9 median / 90 % [ms] | maneuvers |")
+                print("|---|---|---|---|---|")
+                for r in rows:
+                    print(f"| {r['sigma_z']:.3g} | {r['S_sliding']:.3f} | {r['S_stick']:.4f} | "
+                          f"{1e3 * r['delay_median']:.0f} / {1e3 * r['delay_p90']:.0f} | "
+                          f"{r['maneuvers']} |")
     if args.only in (None, "objects"):
         if not pad_file.is_file():
             raise SystemExit(f"{pad_file} is missing: run the pad step first")
