@@ -389,7 +389,8 @@ def run_campaign(
             if on_run is not None:
                 on_run(index, rows)
     elapsed = time.perf_counter() - t0
-    if all(i in store.done() for i in range(runs)):
+    finished = store.done()  # read once: it opens every part file
+    if all(i in finished for i in range(runs)):
         store.consolidate()
     return {
         "requested": runs,
