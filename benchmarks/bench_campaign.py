@@ -117,7 +117,20 @@ def main(argv=None) -> int:
                     help="campaign results directories whose report.json is summarised too")
     ap.add_argument("--no-ray", action="store_true")
     ap.add_argument("--no-mujoco", action="store_true")
+    ap.add_argument("--results-only", action="store_true",
+                    help="keep the section's throughput table and replace only the campaign "
+                         "summaries with those of --results")
     args = ap.parse_args(argv)
+    if args.results_only:
+        begin, end = markers(SECTION)
+        text = args.out.read_text()
+        if begin not in text or end not in text:
+            ap.error(f"{args.out} has no {SECTION} section to keep")
+        body = text.split(begin, 1)[1].split(end, 1)[0]
+        body = body.split("\n### Campaign ", 1)[0].rstrip("\n")
+        section = "\n".join([begin + body, *_results(args.results), end, ""])
+        write_section(args.out, section, SECTION)
+        return 0
     work = ROOT / "build" / "bench_campaign"
     work.mkdir(parents=True, exist_ok=True)
     backends = ["process"]

@@ -202,6 +202,24 @@ def test_draws_reach_the_scenario():
     assert scn.plant["sensor"]["bias"][0] == [0.0, p["force_bias"], p["force_bias"], p["torque_bias"]]
 
 
+def test_mujoco_belief_takes_the_drawn_mu_over_the_identified_file():
+    """The MuJoCo campaign's base scenario names an identified file (fitted on one block, its
+    own mu) as the estimator: each run's belief keeps that file's pad parameters but takes the
+    drawn object's mu, times the mismatch (before, every drawn object was observed with the
+    file's mu, and S could not reach the slip threshold on low-friction objects)."""
+    from lugrip import ContactParams
+
+    c = load_campaign(ROOT / "campaigns" / "mujoco_blocks.yaml")
+    pad = ContactParams.from_yaml(ROOT / "objects" / "mujoco" / "small_resin_block.yaml")
+    for index in (0, 1, 2):
+        scn, p = c.run_scenario(index)
+        est = scn.estimator["mujoco"]
+        assert math.isclose(est["mu"], p["mu"] * (1 + p["mismatch_mu"]))
+        assert math.isclose(est["delta"], pad.delta)
+        assert math.isclose(est["sigma_z"], pad.sigma_z)
+        assert est["k"] == pad.k
+
+
 # --- runs and backends --------------------------------------------------------------------------
 
 

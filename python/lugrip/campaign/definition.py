@@ -515,9 +515,9 @@ class Campaign:
         plant["seed"] = p["plant_seed"]
         d["plant"] = plant
         mism = {k[len("mismatch_"):]: v for k, v in p.items() if k.startswith("mismatch_")}
-        if mism:
+        if mism or "mu" in p:
             d["estimator"] = dict(d.get("estimator") or {})
-            d["estimator"][self.plant] = self._mismatched(base, d, mism)
+            d["estimator"][self.plant] = self._mismatched(base, d, mism, "mu" in p)
         d["name"] = f"{self.name}_run{index}"
         d["criteria"] = {}
         d["criteria_by_plant"] = {}
@@ -526,16 +526,21 @@ class Campaign:
         except ValueError as err:
             raise CampaignError(f"run {index}: drawn parameters {p}: {err}") from None
 
-    def _mismatched(self, base, d: dict, mism: Mapping[str, float]):
+    def _mismatched(self, base, d: dict, mism: Mapping[str, float], drawn_mu: bool = False):
         """The estimator block of one run: what the controller would believe without the
         mismatch (the base scenario's estimator for this plant, else the plant's contact), each
-        listed field times (1 + relative error)."""
+        listed field times (1 + relative error). With `drawn_mu` the belief's mu is the drawn
+        object's: a base estimator that is an identified file carries the mu of the object it
+        was fitted on, and a per-object refit (only mu free) would give the drawn object's, up
+        to the mismatch."""
         from ..sim._closed_loop import estimator_params
         from ..sim.scenarios import Scenario
 
         tmp = Scenario.from_dict(d | {"estimator": {}}, base.source)
         plant_contact = tmp.plant_config(self.plant if self.plant != "mujoco" else None).contact
         est = estimator_params(plant_contact, base.estimator_for(self.plant)) or plant_contact
+        if drawn_mu:
+            est = est.replace(mu=plant_contact.mu)
         return est.replace(**{k: getattr(est, k) * (1.0 + e) for k, e in mism.items()}).to_dict()
 
     # --- identity ---------------------------------------------------------------------------
