@@ -447,13 +447,7 @@ void GraspController::issue_command(bool valid, double slip) noexcept {
     if (s_.react_when_invalid && mode_ == ControllerMode::SlippingAvoidance) {
       // Raise-only reactions from the valid fingers' samples of the period.
       double n_slope = 1.0;
-      double lift = static_floor(n_slope);
-      c.feedforward_force = lift;
-      if (s_.slip_reflex && reflex_armed_) {
-        lift = std::max(lift, s_.reflex_factor * std::min(last_.static_force, command_));
-        c.reflex = true;
-      }
-      lift = std::min(lift, s_.f_max);
+      double lift = std::min(reaction_floor(n_slope, c), s_.f_max);
       if (lift > f_est_ && lag > 0.0) lift += (lift - f_est_) * lag / (1.0 - lag);
       f = std::max(f, std::min(lift, command_ + s_.max_rate_up * t_cmd_));
     }
@@ -473,13 +467,7 @@ void GraspController::issue_command(bool valid, double slip) noexcept {
   if (mode_ == ControllerMode::SlippingAvoidance) {
     // Floor of the static part: feed-forward of the measured load and the slip reflex.
     double n_slope = 1.0;
-    double lift = static_floor(n_slope);
-    c.feedforward_force = lift;
-    if (s_.slip_reflex && reflex_armed_) {
-      // On the static part: a transient f_nd would otherwise be multiplied into f_ns.
-      lift = std::max(lift, s_.reflex_factor * std::min(last_.static_force, command_));
-      c.reflex = true;
-    }
+    const double lift = reaction_floor(n_slope, c);
     clear_period();
     // PI on e = S - s_ref: e > 0 (closer to slip than wanted) raises the force (docs/model.md 9.4).
     e = slip - s_.s_ref;
@@ -579,6 +567,17 @@ void GraspController::clear_period() noexcept {
   peak_s_ = sum_s_ = 0.0;
   n_s_ = 0;
   reflex_armed_ = false;
+}
+
+double GraspController::reaction_floor(double& slope_exponent, GraspControllerOutput& c) noexcept {
+  double lift = static_floor(slope_exponent);
+  c.feedforward_force = lift;
+  if (s_.slip_reflex && reflex_armed_) {
+    // On the static part: a transient f_nd would otherwise be multiplied into f_ns.
+    lift = std::max(lift, s_.reflex_factor * std::min(last_.static_force, command_));
+    c.reflex = true;
+  }
+  return lift;
 }
 
 double GraspController::static_floor(double& slope_exponent) noexcept {

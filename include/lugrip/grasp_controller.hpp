@@ -373,6 +373,8 @@ class GraspController {
   void reset_dynamic() noexcept;
   void issue_command(bool valid, double slip) noexcept;
   double static_floor(double& slope_exponent) noexcept;
+  // static_floor() raised by the armed slip reflex; records both in c (feedforward_force, reflex)
+  double reaction_floor(double& slope_exponent, GraspControllerOutput& c) noexcept;
   void clear_period() noexcept;
 
   GraspControllerSettings s_;
