@@ -41,6 +41,16 @@ GraspControllerSettings free_rates() {
 // Time [s] at which the pivoting filter, started from f0 with S = kS and the default
 // tau_p = 2 s, k_f = 4, s_pivot = 1.3, first computes an update below `floor`: the commands
 // output f0, f1, ... with f_{n+1} = a f_n + (1 - a) k_f (kS - 1.3); command n at n T_cmd.
+// Steps c with the same input until its pivot ends (at most 100000 samples); the samples taken.
+long steps_to_pivot_end(GraspController& c, const GraspControllerInput& in, GraspControllerOutput& out) {
+  long n = 0;
+  do {
+    c.step(in, out);
+    ++n;
+  } while (!out.pivot_finished && n < 100000);
+  return n;
+}
+
 double first_command_wanting_below(double f0, double floor) {
   const double a = std::exp(-kTcmd / 2.0), target = 4.0 * (kS - 1.3);
   double f = f0;
@@ -216,11 +226,7 @@ TEST(PivotEnd, EndsAfterTheTimeAtTheFloorWhenTheCoRStaysIn) {
   const double floor = 1.1 * 0.2 / 0.75;
   const double t_floor = first_command_wanting_below(0.5, floor);
   GraspControllerOutput out;
-  long n = 0;
-  do {
-    c.step(one(kS, 0.9, 0.2), out);
-    ++n;
-  } while (!out.pivot_finished && n < 100000);
+  long n = steps_to_pivot_end(c, one(kS, 0.9, 0.2), out);
   EXPECT_EQ(out.pivot_end, PivotEnd::AtFloor);
   EXPECT_NEAR(n * kDt, t_floor + 1.0 + kDt, 1e-9);
   EXPECT_EQ(out.mode, ControllerMode::SlippingAvoidance);
@@ -241,11 +247,7 @@ TEST(PivotEnd, EndsAfterTheTimeAtTheFloorWhenTheCoRStaysIn) {
   GraspController p(can(), paper);
   p.reset(0.5);
   p.request_pivoting();
-  n = 0;
-  do {
-    p.step(one(kS, 0.9, 0.2), out);
-    ++n;
-  } while (!out.pivot_finished && n < 100000);
+  n = steps_to_pivot_end(p, one(kS, 0.9, 0.2), out);
   EXPECT_EQ(out.pivot_end, PivotEnd::Timeout);
 }
 
@@ -288,22 +290,14 @@ TEST(PivotEnd, ASlidingContactDoesNotEndItOnTheCoR) {
   c.reset(0.3);
   c.request_pivoting();
   GraspControllerOutput out;
-  long n = 0;
-  do {
-    c.step(one(1.0, 1.4, 0.2), out);
-    ++n;
-  } while (!out.pivot_finished && n < 100000);
+  long n = steps_to_pivot_end(c, one(1.0, 1.4, 0.2), out);
   EXPECT_EQ(out.pivot_end, PivotEnd::AtFloor);
   EXPECT_NEAR(n * kDt, 1.0 + kDt, 1e-9);
   // below the bound the same input ends it after three samples at the floor
   GraspController d(can(), free_rates());
   d.reset(0.3);
   d.request_pivoting();
-  n = 0;
-  do {
-    d.step(one(0.98, 1.4, 0.2), out);
-    ++n;
-  } while (!out.pivot_finished && n < 100000);
+  n = steps_to_pivot_end(d, one(0.98, 1.4, 0.2), out);
   EXPECT_EQ(out.pivot_end, PivotEnd::CorThreshold);
   EXPECT_EQ(n, 4);
 }
