@@ -115,6 +115,8 @@ struct Table<GraspControllerSettings> {
       field("feedforward_trend", &S::feedforward_trend, "relative force rise that counts as a trend [-]"),
       field("reaction_lag", &S::reaction_lag, "gripper lag the reaction overshoots for (0: off) [s]"),
       field("react_when_invalid", &S::react_when_invalid, "raise-only reactions on invalid samples"),
+      field("reserve_force", &S::reserve_force, "standing reserve: push to absorb per finger (0: off) [N]"),
+      field("reserve_torque", &S::reserve_torque, "standing reserve: twist to absorb per finger (0: off) [N m]"),
       field("f_min", &S::f_min, "minimum force [N]"),
       field("f_max", &S::f_max, "maximum force [N]"),
       field("max_rate_up", &S::max_rate_up, "command increase limit (inf: off) [N/s]"),

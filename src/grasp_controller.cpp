@@ -126,6 +126,10 @@ bool validate(const GraspControllerSettings& s, std::string* message) {
     bad("feedforward_trend", s.feedforward_trend, "must be finite, >= 0 and <= 1000");
   if (!(std::isfinite(s.reaction_lag) && s.reaction_lag >= 0.0 && s.reaction_lag <= 1.0e3))
     bad("reaction_lag", s.reaction_lag, "must be finite, >= 0 and <= 1000 [s]");
+  if (!(std::isfinite(s.reserve_force) && s.reserve_force >= 0.0 && s.reserve_force <= kForceMax))
+    bad("reserve_force", s.reserve_force, "must be finite, >= 0 and <= 1e+06 [N]");
+  if (!(std::isfinite(s.reserve_torque) && s.reserve_torque >= 0.0 && s.reserve_torque <= kForceMax))
+    bad("reserve_torque", s.reserve_torque, "must be finite, >= 0 and <= 1e+06 [N m]");
   if (message) *message = msg;
   return msg.empty();
 }
@@ -156,7 +160,8 @@ std::string to_string(const GraspControllerSettings& s) {
          ", slip_reflex=" + flag(s.slip_reflex) + ", reflex_slippage=" + num(s.reflex_slippage) +
          ", reflex_samples=" + std::to_string(s.reflex_samples) + ", reflex_factor=" + num(s.reflex_factor) + ", average_slippage=" + flag(s.average_slippage) +
          ", feedforward_horizon=" + num(s.feedforward_horizon) + ", feedforward_trend=" + num(s.feedforward_trend) +
-         ", reaction_lag=" + num(s.reaction_lag) + ", react_when_invalid=" + flag(s.react_when_invalid) + ")";
+         ", reaction_lag=" + num(s.reaction_lag) + ", react_when_invalid=" + flag(s.react_when_invalid) +
+         ", reserve_force=" + num(s.reserve_force) + ", reserve_torque=" + num(s.reserve_torque) + ")";
 }
 
 const char* to_string(ControllerMode m) noexcept {
@@ -604,6 +609,11 @@ double GraspController::static_floor(double& slope_exponent) noexcept {
                                         s_.feedforward_slippage).force;
         if (std::isfinite(fx) && fx > (1.0 + s_.feedforward_trend) * f) f = fx;
       }
+      if (std::isfinite(f)) force = std::max(force, f);
+    }
+    if (s_.reserve_force > 0.0 || s_.reserve_torque > 0.0) {
+      // Standing reserve: the static force of the load plus the disturbance the task expects.
+      const double f = solver_.solve(std::fabs(ft) + s_.reserve_force, std::fabs(tau) + s_.reserve_torque, 1.0).force;
       if (std::isfinite(f)) force = std::max(force, f);
     }
     if (s_.slope_gain) {

@@ -89,6 +89,16 @@ struct GraspControllerSettings {
   //! the force stays the PI's (the feed-forward, noisier, only acts when the load jumps).
   double feedforward_slippage = 0.9;
 
+  // --- standing reserve for the task's disturbances (not in the paper; docs/controller.md §8) --
+  //! (*) [N] default 0 = off. Per finger: the push the grasp must absorb without reacting (one
+  //! that arrives faster than the gripper's command period and lag). At each command the static
+  //! part is floored at the static grasp force (StaticForceSolver, at S = feedforward_slippage)
+  //! of the measured load with reserve_force added to |f_t| and reserve_torque to |tau|, so that
+  //! such a push keeps S below the reflex threshold while the reaction is on its way. Not applied
+  //! while pivoting. >= 0, finite.
+  double reserve_force = 0.0;
+  double reserve_torque = 0.0;  //!< (*) [N m] default 0 = off; the twist to absorb, as reserve_force. >= 0, finite.
+
   // --- slip reflex (not in the paper) ---------------------------------------------------------
   //! (*) default true; false = paper. When S = max_i S_i stays at or above reflex_slippage on
   //! reflex_samples consecutive valid samples (the dry capacity is used up: the contact slides or

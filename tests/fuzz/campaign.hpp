@@ -313,7 +313,8 @@ class Campaign {
                   LUGRIP_FUZZ_REAL(G, pivot_end_filter), LUGRIP_FUZZ_REAL(G, pivot_floor_time),
                   LUGRIP_FUZZ_REAL(G, pivot_end_slippage),
                   LUGRIP_FUZZ_REAL(G, feedforward_horizon), LUGRIP_FUZZ_REAL(G, feedforward_trend),
-                  LUGRIP_FUZZ_REAL(G, reaction_lag)};
+                  LUGRIP_FUZZ_REAL(G, reaction_lag),      LUGRIP_FUZZ_REAL(G, reserve_force),
+                  LUGRIP_FUZZ_REAL(G, reserve_torque)};
     ctl_.ints = {LUGRIP_FUZZ_INT(G, command_ratio), LUGRIP_FUZZ_INT(G, pivot_end_samples)};
     ctl_.init([](const G& s) { return validate(s, nullptr); });
   }

@@ -230,6 +230,8 @@ class Scenario:
     criteria_by_plant: dict = dataclasses.field(default_factory=dict)
     faults: dict = dataclasses.field(default_factory=dict)
     source: Path | None = None
+    #: the standing reserve's derivation (controller ``reserve: disturbances``), else empty
+    reserve: dict = dataclasses.field(default_factory=dict)
 
     @classmethod
     def from_dict(cls, data: Mapping[str, Any], source: Path | None = None) -> Scenario:
@@ -295,6 +297,19 @@ class Scenario:
         )
         if s.suite not in SUITES:
             raise ValueError(f"{where}: suite {s.suite!r}: expected one of {', '.join(SUITES)}")
+        reserve = s.controller.pop("reserve", None)
+        if reserve is not None:
+            if reserve != "disturbances":
+                raise ValueError(
+                    f"{where}: controller.reserve: {reserve!r}: the only rule is 'disturbances' "
+                    "(or give reserve_force / reserve_torque)"
+                )
+            crit = s.criteria_by_plant.get("mujoco", s.criteria)
+            ratio = int(s.controller.get("command_ratio", 10))
+            rate = float(s.controller.get("sensor_rate", 500.0))
+            s.reserve = disturbance_reserve(s.plant, crit, ratio / rate)
+            for key in ("reserve_force", "reserve_torque"):
+                s.controller.setdefault(key, s.reserve[key])
         s.plant_config()  # validates the plant block now, naming bad fields
         if s.mujoco:
             s.scene_spec()  # and the MuJoCo scene
@@ -305,6 +320,7 @@ class Scenario:
     def to_dict(self) -> dict:
         d = dataclasses.asdict(self)
         d.pop("source")
+        d.pop("reserve")
         if d["steady_window"] is not None:
             d["steady_window"] = list(d["steady_window"])
         return d
@@ -450,6 +466,51 @@ def expand_disturbances(items: Sequence[Mapping[str, Any]]) -> list[dict]:
             dict(neg, shape="ramp", t_start=t0 + dur - edge, duration=edge),
         ]
     return out
+
+
+def disturbance_reserve(
+    plant: Mapping[str, Any], criteria: Mapping[str, Any], command_period: float = 0.02
+) -> dict[str, Any]:
+    """Per-finger standing reserve (``reserve_force`` [N], ``reserve_torque`` [N m]) for the
+    scenario's pulses: the largest rise of the load's magnitude any one pulse causes (force
+    against the weight, torque about the grasp point), less what the object may take before the
+    reaction arrives without leaving the slip budget (docs/controller.md §8).
+
+    The allowance is the excess that moves the free object by the budget within the reaction
+    time t_r = command period + actuator time constant: 2 m x_max / t_r^2 for the force and
+    2 I_grasp theta_max / t_r^2 for the torque (I_grasp = I + m |cog|^2). Both are split over the
+    two fingers. Wrist moves are slow and left to the feedback.
+    """
+    g = 9.81
+    obj = plant.get("object") or {}
+    m = float(obj.get("mass", 0.0))
+    inertia = float(obj.get("inertia", 0.0))
+    cog = [float(v) for v in obj.get("cog", (0.0, 0.0))]
+    t_r = float(command_period) + float((plant.get("actuator") or {}).get("time_constant", 0.0))
+    x_max = float(criteria.get("max_hold_slip_mm", 1.0)) * 1e-3
+    th_max = math.radians(float(criteria.get("max_hold_rotation_deg", 1.0)))
+    i_grasp = inertia + m * (cog[0] ** 2 + cog[1] ** 2)
+    weight = (0.0, -m * g)
+    tau_g = cog[0] * weight[1] - cog[1] * weight[0]  # about the grasp point
+    d_force = d_torque = 0.0
+    for q in plant.get("disturbances") or []:
+        f = [float(v) for v in q.get("force", (0.0, 0.0))]
+        pt = [float(v) for v in q.get("point", (0.0, 0.0))]
+        r = (cog[0] + pt[0], cog[1] + pt[1])
+        tau = float(q.get("torque", 0.0)) + r[0] * f[1] - r[1] * f[0]
+        d_force = max(d_force, math.hypot(weight[0] + f[0], weight[1] + f[1]) - abs(weight[1]))
+        d_torque = max(d_torque, abs(tau_g + tau) - abs(tau_g))
+    allow_f = 2.0 * m * x_max / t_r**2 if t_r > 0 else 0.0
+    allow_t = 2.0 * i_grasp * th_max / t_r**2 if t_r > 0 else 0.0
+    return {
+        "reserve_force": max(0.0, 0.5 * (d_force - allow_f)),
+        "reserve_torque": max(0.0, 0.5 * (d_torque - allow_t)),
+        "largest_force_rise": d_force,
+        "largest_torque_rise": d_torque,
+        "allowance_force": allow_f,
+        "allowance_torque": allow_t,
+        "reaction_time": t_r,
+    }
 
 
 def load_scenario(name: str | Path) -> Scenario:
