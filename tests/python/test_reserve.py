@@ -18,10 +18,12 @@ def test_reserve_rule_for_the_box_by_hand():
     """Box: 0.45 kg, I = 6.15e-4 kg m^2, CoG 10 mm below the grasp point; pulses 3 N down, 2 N
     sideways (at the CoG: 20 N mm about the grasp point), 5 N up, +-20 N mm. The largest rise of
     |load| is the 3 N push (the up push lowers it, the sideways one adds
-    sqrt(4.41^2 + 2^2) - 4.41 = 0.43 N); of |torque| 20 N mm (the weight has no arm). Reaction
-    time 20 ms + 30 ms. Allowances: 2 m x / t^2 = 0.36 N, 2 (I + m d^2) theta / t^2 = 9.2 N mm."""
+    sqrt(4.41^2 + 2^2) - 4.41 = 0.43 N); of |torque| 20 N mm (the weight has no arm). Without a
+    rate limit the reaction time is 20 ms + 30 ms; allowances 2 m x / t^2 = 0.36 N and
+    2 (I + m d^2) theta / t^2 = 9.2 N mm."""
     scn = sc.load_scenario(sc.scenario_dir() / "unseen" / "box_heavy.yaml")
-    r = scn.reserve
+    crit = scn.criteria_by_plant["mujoco"]
+    r = sc.disturbance_reserve(scn.plant, crit, 0.02)
     t = 0.02 + 0.03
     allow_f = 2 * 0.45 * 1e-3 / t**2
     allow_t = 2 * (6.15e-4 + 0.45 * 0.01**2) * math.radians(1.0) / t**2
@@ -30,8 +32,31 @@ def test_reserve_rule_for_the_box_by_hand():
     assert r["largest_torque_rise"] == pytest.approx(0.020)
     assert r["allowance_force"] == pytest.approx(allow_f)
     assert r["allowance_torque"] == pytest.approx(allow_t)
-    assert scn.controller["reserve_force"] == pytest.approx((3.0 - allow_f) / 2)  # 1.32 N
-    assert scn.controller["reserve_torque"] == pytest.approx((0.020 - allow_t) / 2)  # 5.4 N mm
+    assert r["reserve_force"] == pytest.approx((3.0 - allow_f) / 2)  # 1.32 N
+    assert r["reserve_torque"] == pytest.approx((0.020 - allow_t) / 2)  # 5.4 N mm
+
+
+def test_reserve_rule_with_the_rate_limit_is_its_own_fixed_point():
+    """With the scene's identified contact and 200 N/s the reaction time adds the ramp from the
+    reserve's force to the force the whole pulse needs; the solved t_r reproduces itself
+    (consistency with lugrip's static grasp force), and the reserve only grows."""
+    import lugrip
+    from lugrip.sim._closed_loop import estimator_params
+
+    scn = sc.load_scenario(sc.scenario_dir() / "unseen" / "box_heavy.yaml")
+    r = scn.reserve
+    assert scn.controller["reserve_force"] == r["reserve_force"]
+    assert scn.controller["reserve_torque"] == r["reserve_torque"]
+    contact = estimator_params(scn.plant_config().contact, scn.estimator_for("mujoco"))
+    load_f, load_t = 0.5 * 0.45 * 9.81, 0.0
+    full = max(lugrip.static_grasp_force(contact, load_f + 1.5, load_t, 1.0)
+               - lugrip.static_grasp_force(contact, load_f + r["reserve_force"], load_t, 1.0),
+               lugrip.static_grasp_force(contact, load_f, load_t + 0.010, 1.0)
+               - lugrip.static_grasp_force(contact, load_f, load_t + r["reserve_torque"], 1.0))
+    assert r["reaction_time"] == pytest.approx(0.05 + full / 200.0, rel=1e-6)
+    assert r["ramp_time"] > 0.0
+    bare = sc.disturbance_reserve(scn.plant, scn.criteria_by_plant["mujoco"], 0.02)
+    assert r["reserve_force"] > bare["reserve_force"] and r["reserve_torque"] > bare["reserve_torque"]
 
 
 def test_reserve_rule_rejects_an_unknown_rule(tmp_path):

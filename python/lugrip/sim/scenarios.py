@@ -47,7 +47,7 @@ from .._controller import controller_settings, static_grasp_force
 from .._params import ContactParams
 from .._yaml import load_yaml, to_number
 from . import faults as _faults
-from ._closed_loop import ClosedLoopRun, run_closed_loop
+from ._closed_loop import ClosedLoopRun, estimator_params, run_closed_loop
 from ._plant import PlantConfig
 
 __all__ = [
@@ -307,7 +307,17 @@ class Scenario:
             crit = s.criteria_by_plant.get("mujoco", s.criteria)
             ratio = int(s.controller.get("command_ratio", 10))
             rate = float(s.controller.get("sensor_rate", 500.0))
-            s.reserve = disturbance_reserve(s.plant, crit, ratio / rate)
+            est = s.estimator_for("mujoco") if "mujoco" in s.estimator else s.estimator_for(
+                s.plant_model()
+            )
+            contact = estimator_params(s.plant_config().contact, est) or s.plant_config().contact
+            s.reserve = disturbance_reserve(
+                s.plant,
+                crit,
+                ratio / rate,
+                contact=contact,
+                rate_up=float(s.controller.get("max_rate_up", math.inf)),
+            )
             for key in ("reserve_force", "reserve_torque"):
                 s.controller.setdefault(key, s.reserve[key])
         s.plant_config()  # validates the plant block now, naming bad fields
@@ -469,7 +479,12 @@ def expand_disturbances(items: Sequence[Mapping[str, Any]]) -> list[dict]:
 
 
 def disturbance_reserve(
-    plant: Mapping[str, Any], criteria: Mapping[str, Any], command_period: float = 0.02
+    plant: Mapping[str, Any],
+    criteria: Mapping[str, Any],
+    command_period: float = 0.02,
+    *,
+    contact: ContactParams | None = None,
+    rate_up: float = math.inf,
 ) -> dict[str, Any]:
     """Per-finger standing reserve (``reserve_force`` [N], ``reserve_torque`` [N m]) for the
     scenario's pulses: the largest rise of the load's magnitude any one pulse causes (force
@@ -477,16 +492,19 @@ def disturbance_reserve(
     reaction arrives without leaving the slip budget (docs/controller.md §8).
 
     The allowance is the excess that moves the free object by the budget within the reaction
-    time t_r = command period + actuator time constant: 2 m x_max / t_r^2 for the force and
-    2 I_grasp theta_max / t_r^2 for the torque (I_grasp = I + m |cog|^2). Both are split over the
-    two fingers. Wrist moves are slow and left to the feedback.
+    time t_r: 2 m x_max / t_r^2 for the force and 2 I_grasp theta_max / t_r^2 for the torque
+    (I_grasp = I + m |cog|^2), both split over the two fingers. t_r is one command period plus the
+    actuator's time constant, plus, with `contact` and a finite `rate_up` [N/s], the time the
+    rate limit takes from the reserve's force to the force the whole pulse needs (static grasp
+    forces of `contact` at S = 1 for the per-finger loads; t_r and the reserve are solved
+    together). Wrist moves are slow and left to the feedback.
     """
     g = 9.81
     obj = plant.get("object") or {}
     m = float(obj.get("mass", 0.0))
     inertia = float(obj.get("inertia", 0.0))
     cog = [float(v) for v in obj.get("cog", (0.0, 0.0))]
-    t_r = float(command_period) + float((plant.get("actuator") or {}).get("time_constant", 0.0))
+    t_0 = float(command_period) + float((plant.get("actuator") or {}).get("time_constant", 0.0))
     x_max = float(criteria.get("max_hold_slip_mm", 1.0)) * 1e-3
     th_max = math.radians(float(criteria.get("max_hold_rotation_deg", 1.0)))
     i_grasp = inertia + m * (cog[0] ** 2 + cog[1] ** 2)
@@ -500,16 +518,47 @@ def disturbance_reserve(
         tau = float(q.get("torque", 0.0)) + r[0] * f[1] - r[1] * f[0]
         d_force = max(d_force, math.hypot(weight[0] + f[0], weight[1] + f[1]) - abs(weight[1]))
         d_torque = max(d_torque, abs(tau_g + tau) - abs(tau_g))
-    allow_f = 2.0 * m * x_max / t_r**2 if t_r > 0 else 0.0
-    allow_t = 2.0 * i_grasp * th_max / t_r**2 if t_r > 0 else 0.0
+
+    def reserve(t_r: float) -> tuple[float, float]:
+        allow_f = 2.0 * m * x_max / t_r**2
+        allow_t = 2.0 * i_grasp * th_max / t_r**2
+        return max(0.0, 0.5 * (d_force - allow_f)), max(0.0, 0.5 * (d_torque - allow_t))
+
+    load_f, load_t = 0.5 * m * g, 0.5 * abs(tau_g)  # per finger
+    ramp = 0.0
+    t_r = t_0
+    if t_0 > 0 and contact is not None and math.isfinite(rate_up) and (d_force > 0 or d_torque > 0):
+
+        def force(df: float, dt: float) -> float:
+            return static_grasp_force(contact, load_f + df, load_t + dt, 1.0)
+
+        def f_full(which: str) -> float:
+            return force(0.5 * d_force, 0.0) if which == "f" else force(0.0, 0.5 * d_torque)
+
+        def excess(t: float) -> float:
+            # reaction time the ramp adds at t minus what t already assumes (decreasing in t)
+            rf, rt = reserve(t)
+            step = max(f_full("f") - force(rf, 0.0), f_full("t") - force(0.0, rt), 0.0)
+            return t_0 + step / rate_up - t
+
+        lo, hi = t_0, t_0 + max(f_full("f"), f_full("t")) / rate_up
+        if excess(lo) > 0.0:
+            for _ in range(60):  # bisection: the step shrinks as t (and the reserve) grows
+                mid = 0.5 * (lo + hi)
+                lo, hi = (mid, hi) if excess(mid) > 0.0 else (lo, mid)
+            t_r = hi
+        ramp = t_r - t_0
+    rf, rt = reserve(t_r) if t_r > 0 else (0.5 * d_force, 0.5 * d_torque)
+    t_r, ramp, rf, rt = float(t_r), float(ramp), float(rf), float(rt)
     return {
-        "reserve_force": max(0.0, 0.5 * (d_force - allow_f)),
-        "reserve_torque": max(0.0, 0.5 * (d_torque - allow_t)),
+        "reserve_force": rf,
+        "reserve_torque": rt,
         "largest_force_rise": d_force,
         "largest_torque_rise": d_torque,
-        "allowance_force": allow_f,
-        "allowance_torque": allow_t,
+        "allowance_force": 2.0 * m * x_max / t_r**2 if t_r > 0 else 0.0,
+        "allowance_torque": 2.0 * i_grasp * th_max / t_r**2 if t_r > 0 else 0.0,
         "reaction_time": t_r,
+        "ramp_time": ramp,
     }
 
 
