@@ -55,6 +55,8 @@ PAPER_SETTINGS: dict[str, Any] = {
     "feedforward_horizon": 0.0,
     "reaction_lag": 0.0,
     "react_when_invalid": False,
+    "reserve_force": 0.0,
+    "reserve_torque": 0.0,
     "pivot_end_filter": 0.0,
     "pivot_end_at_floor": False,
     "pivot_floor_time": math.inf,
