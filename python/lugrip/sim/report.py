@@ -350,7 +350,7 @@ GL_PACKAGES = {
 
 def choose_gl_backend() -> str | None:
     """Set ``MUJOCO_GL`` for offscreen rendering when it is unset and there is no display:
-    "egl" when libEGL is installed, else "osmesa" when libOSMesa is. MuJoCo reads the variable
+    "egl" when libEGL is installed and opens a context, else "osmesa" when libOSMesa does. MuJoCo reads the variable
     when it is first imported, so this must run before. Returns the back end in force (None:
     none found, or MuJoCo was imported already; rendering then reports why it failed)."""
     current = os.environ.get("MUJOCO_GL")
@@ -361,10 +361,30 @@ def choose_gl_backend() -> str | None:
     if "mujoco" in sys.modules:
         return None
     for backend, lib in (("egl", "EGL"), ("osmesa", "OSMesa")):
-        if ctypes.util.find_library(lib):
+        if ctypes.util.find_library(lib) and _gl_context_works(backend):
             os.environ["MUJOCO_GL"] = backend
             return backend
     return None
+
+
+def _gl_context_works(backend: str) -> bool:
+    """Whether MuJoCo can open an offscreen context with `backend` here, tried in a child
+    process (MuJoCo fixes its back end at import; libEGL may be installed without a usable
+    device, as on a container without a GPU, where OSMesa still renders)."""
+    import subprocess
+
+    probe = "import mujoco; c = mujoco.GLContext(8, 8); c.make_current(); c.free()"
+    try:
+        p = subprocess.run(
+            [sys.executable, "-c", probe],
+            env={**os.environ, "MUJOCO_GL": backend},
+            capture_output=True,
+            timeout=60,
+            check=False,
+        )
+    except (OSError, subprocess.SubprocessError):
+        return False
+    return p.returncode == 0
 
 
 

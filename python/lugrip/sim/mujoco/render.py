@@ -3,7 +3,7 @@ optional MP4.
 
 MuJoCo picks its OpenGL back end from ``MUJOCO_GL`` when it is first imported; without a display
 :func:`choose_gl_backend` sets EGL (Mesa's software EGL: Debian packages ``libegl1``,
-``libegl-mesa0``, ``libgl1-mesa-dri``) or OSMesa (``libosmesa6``), whichever is installed. It
+``libegl-mesa0``, ``libgl1-mesa-dri``) or OSMesa (``libosmesa6``): the first that opens a context. It
 must run before ``mujoco`` is imported, so it lives in :mod:`lugrip.sim.report`, which does not
 import MuJoCo. MP4 files are written through ``imageio-ffmpeg`` (a pip
 wheel that carries its own ffmpeg; ``pip install "lugrip[video]"``).
