@@ -158,8 +158,10 @@ std::string to_string(const GraspControllerSettings& s) {
          ", loop_gain_p=" + num(s.loop_gain_p) + ", loop_gain_i=" + num(s.loop_gain_i) +
          ", feedforward=" + flag(s.feedforward) + ", feedforward_slippage=" + num(s.feedforward_slippage) +
          ", slip_reflex=" + flag(s.slip_reflex) + ", reflex_slippage=" + num(s.reflex_slippage) +
-         ", reflex_samples=" + std::to_string(s.reflex_samples) + ", reflex_factor=" + num(s.reflex_factor) + ", average_slippage=" + flag(s.average_slippage) +
+         ", reflex_samples=" + std::to_string(s.reflex_samples) + ", reflex_factor=" + num(s.reflex_factor) +
+         ", reflex_in_period=" + flag(s.reflex_in_period) + ", average_slippage=" + flag(s.average_slippage) +
          ", feedforward_horizon=" + num(s.feedforward_horizon) + ", feedforward_trend=" + num(s.feedforward_trend) +
+         ", feedforward_trend_grasp=" + flag(s.feedforward_trend_grasp) +
          ", reaction_lag=" + num(s.reaction_lag) + ", react_when_invalid=" + flag(s.react_when_invalid) +
          ", reserve_force=" + num(s.reserve_force) + ", reserve_torque=" + num(s.reserve_torque) + ")";
 }
@@ -373,7 +375,8 @@ Status GraspController::step(const GraspControllerInput& in, GraspControllerOutp
     sum_s_ += slip;
     ++n_s_;
     run_s_ = slip >= s_.reflex_slippage ? run_s_ + 1 : 0;
-    if (run_s_ >= s_.reflex_samples) reflex_armed_ = true;
+    if (slip >= s_.reflex_slippage) ++count_s_;
+    if ((s_.reflex_in_period ? count_s_ : run_s_) >= s_.reflex_samples) reflex_armed_ = true;
   } else {
     run_s_ = 0;
   }
@@ -571,6 +574,7 @@ void GraspController::clear_period() noexcept {
   n_load_.fill(0);
   peak_s_ = sum_s_ = 0.0;
   n_s_ = 0;
+  count_s_ = 0;
   reflex_armed_ = false;
 }
 
@@ -591,12 +595,21 @@ double GraspController::static_floor(double& slope_exponent) noexcept {
   constexpr double kStep = 1.1;  // relative force step of the slope's finite difference
   double force = 0.0, s_max = -1.0;
   slope_exponent = 1.0;
+  // Mean-load force of each finger and the grasp's (the largest): the trend test's reference.
+  std::array<double, kMaxFingers> f_mean{};
+  double f_grasp = 0.0;
+  for (int i = 0; i < kMaxFingers; ++i) {
+    if (n_load_[i] == 0 || !s_.feedforward) continue;
+    f_mean[i] = solver_.solve(sum_f_t_[i] / n_load_[i], sum_tau_[i] / n_load_[i], s_.feedforward_slippage).force;
+    if (std::isfinite(f_mean[i])) f_grasp = std::max(f_grasp, f_mean[i]);
+  }
   for (int i = 0; i < kMaxFingers; ++i) {
     if (n_load_[i] == 0) continue;
     const double n = n_load_[i];
     const double ft = sum_f_t_[i] / n, tau = sum_tau_[i] / n;
     if (s_.feedforward) {
-      double f = solver_.solve(ft, tau, s_.feedforward_slippage).force;
+      double f = f_mean[i];
+      const double f_ref = s_.feedforward_trend_grasp ? f_grasp : f;
       const double den = n * sum_kk_[i] - sum_k_[i] * sum_k_[i];
       if (s_.feedforward_horizon > 0.0 && n_load_[i] >= 3 && den > 0.0 && std::isfinite(f)) {
         // Least-squares trend of the period's load, extrapolated from the last sample's index
@@ -607,7 +620,7 @@ double GraspController::static_floor(double& slope_exponent) noexcept {
         const double slope_t = (n * sum_kt_[i] - sum_k_[i] * sum_tau_[i]) / den;
         const double fx = solver_.solve(std::max(0.0, ft + slope_f * ahead), tau + slope_t * ahead,
                                         s_.feedforward_slippage).force;
-        if (std::isfinite(fx) && fx > (1.0 + s_.feedforward_trend) * f) f = fx;
+        if (std::isfinite(fx) && fx > (1.0 + s_.feedforward_trend) * f_ref) f = fx;
       }
       if (std::isfinite(f)) force = std::max(force, f);
     }

@@ -70,7 +70,7 @@ struct GraspControllerSettings {
   //! combined with gain_schedule_force > 0.
   bool slope_gain = true;
   double loop_gain_p = 0.5;  //!< (*) [-] k_p |dS/df_n| with slope_gain, finite, > 0
-  double loop_gain_i = 2.0;  //!< (*) [1/s] k_i |dS/df_n| with slope_gain, finite, > 0
+  double loop_gain_i = 4.0;  //!< (*) [1/s] k_i |dS/df_n| with slope_gain, finite, > 0
 
   //! (*) default true; false = paper (S of the sample at the command). The PI's S is the mean of
   //! max_i S_i over the valid samples of the command period: S is sampled at the sensor rate and
@@ -115,6 +115,10 @@ struct GraspControllerSettings {
   //! within one command period.
   int reflex_samples = 3;
   double reflex_factor = 1.25;  //!< (*) [-] raise of the static part per period of detected slip, > 1
+  //! (*) default true; false = consecutive samples (the earlier rule). The reflex_samples samples
+  //! at or above reflex_slippage may lie anywhere in the command period: a chattering slide
+  //! (stick-slip of a compliant pad) alternates S between the bound and below it.
+  bool reflex_in_period = true;
 
   // --- reaction to fast load changes (not in the paper; docs/controller.md §6) ----------------
   //! (*) [s] default 0.03; 0 = off (paper: the load of the period only). The feed-forward also
@@ -126,6 +130,10 @@ struct GraspControllerSettings {
   //! (*) [-] the extrapolated load is used only when its static force exceeds that of the
   //! period's mean load by more than this fraction (a trend, not sensor noise). >= 0, finite.
   double feedforward_trend = 0.5;
+  //! (*) default true; false = each finger's own mean-load force (the earlier rule). The trend's
+  //! force must exceed the largest mean-load force over the fingers (the grasp's) by
+  //! feedforward_trend: a lightly loaded finger's extrapolated noise is no edge.
+  bool feedforward_trend_grasp = true;
   //! (*) [s] default 0.03; 0 = off (paper). Time constant of the gripper's force lag assumed by the
   //! reaction: when the feed-forward or the reflex lifts the static part above the force the
   //! gripper is estimated to apply, the command overshoots the target by the lag's shortfall over
@@ -421,6 +429,7 @@ class GraspController {
   double sum_s_ = 0.0;        // sum of max_i S_i over the valid samples since the last command
   int n_s_ = 0;
   int run_s_ = 0;              // consecutive valid samples with S >= reflex_slippage
+  int count_s_ = 0;            // valid samples with S >= reflex_slippage since the last command
   bool reflex_armed_ = false;  // such a run reached reflex_samples since the last command
   GraspControllerOutput last_{};  // command fields of the last command
 };

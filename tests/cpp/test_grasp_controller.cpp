@@ -1084,13 +1084,29 @@ TEST(ControllerReflex, RaisesWithinOneCommandPeriodWhenTheSpeedIsUnobservable) {
   ASSERT_TRUE(out.command_issued);
   EXPECT_TRUE(out.reflex);
   EXPECT_GE(out.force, s.reflex_factor * f0 - 1e-12);
-  // Isolated samples above the threshold (noise) do not trigger it.
+  // Isolated samples above the threshold (noise: two per period, fewer than reflex_samples) do
+  // not trigger it.
   GraspController d(can(), s);
   d.reset(2.0);
   out = run(d, one(0.8), 11);
   for (int k = 0; k < 50; ++k) {
-    d.step(one(k % 2 ? 1.0 : 0.8), out);
+    d.step(one(k % 5 == 2 ? 1.0 : 0.8), out);
     EXPECT_FALSE(out.reflex);
+  }
+  // Every other sample at the bound (a chattering slide: five per period, never three in a row)
+  // triggers it with reflex_in_period, not with the consecutive rule.
+  for (const bool in_period : {true, false}) {
+    GraspControllerSettings a = s;
+    a.reflex_in_period = in_period;
+    GraspController g(can(), a);
+    g.reset(2.0);
+    out = run(g, one(0.8), 11);
+    bool fired = false;
+    for (int k = 0; k < 20; ++k) {
+      g.step(one(k % 2 ? 1.0 : 0.8), out);
+      fired = fired || out.reflex;
+    }
+    EXPECT_EQ(fired, in_period);
   }
   // Without the reflex only the PI moves (one command: + k_p e at most).
   GraspControllerSettings off = s;

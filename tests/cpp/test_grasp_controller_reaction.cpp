@@ -109,6 +109,30 @@ TEST(ControllerReaction, NoiseBelowTheTrendThresholdKeepsTheMeanLoad) {
   EXPECT_NEAR(out.feedforward_force, mean_force, 1e-9 * mean_force);
 }
 
+TEST(ControllerReaction, TrendOfALightFingerIsComparedWithTheGraspsForce) {
+  // Finger 0 carries a steady 2.2 N; finger 1's f_t ramps from 0.5 N to 1.4 N (extrapolated:
+  // 1.4 + 0.1 * 15 = 2.9 N). Against its own mean (0.95 N) that is a trend; against the grasp's
+  // mean-load force (finger 0's, 2.2 N) it is less than the 50 % rise feedforward_trend asks.
+  const ContactParams p = box();
+  StaticForceSolver solver(p);
+  const double f_grasp = solver.solve(2.2, 0.0, 0.9).force;
+  const double f_ramp = solver.solve(1.4 + 0.1 * (0.03 / kDt), 0.0, 0.9).force;
+  ASSERT_GT(f_ramp, 1.2 * f_grasp);
+  ASSERT_LT(f_ramp, 1.5 * f_grasp);
+  for (const bool grasp : {true, false}) {
+    GraspControllerSettings s = fast();
+    s.reaction_lag = 0.0;
+    s.feedforward_trend_grasp = grasp;
+    GraspController c(p, s);
+    c.reset(5.0);
+    GraspControllerOutput out;
+    c.step(two(finger(0.7, 2.2), finger(0.7, 0.5)), out);
+    for (int k = 0; k < 10; ++k) c.step(two(finger(0.7, 2.2), finger(0.7, 0.5 + 0.1 * k)), out);
+    ASSERT_TRUE(out.command_issued);
+    EXPECT_NEAR(out.feedforward_force, grasp ? f_grasp : f_ramp, 1e-6 * f_ramp) << grasp;
+  }
+}
+
 TEST(ControllerReaction, LagCompensationReachesTheTargetWithinOneCommand) {
   // Gripper: tau_g df/dt = u - f, tau_g = 30 ms, integrated at 1 kHz. The load steps at a
   // command; the next command's feed-forward target is f*; without compensation the gripper
