@@ -42,6 +42,8 @@ SINGLE_OFF = {
     # the reaction to loads faster than one command (trend feed-forward, lag overshoot, reactions
     # on samples with an invalid finger) off together: the controller before it
     "no_fast_reaction": {"feedforward_horizon": 0.0, "reaction_lag": 0.0, "react_when_invalid": False},
+    # the standing reserve the unseen scenes derive from their pulses (the paper's scenes have none)
+    "no_reserve": {"reserve_force": 0.0, "reserve_torque": 0.0},
 }
 VARIANTS = {"default": {}, "paper": dict(lugrip.PAPER_SETTINGS), **SINGLE_OFF}
 HELD_OUT_SEEDS = (1001, 1002, 1003, 1004, 1005, 1006, 1007)
