@@ -117,6 +117,7 @@ struct Table<GraspControllerSettings> {
       field("feedforward_horizon", &S::feedforward_horizon, "feed-forward extrapolates the load's trend this far [s]"),
       field("feedforward_trend", &S::feedforward_trend, "relative force rise that counts as a trend [-]"),
       field("feedforward_trend_grasp", &S::feedforward_trend_grasp, "trend compared with the grasp's mean-load force"),
+      field("feedforward_trend_check", &S::feedforward_trend_check, "trend's lift the next period's load does not confirm is taken back"),
       field("reaction_lag", &S::reaction_lag, "gripper lag the reaction overshoots for (0: off) [s]"),
       field("react_when_invalid", &S::react_when_invalid, "raise-only reactions on invalid samples"),
       field("f_min", &S::f_min, "minimum force [N]"),

@@ -162,6 +162,7 @@ std::string to_string(const GraspControllerSettings& s) {
          ", reflex_in_period=" + flag(s.reflex_in_period) + ", average_slippage=" + flag(s.average_slippage) +
          ", feedforward_horizon=" + num(s.feedforward_horizon) + ", feedforward_trend=" + num(s.feedforward_trend) +
          ", feedforward_trend_grasp=" + flag(s.feedforward_trend_grasp) +
+         ", feedforward_trend_check=" + flag(s.feedforward_trend_check) +
          ", reaction_lag=" + num(s.reaction_lag) + ", react_when_invalid=" + flag(s.react_when_invalid) +
          ", reserve_force=" + num(s.reserve_force) + ", reserve_torque=" + num(s.reserve_torque) + ")";
 }
@@ -229,6 +230,7 @@ void GraspController::reset(double current_force) noexcept {
   last_kp_ = last_e_ = 0.0;
   clear_period();
   f_est_ = command_;
+  trend_lift_ = trend_force_ = 0.0;
   run_s_ = 0;
   reflex_armed_ = false;
   reset_dynamic();
@@ -504,9 +506,14 @@ void GraspController::issue_command(bool valid, double slip) noexcept {
     if (init_static_) {  // bumpless (re)start from the last command
       integrator_ = command_ - k_p * e;
       init_static_ = false;
-    } else if (s_.slope_gain) {
-      integrator_ += (last_kp_ - k_p) * last_e_;  // gain change without a jump of f_ns
+    } else {
+      if (s_.slope_gain) integrator_ += (last_kp_ - k_p) * last_e_;  // gain change without a jump of f_ns
+      // The trend's lift that the period's load did not confirm; only a sticking contact's
+      // load can refute it (while sliding, f_t is capped at mu f_n).
+      if (s_.feedforward_trend_check && trend_lift_ > 0.0 && c.peak_slippage < s_.reflex_slippage)
+        integrator_ -= std::min(trend_lift_, std::max(0.0, trend_force_ - floor_measured_));
     }
+    trend_lift_ = 0.0;
     const double u = k_p * e + integrator_;
     const double lo = clamp(lift, s_.f_min, s_.f_max);
     f_ns = clamp(u, lo, s_.f_max);
@@ -514,6 +521,9 @@ void GraspController::issue_command(bool valid, double slip) noexcept {
       if (u < lo && lo > s_.f_min) {
         reacting = true;
         integrator_ = f_ns - k_p * e;  // the floor lifted the PI: restart it there
+        // the part the trend added beyond the measured load's floor, checked at the next command
+        trend_lift_ = f_ns - clamp(std::max(u, floor_measured_), s_.f_min, f_ns);
+        trend_force_ = f_ns;
       } else {
         c.saturated = true;
         if (s_.anti_windup) integrator_ = f_ns - k_p * e;  // back-calculation, static part only
@@ -583,7 +593,9 @@ double GraspController::reaction_floor(double& slope_exponent, GraspControllerOu
   c.feedforward_force = lift;
   if (s_.slip_reflex && reflex_armed_) {
     // On the static part: a transient f_nd would otherwise be multiplied into f_ns.
-    lift = std::max(lift, s_.reflex_factor * std::min(last_.static_force, command_));
+    const double reflex = s_.reflex_factor * std::min(last_.static_force, command_);
+    lift = std::max(lift, reflex);
+    floor_measured_ = std::max(floor_measured_, reflex);
     c.reflex = true;
   }
   return lift;
@@ -603,6 +615,7 @@ double GraspController::static_floor(double& slope_exponent) noexcept {
     f_mean[i] = solver_.solve(sum_f_t_[i] / n_load_[i], sum_tau_[i] / n_load_[i], s_.feedforward_slippage).force;
     if (std::isfinite(f_mean[i])) f_grasp = std::max(f_grasp, f_mean[i]);
   }
+  floor_measured_ = f_grasp;
   for (int i = 0; i < kMaxFingers; ++i) {
     if (n_load_[i] == 0) continue;
     const double n = n_load_[i];

@@ -70,7 +70,7 @@ struct GraspControllerSettings {
   //! combined with gain_schedule_force > 0.
   bool slope_gain = true;
   double loop_gain_p = 0.5;  //!< (*) [-] k_p |dS/df_n| with slope_gain, finite, > 0
-  double loop_gain_i = 4.0;  //!< (*) [1/s] k_i |dS/df_n| with slope_gain, finite, > 0
+  double loop_gain_i = 2.0;  //!< (*) [1/s] k_i |dS/df_n| with slope_gain, finite, > 0
 
   //! (*) default true; false = paper (S of the sample at the command). The PI's S is the mean of
   //! max_i S_i over the valid samples of the command period: S is sampled at the sensor rate and
@@ -134,6 +134,12 @@ struct GraspControllerSettings {
   //! force must exceed the largest mean-load force over the fingers (the grasp's) by
   //! feedforward_trend: a lightly loaded finger's extrapolated noise is no edge.
   bool feedforward_trend_grasp = true;
+  //! (*) default true; false = the PI keeps the trend's lift (the earlier rule). When the trend
+  //! lifted the static part above the mean load's force, the next command checks the prediction:
+  //! the part of the lift that the new period's mean load does not confirm (its feed-forward
+  //! force below the predicted one) is taken back from the integrator, so a predicted rise that
+  //! did not come (half a cycle of a rocking object) is not left for the PI to drain.
+  bool feedforward_trend_check = true;
   //! (*) [s] default 0.03; 0 = off (paper). Time constant of the gripper's force lag assumed by the
   //! reaction: when the feed-forward or the reflex lifts the static part above the force the
   //! gripper is estimated to apply, the command overshoots the target by the lag's shortfall over
@@ -425,6 +431,9 @@ class GraspController {
   std::array<double, kMaxFingers> sum_k_{}, sum_kk_{};   // sums of k, k^2 over those samples
   std::array<int, kMaxFingers> k_load_{};                // sample index in the period
   double f_est_ = 0.0;        // gripper force estimated through reaction_lag [N]
+  double floor_measured_ = 0.0;  // reaction floor without the trend (mean load, reflex) [N]
+  double trend_lift_ = 0.0;      // part of the last restart of the integrator due to the trend [N]
+  double trend_force_ = 0.0;     // static part the trend lifted to at the last command [N]
   double peak_s_ = 0.0;       // peak of max_i S_i since the last command
   double sum_s_ = 0.0;        // sum of max_i S_i over the valid samples since the last command
   int n_s_ = 0;

@@ -133,6 +133,44 @@ TEST(ControllerReaction, TrendOfALightFingerIsComparedWithTheGraspsForce) {
   }
 }
 
+TEST(ControllerReaction, TrendLiftTheNextPeriodDoesNotConfirmIsTakenBack) {
+  // Period 1: a steady 2.2 N; period 2: f_t ramps to 3.7 N (the trend lifts the static part to
+  // the force of 6.2 N); period 3: the load is back at 2.2 N. With feedforward_trend_check the
+  // integrator gives back the lift beyond period 2's mean-load force; without it, or when the
+  // contact reached the reflex threshold in period 3 (a sliding contact's f_t cannot refute the
+  // prediction), the PI keeps the lift and only drains it.
+  const ContactParams p = box();
+  StaticForceSolver solver(p);
+  const double f_m2 = solver.solve(2.2 + 0.75, 0.0, 0.9).force;  // period 2's mean load
+  struct Case { bool check; bool sliding; bool kept; };
+  for (const Case k : {Case{true, false, false}, Case{false, false, true}, Case{true, true, true}}) {
+    GraspControllerSettings s = fast();
+    s.reaction_lag = 0.0;
+    s.feedforward_trend_check = k.check;
+    GraspController c(p, s);
+    c.reset(5.0);
+    GraspControllerOutput out;
+    c.step(two(finger(0.7, 2.2), finger(0.7, 2.2)), out);  // the first command
+    for (int n = 0; n < 10; ++n) c.step(two(finger(0.7, 2.2), finger(0.7, 2.2)), out);
+    for (int n = 0; n < 10; ++n) {
+      const double ft = 2.2 + 1.5 * n / 9.0;
+      c.step(two(finger(0.7, ft), finger(0.7, ft)), out);
+    }
+    ASSERT_TRUE(out.command_issued);
+    const double lifted = out.static_force;
+    ASSERT_GT(lifted, 1.5 * f_m2);  // the trend lifted it
+    for (int n = 0; n < 10; ++n) {
+      const double S = k.sliding && n == 4 ? 0.96 : 0.7;
+      c.step(two(finger(S, 2.2), finger(0.7, 2.2)), out);
+    }
+    ASSERT_TRUE(out.command_issued);
+    if (k.kept)
+      EXPECT_GT(out.static_force, 0.85 * lifted) << k.check << k.sliding;
+    else
+      EXPECT_LT(out.static_force, 1.05 * f_m2) << k.check << k.sliding;
+  }
+}
+
 TEST(ControllerReaction, LagCompensationReachesTheTargetWithinOneCommand) {
   // Gripper: tau_g df/dt = u - f, tau_g = 30 ms, integrated at 1 kHz. The load steps at a
   // command; the next command's feed-forward target is f*; without compensation the gripper
