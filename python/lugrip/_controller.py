@@ -198,8 +198,10 @@ class GraspController:
             static part alone; omega_deadband: dead band of C_d in omega resolutions, 0 = off),
             slope_gain, loop_gain_p [-], loop_gain_i [1/s]: PI gains from the plant's slope
             dS/df_n; feedforward, feedforward_slippage: static part floored at the static grasp
-            force of the measured load; slip_reflex, reflex_slippage, reflex_factor: raise the
-            command when the peak of S reaches the threshold (see
+            force of the measured load (feedforward_trend_grasp, feedforward_trend_check: the
+            trend's reference and the check of its prediction); slip_reflex, reflex_slippage,
+            reflex_factor, reflex_in_period: raise the command when the peak of S reaches the
+            threshold (see
             :data:`PAPER_SETTINGS` for the paper's law),
             range (f_min, f_max [N]), rate
             limits (max_rate_up, max_rate_down [N/s], inf = off), invalid_raise_step [N], pivoting
