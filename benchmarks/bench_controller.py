@@ -114,7 +114,7 @@ def section_name(plant: str) -> str:
     return "controller" if plant == "patch" else f"controller-{plant}"
 
 
-def markdown(results: dict, plant: str, seeds: list[int | None], elapsed: float) -> str:
+def markdown(results: dict, plant: str, seeds: list[int | None], elapsed: float, options: str = "") -> str:
     begin, end = markers(section_name(plant))
     lines = [
         begin,
@@ -122,7 +122,7 @@ def markdown(results: dict, plant: str, seeds: list[int | None], elapsed: float)
         "",
         "`python benchmarks/bench_controller.py"
         + ("" if plant == "patch" else f" --plant {plant}")
-        + f" --seeds {len(seeds)}` ({elapsed / 60:.1f} min). Per scenario and controller: seeds "
+        + f" --seeds {len(seeds)}{options}` ({elapsed / 60:.1f} min). Per scenario and controller: seeds "
         "passing every criterion of the scenario (tuned seed + held-out seeds), the worst slip "
         "and rotation from the lift start on, the worst steady-hold command peak-to-peak / mean, "
         "the mean hold force per finger (mean over seeds) and the smallest passing constant force "
@@ -182,7 +182,10 @@ def main(argv: list[str] | None = None) -> int:
             per["constant_force"] = constant_force(name, args.plant)
         results[name] = per
     elapsed = time.perf_counter() - t0
-    text = markdown(results, plant, seeds, elapsed)
+    options = ("" if args.variants == ",".join(VARIANTS) else f" --variants {args.variants}") + (
+        " --no-constant" if args.no_constant else ""
+    )
+    text = markdown(results, plant, seeds, elapsed, options)
     print(text)
     if args.json:
         args.json.write_text(json.dumps(results, indent=1, default=float))
