@@ -50,7 +50,7 @@ HELD_OUT_SEEDS = (1001, 1002, 1003, 1004, 1005, 1006, 1007)
 
 
 def scenario_names() -> list[str]:
-    return sc.list_scenarios() + [f"unseen/{n}" for n in ("box_heavy", "bar_offset", "cup_light", "plate_pivot")]
+    return sc.list_scenarios() + [f"unseen/{n}" for n in ("box_heavy", "bar_offset", "bar_tilt", "cup_light", "plate_pivot")]
 
 
 def load(name: str) -> sc.Scenario:
