@@ -56,8 +56,11 @@ OBJECTS = {
     "cup": "cup_light",
     "plate": "plate_pivot",
 }
-#: scenario -> object file (the full can shares the empty can's)
-SCENARIO_OBJECT = {v: k for k, v in OBJECTS.items()} | {"exp4_aluminium_can_full": "aluminium_can"}
+#: scenario -> object file (the full can shares the empty can's, the tilted bar the bar's)
+SCENARIO_OBJECT = {v: k for k, v in OBJECTS.items()} | {
+    "exp4_aluminium_can_full": "aluminium_can",
+    "bar_tilt": "bar",
+}
 #: the scene whose pad and contact-radius law the pad fit uses (every scene has the same pad)
 PAD_SCENE = "exp2_small_resin_block"
 PAD_SEED = 0  #: the pad data set's seed; object k uses PAD_SEED + 101 + k
