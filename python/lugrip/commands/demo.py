@@ -152,6 +152,10 @@ def run_demo(out_dir: str | Path, steps: list[DemoStep] | None = None,
 
 def run(args: argparse.Namespace) -> int:
     steps = _select(args.only)
+    if any(step.name == "mujoco" for step in steps):
+        from ..sim import report
+
+        report.choose_gl_backend()  # the frames: before any step imports MuJoCo
     path, failed = run_demo(args.out, steps)
     print(f"wrote {path}", file=sys.stderr)
     if failed:
