@@ -227,6 +227,24 @@ def test_demo_reports_a_failing_step_and_runs_the_others(tmp_path):
     assert "bad: FAILED" in log.getvalue() and "good: ok" in log.getvalue()
 
 
+def test_demo_chooses_the_gl_back_end_before_its_steps(tmp_path, monkeypatch):
+    """With the mujoco step selected, `lugrip demo` picks the offscreen back end before any step
+    runs (MuJoCo fixes it at import, and an earlier step imports MuJoCo); without it, never."""
+    from lugrip.commands import demo
+    from lugrip.sim import report
+
+    calls = []
+    monkeypatch.setattr(report, "choose_gl_backend", lambda: calls.append("gl") or "osmesa")
+    fake = [demo.DemoStep("ls", "LS", lambda out_dir: calls.append("ls") or "ok"),
+            demo.DemoStep("mujoco", "MuJoCo", lambda out_dir: calls.append("mujoco") or "ok")]
+    monkeypatch.setattr(demo, "STEPS", fake)
+    assert main(["demo", "--out", str(tmp_path / "a")]) == 0
+    assert calls == ["gl", "ls", "mujoco"]
+    calls.clear()
+    assert main(["demo", "--out", str(tmp_path / "b"), "--only", "ls"]) == 0
+    assert calls == ["ls"]
+
+
 def test_every_registered_command_has_help(capsys):
     """Each module of lugrip.commands.COMMANDS registers a subcommand listed in --help."""
     import importlib
