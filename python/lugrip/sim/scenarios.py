@@ -310,7 +310,8 @@ class Scenario:
             est = s.estimator_for("mujoco") if "mujoco" in s.estimator else s.estimator_for(
                 s.plant_model()
             )
-            contact = estimator_params(s.plant_config().contact, est) or s.plant_config().contact
+            plant_contact = s.plant_config().contact
+            contact = estimator_params(plant_contact, est) or plant_contact
             s.reserve = disturbance_reserve(
                 s.plant,
                 crit,
@@ -519,9 +520,11 @@ def disturbance_reserve(
         d_force = max(d_force, math.hypot(weight[0] + f[0], weight[1] + f[1]) - abs(weight[1]))
         d_torque = max(d_torque, abs(tau_g + tau) - abs(tau_g))
 
+    def allowances(t_r: float) -> tuple[float, float]:
+        return 2.0 * m * x_max / t_r**2, 2.0 * i_grasp * th_max / t_r**2
+
     def reserve(t_r: float) -> tuple[float, float]:
-        allow_f = 2.0 * m * x_max / t_r**2
-        allow_t = 2.0 * i_grasp * th_max / t_r**2
+        allow_f, allow_t = allowances(t_r)
         return max(0.0, 0.5 * (d_force - allow_f)), max(0.0, 0.5 * (d_torque - allow_t))
 
     load_f, load_t = 0.5 * m * g, 0.5 * abs(tau_g)  # per finger
@@ -532,16 +535,16 @@ def disturbance_reserve(
         def force(df: float, dt: float) -> float:
             return static_grasp_force(contact, load_f + df, load_t + dt, 1.0)
 
-        def f_full(which: str) -> float:
-            return force(0.5 * d_force, 0.0) if which == "f" else force(0.0, 0.5 * d_torque)
+        # the forces the whole push needs (fixed; only the reserve's force moves with t)
+        full_f, full_t = force(0.5 * d_force, 0.0), force(0.0, 0.5 * d_torque)
 
         def excess(t: float) -> float:
             # reaction time the ramp adds at t minus what t already assumes (decreasing in t)
             rf, rt = reserve(t)
-            step = max(f_full("f") - force(rf, 0.0), f_full("t") - force(0.0, rt), 0.0)
+            step = max(full_f - force(rf, 0.0), full_t - force(0.0, rt), 0.0)
             return t_0 + step / rate_up - t
 
-        lo, hi = t_0, t_0 + max(f_full("f"), f_full("t")) / rate_up
+        lo, hi = t_0, t_0 + max(full_f, full_t) / rate_up
         if excess(lo) > 0.0:
             for _ in range(60):  # bisection: the step shrinks as t (and the reserve) grows
                 mid = 0.5 * (lo + hi)
@@ -549,14 +552,15 @@ def disturbance_reserve(
             t_r = hi
         ramp = t_r - t_0
     rf, rt = reserve(t_r) if t_r > 0 else (0.5 * d_force, 0.5 * d_torque)
+    allow_f, allow_t = allowances(t_r) if t_r > 0 else (0.0, 0.0)
     t_r, ramp, rf, rt = float(t_r), float(ramp), float(rf), float(rt)
     return {
         "reserve_force": rf,
         "reserve_torque": rt,
         "largest_force_rise": d_force,
         "largest_torque_rise": d_torque,
-        "allowance_force": 2.0 * m * x_max / t_r**2 if t_r > 0 else 0.0,
-        "allowance_torque": 2.0 * i_grasp * th_max / t_r**2 if t_r > 0 else 0.0,
+        "allowance_force": float(allow_f),
+        "allowance_torque": float(allow_t),
         "reaction_time": t_r,
         "ramp_time": ramp,
     }
