@@ -122,7 +122,8 @@ void bind_slip_control(nb::module_& m) {
       }, "enabled"_a)
       .def("set_mu", [](SC& sc, double mu) {
         sc.guard.check("SlipControl");
-        sc.set_mu(mu);
+        if (!sc.set_mu(mu))
+          throw nb::value_error(("mu = " + std::to_string(mu) + ": must be finite, > 0 and <= 10").c_str());
       }, "mu"_a)
       .def("set_controller_settings", [](SC& sc, const GraspControllerSettings& s) {
         sc.guard.check("SlipControl");

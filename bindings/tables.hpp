@@ -97,9 +97,6 @@ struct Table<GraspControllerSettings> {
       field("k_p", &S::k_p, "proportional gain [N]"),
       field("k_i", &S::k_i, "integral gain [N/s]"),
       field("anti_windup", &S::anti_windup, "back-calculation anti-windup"),
-      field("gain_schedule_force", &S::gain_schedule_force, "gain scheduling force (0: off) [N]"),
-      field("static_equivalent_slippage", &S::static_equivalent_slippage,
-            "integrate the slippage of the static part alone"),
       field("omega_deadband", &S::omega_deadband, "C_d dead band in speed resolutions [-]"),
       field("slope_gain", &S::slope_gain, "PI gains from the plant's slope dS/df_n"),
       field("loop_gain_p", &S::loop_gain_p, "proportional loop gain k_p |dS/df_n| [-]"),
@@ -111,15 +108,12 @@ struct Table<GraspControllerSettings> {
       field("reserve_torque", &S::reserve_torque, "standing reserve: twist to absorb per finger (0: off) [N m]"),
       field("slip_reflex", &S::slip_reflex, "raise the force when S reaches reflex_slippage"),
       field("reflex_slippage", &S::reflex_slippage, "reflex threshold on S [-]"),
-      field("reflex_samples", &S::reflex_samples, "consecutive samples at or above the threshold"),
+      field("reflex_samples", &S::reflex_samples, "samples of one command period at or above the threshold"),
       field("reflex_factor", &S::reflex_factor, "static-part raise per period of detected slip [-]"),
-      field("reflex_in_period", &S::reflex_in_period, "reflex samples anywhere in the command period (not consecutive)"),
       field("feedforward_horizon", &S::feedforward_horizon, "feed-forward extrapolates the load's trend this far [s]"),
       field("feedforward_trend", &S::feedforward_trend, "relative force rise that counts as a trend [-]"),
-      field("feedforward_trend_grasp", &S::feedforward_trend_grasp, "trend compared with the grasp's mean-load force"),
-      field("feedforward_trend_check", &S::feedforward_trend_check, "trend's lift the next period's load does not confirm is taken back"),
       field("reaction_lag", &S::reaction_lag, "gripper lag the reaction overshoots for (0: off) [s]"),
-      field("react_when_invalid", &S::react_when_invalid, "raise-only reactions on invalid samples"),
+      field("mu_probe", &S::mu_probe, "relative size of the grip probe that learns mu (0: off) [-]"),
       field("f_min", &S::f_min, "minimum force [N]"),
       field("f_max", &S::f_max, "maximum force [N]"),
       field("max_rate_up", &S::max_rate_up, "command increase limit (inf: off) [N/s]"),
@@ -246,6 +240,9 @@ struct Table<GraspControllerOutput> {
       field("feedforward_force", &S::feedforward_force, "feed-forward force at the last command [N]"),
       field("peak_slippage", &S::peak_slippage, "peak of max_i S_i over the period before the last command [-]"),
       field("reflex", &S::reflex, "the slip reflex raised the last command"),
+      field("mu_belief", &S::mu_belief, "friction coefficient the controller believes now [-]"),
+      field("probing", &S::probing, "a grip probe raised the last command"),
+      field("probe_slip", &S::probe_slip, "a grip probe found the contact sliding at the last command (mu lowered)"),
       field("dynamic_sample", &S::dynamic_sample, "signed C_d omega_hat per finger at this sample [N]"),
       field("dynamic_peak", &S::dynamic_peak, "peak of max_i |C_d omega_hat_i| since the last command [N]"),
       field("mean_c_tilde", &S::mean_c_tilde, "mean |c~_i| of the valid fingers [-]"),
@@ -454,7 +451,8 @@ struct Table<ClosedLoopSample> {
       field("finite", &S::finite, "every value of this sample is finite"),
       field("status", &S::status, "Status code of the cycle"),
       field("fault_active", &S::fault_active, "an injected fault acted on this sample"),
-      field("actuator_command", &S::actuator_command, "command reaching the gripper after actuator faults [N]"));
+      field("actuator_command", &S::actuator_command, "command reaching the gripper after actuator faults [N]"),
+      field("mu_belief", &S::mu_belief, "friction coefficient the controller believes [-]"));
 };
 
 }  // namespace lugrip_bind

@@ -166,6 +166,7 @@ void ClosedLoopLog::reserve(size_t n) {
   for (auto* v : {&command_issued, &pivot_finished, &supported, &dropped, &finite, &fault_active}) v->reserve(n);
   status.reserve(n);
   actuator_command.reserve(n);
+  mu_belief.reserve(n);
 }
 
 void ClosedLoopLog::append(const ClosedLoopSample& s) {
@@ -208,6 +209,7 @@ void ClosedLoopLog::append(const ClosedLoopSample& s) {
   status.push_back(s.status);
   fault_active.push_back(s.fault_active);
   actuator_command.push_back(s.actuator_command);
+  mu_belief.push_back(s.mu_belief);
 }
 
 // --- loop ------------------------------------------------------------------------------------
@@ -478,6 +480,7 @@ Status ClosedLoop::step(ClosedLoopSample& out) noexcept {
   out.t = t;
   out.command = command_;
   out.actuator_command = actuator;
+  out.mu_belief = cfg_.kind == ControllerKind::Lugrip ? sc_.controller().mu_belief() : sc_.controller().mu();
   out.status = static_cast<int>(status);
   out.fault_active = fault;
   const bool lugrip = cfg_.kind == ControllerKind::Lugrip && started_;

@@ -86,6 +86,12 @@ ContactModel::ContactModel(const ContactParams& params) : p_(checked(params)), l
   }
 }
 
+bool ContactModel::set_mu(double mu) noexcept {
+  if (!(std::isfinite(mu) && mu > 0.0 && mu <= 10.0)) return false;  // the range validate() accepts
+  p_.mu = mu;
+  return true;
+}
+
 double ContactModel::rho(double f_n) const noexcept { return p_.delta * detail::fast_pow_pos(f_n, p_.gamma); }
 double ContactModel::ft_max(double f_n) const noexcept { return p_.mu * f_n; }
 double ContactModel::tau_max(double f_n) const noexcept {

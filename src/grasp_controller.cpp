@@ -16,6 +16,15 @@ namespace {
 constexpr double kMaxSlippage = 1.0e3;
 constexpr double kMaxInput = 1.0e6;
 constexpr int kCountMax = 1 << 30;  // saturation of the pivot end counter
+// Grip probe (mu_probe, docs/controller.md "Friction learned").
+constexpr double kProbeMinS = 0.5;        // probes only while S (against the belief) is this high
+constexpr double kProbeFall = 0.02;       // ... and not falling by more than this per period
+constexpr double kProbeElasticity = 0.5;  // d ln load / d ln f_n at or above: the contact slides
+constexpr double kProbeSigmas = 2.0;      // ... beyond this many standard errors of the load
+constexpr double kProbeStepDown = 0.7;    // the belief falls by at most 30 % per probe
+constexpr double kMuFloor = 0.5;          // ... and never below half the told mu
+constexpr double kProbeSameS = 0.05;      // S within this of the last stick answer: back off
+constexpr double kProbeGapMax = 1.0;      // [s] longest back-off
 
 // Shortest of %.15g / %.17g that reads back exactly.
 std::string fmt(double v) { return detail::format_number(v); }
@@ -76,9 +85,6 @@ bool validate(const GraspControllerSettings& s, std::string* message) {
       bad(name, v, std::string("must be finite, ") + (lo_open ? "> " : ">= ") + fmt(lo) + " and <= " + fmt(hi) + unit);
   };
   within("sensor_rate", s.sensor_rate, kRateMin, false, kRateMax, " [Hz]");
-  if (!(s.gain_schedule_force == 0.0 ||
-        (std::isfinite(s.gain_schedule_force) && s.gain_schedule_force >= kForceMin && s.gain_schedule_force <= kForceMax)))
-    bad("gain_schedule_force", s.gain_schedule_force, "must be 0 (off) or in [1e-06, 1e+06] [N]");
   if (!(s.command_ratio >= 1 && s.command_ratio <= kRatioMax)) bad("command_ratio", s.command_ratio, "must be >= 1 and <= 1000000");
   within("k_cd", s.k_cd, 0.0, true, kGainMax, " [N s/rad]");
   within("p_cd", s.p_cd, kPoleMin, false, kCornerMax, " [rad/s]");
@@ -111,8 +117,8 @@ bool validate(const GraspControllerSettings& s, std::string* message) {
     bad("pivot_end_filter", s.pivot_end_filter, "must be finite, >= 0 and <= 1e6");
   within("loop_gain_p", s.loop_gain_p, 0.0, true, kGainMax, " [-]");
   within("loop_gain_i", s.loop_gain_i, 0.0, true, kGainMax, " [1/s]");
-  if (s.slope_gain && s.gain_schedule_force > 0.0)
-    bad("gain_schedule_force", s.gain_schedule_force, "must be 0 when slope_gain is on (one gain law)");
+  if (!(std::isfinite(s.mu_probe) && s.mu_probe >= 0.0 && s.mu_probe <= 0.5))
+    bad("mu_probe", s.mu_probe, "must be finite, >= 0 and <= 0.5");
   if (!(s.feedforward_slippage >= kSlippageMin && s.feedforward_slippage <= 1.0))
     bad("feedforward_slippage", s.feedforward_slippage, "must satisfy 1e-03 <= feedforward_slippage <= 1");
   if (!(s.reflex_slippage >= kSlippageMin && s.reflex_slippage <= 1.0))
@@ -141,8 +147,7 @@ std::string to_string(const GraspControllerSettings& s) {
          ", command_ratio=" + std::to_string(s.command_ratio) + ", k_cd=" + num(s.k_cd) +
          ", p_cd=" + num(s.p_cd) + ", z_cd=" + num(s.z_cd) + ", dynamic_enabled=" + flag(s.dynamic_enabled) +
          ", s_ref=" + num(s.s_ref) + ", k_p=" + num(s.k_p) + ", k_i=" + num(s.k_i) +
-         ", anti_windup=" + flag(s.anti_windup) + ", gain_schedule_force=" + num(s.gain_schedule_force) +
-         ", static_equivalent_slippage=" + flag(s.static_equivalent_slippage) +
+         ", anti_windup=" + flag(s.anti_windup) +
          ", omega_deadband=" + num(s.omega_deadband) +
          ", f_min=" + num(s.f_min) + ", f_max=" + num(s.f_max) +
          ", max_rate_up=" + num(s.max_rate_up) + ", max_rate_down=" + num(s.max_rate_down) +
@@ -159,11 +164,9 @@ std::string to_string(const GraspControllerSettings& s) {
          ", feedforward=" + flag(s.feedforward) + ", feedforward_slippage=" + num(s.feedforward_slippage) +
          ", slip_reflex=" + flag(s.slip_reflex) + ", reflex_slippage=" + num(s.reflex_slippage) +
          ", reflex_samples=" + std::to_string(s.reflex_samples) + ", reflex_factor=" + num(s.reflex_factor) +
-         ", reflex_in_period=" + flag(s.reflex_in_period) + ", average_slippage=" + flag(s.average_slippage) +
+         ", average_slippage=" + flag(s.average_slippage) +
          ", feedforward_horizon=" + num(s.feedforward_horizon) + ", feedforward_trend=" + num(s.feedforward_trend) +
-         ", feedforward_trend_grasp=" + flag(s.feedforward_trend_grasp) +
-         ", feedforward_trend_check=" + flag(s.feedforward_trend_check) +
-         ", reaction_lag=" + num(s.reaction_lag) + ", react_when_invalid=" + flag(s.react_when_invalid) +
+         ", reaction_lag=" + num(s.reaction_lag) + ", mu_probe=" + num(s.mu_probe) +
          ", reserve_force=" + num(s.reserve_force) + ", reserve_torque=" + num(s.reserve_torque) + ")";
 }
 
@@ -203,7 +206,7 @@ GraspController::GraspController(const ContactParams& params, const GraspControl
 GraspController::GraspController(const ContactModel& model, const GraspControllerSettings& settings)
     : s_(checked(settings)), solver_(model) {
   const ContactParams& params = model.params();
-  mu_ = params.mu;
+  mu_ = mu0_ = params.mu;
   gamma_ = params.gamma;
   dt_ = 1.0 / s_.sensor_rate;
   t_cmd_ = s_.command_ratio * dt_;
@@ -231,13 +234,26 @@ void GraspController::reset(double current_force) noexcept {
   clear_period();
   f_est_ = command_;
   trend_lift_ = trend_force_ = 0.0;
-  run_s_ = 0;
   reflex_armed_ = false;
+  reset_probe();
+  mu_ = mu0_;
+  solver_.set_mu(mu_);
   reset_dynamic();
   last_ = GraspControllerOutput();
   last_.force = command_;
   last_.static_force = command_;
   last_.floor = s_.f_min;
+  last_.mu_belief = mu_;
+}
+
+void GraspController::reset_probe() noexcept {
+  probe_left_ = 0;
+  probe_wait_ = 0;
+  probe_gap_ = kProbeGapMin;
+  probe_s_ = prev_s_ = 0.0;
+  probe_base_ = 0.0;
+  probe_slip_ = false;
+  prev_load_ = {};
 }
 
 void GraspController::reset_dynamic() noexcept {
@@ -271,18 +287,19 @@ void GraspController::set_settings(const GraspControllerSettings& settings) {
   last_.force = command_;
 }
 
-void GraspController::set_mu(double mu) {
-  ContactParams p = table1_params();
-  p.mu = mu;
-  validate_or_throw(p);  // names a bad mu before the tables are rebuilt
-  p = solver_.model().params();
-  p.mu = mu;
-  set_contact_model(ContactModel(p));
+bool GraspController::set_mu(double mu) noexcept {
+  if (!solver_.set_mu(mu)) return false;
+  mu_ = mu0_ = mu;
+  last_.mu_belief = mu_;
+  reset_probe();
+  return true;
 }
 
 void GraspController::set_contact_model(const ContactModel& model) {
   solver_ = StaticForceSolver(model);
-  mu_ = model.params().mu;
+  mu_ = mu0_ = model.params().mu;
+  last_.mu_belief = mu_;
+  reset_probe();
   gamma_ = model.params().gamma;
 }
 
@@ -310,6 +327,7 @@ Status GraspController::step(const GraspControllerInput& in, GraspControllerOutp
     pivot_floor_samples_ = 0;
     pivot_c_init_ = true;
     peak_ = 0.0;
+    probe_left_ = 0;
   } else if (request_ == Request::Avoid && mode_ == ControllerMode::Pivoting) {
     end_pivot(PivotEnd::Requested, out);
   }
@@ -340,13 +358,17 @@ Status GraspController::step(const GraspControllerInput& in, GraspControllerOutp
       out.dynamic_sample[i] = cd_[i].output();  // state held, sample not filtered
       continue;
     }
-    slip = std::max(slip, f.slippage);
+    slip = std::max(slip, f.slippage * (mu0_ / mu_));  // S against the believed mu
     c_sum += std::fabs(f.c_tilde);
     f_t_max = std::max(f_t_max, std::fabs(f.f_t));
     ++n_valid;
     if (std::isfinite(f.tau) && std::fabs(f.tau) <= kMaxInput) {  // load for the static floor
       const double k = n_load_[i];
       sum_f_t_[i] += std::fabs(f.f_t);
+      sum_ft2_[i] += f.f_t * f.f_t;
+      sum_tau2_[i] += f.tau * f.tau;
+      if (std::isfinite(f.f_n) && f.f_n > 0.0 && f.f_n <= kMaxInput) sum_f_n_[i] += f.f_n;
+      else fn_ok_[i] = false;
       sum_tau_[i] += f.tau;
       sum_kf_[i] += k * std::fabs(f.f_t);
       sum_kt_[i] += k * f.tau;
@@ -376,11 +398,8 @@ Status GraspController::step(const GraspControllerInput& in, GraspControllerOutp
     peak_s_ = std::max(peak_s_, slip);
     sum_s_ += slip;
     ++n_s_;
-    run_s_ = slip >= s_.reflex_slippage ? run_s_ + 1 : 0;
     if (slip >= s_.reflex_slippage) ++count_s_;
-    if ((s_.reflex_in_period ? count_s_ : run_s_) >= s_.reflex_samples) reflex_armed_ = true;
-  } else {
-    run_s_ = 0;
+    if (count_s_ >= s_.reflex_samples) reflex_armed_ = true;
   }
   out.status = valid ? Status::Ok : worst;
   out.mean_c_tilde = n_valid > 0 ? c_sum / n_valid : 0.0;
@@ -430,6 +449,9 @@ Status GraspController::step(const GraspControllerInput& in, GraspControllerOutp
   out.feedforward_force = last_.feedforward_force;
   out.peak_slippage = last_.peak_slippage;
   out.reflex = last_.reflex;
+  out.mu_belief = last_.mu_belief;
+  out.probing = last_.probing;
+  out.probe_slip = last_.probe_slip;
   out.saturated = last_.saturated;
   out.rate_limited = last_.rate_limited;
   out.held = last_.held;
@@ -454,7 +476,9 @@ void GraspController::issue_command(bool valid, double slip) noexcept {
   const double lag = s_.reaction_lag > 0.0 ? std::exp(-t_cmd_ / s_.reaction_lag) : 0.0;
   if (!valid) {  // safe command: hold (or raise), never below the floor; restart bumplessly
     double f = std::max(command_ + s_.invalid_raise_step, floor);
-    if (s_.react_when_invalid && mode_ == ControllerMode::SlippingAvoidance) {
+    probe_left_ = 0;  // a probe under way is abandoned
+    prev_load_ = {};
+    if (mode_ == ControllerMode::SlippingAvoidance) {
       // Raise-only reactions from the valid fingers' samples of the period.
       double n_slope = 1.0;
       double lift = std::min(reaction_floor(n_slope, c), s_.f_max);
@@ -468,6 +492,8 @@ void GraspController::issue_command(bool valid, double slip) noexcept {
     clear_period();
     c.force = command_;
     c.held = true;
+    c.probing = false;
+    c.mu_belief = mu_;
     return;
   }
   c.held = false;
@@ -476,32 +502,22 @@ void GraspController::issue_command(bool valid, double slip) noexcept {
   bool reacting = false;  // the feed-forward or the reflex lifted the static part
   if (mode_ == ControllerMode::SlippingAvoidance) {
     // Floor of the static part: feed-forward of the measured load and the slip reflex.
+    // The grip probe's answer first: a slip it finds lowers the belief, which the floors use.
+    probe_evaluate(slip);
     double n_slope = 1.0;
     const double lift = reaction_floor(n_slope, c);
+    const bool probe_started = probe_start(slip, c.reflex || lift > std::min(last_.static_force, command_));
     clear_period();
     // PI on e = S - s_ref: e > 0 (closer to slip than wanted) raises the force (docs/model.md 9.4).
     e = slip - s_.s_ref;
-    // Integrated error: with static_equivalent_slippage the slippage the static part alone would
-    // give, S_s = S ((f_ns + f_nd) / f_ns)^(1 + gamma) at the last command (= S when f_nd = 0).
-    // Only the integrator uses it: in the proportional term the ratio would feed the new f_ns
-    // back into the next error and alternate from command to command.
-    double e_i = e;
-    if (s_.static_equivalent_slippage && s_.dynamic_enabled && last_.dynamic_force > 0.0 &&
-        last_.static_force > 0.0)
-      e_i = slip * std::pow(1.0 + last_.dynamic_force / last_.static_force, 1.0 + gamma_) - s_.s_ref;
     double k_p, k_i;
     if (s_.slope_gain) {  // loop gain k |dS/df_n| independent of the force (docs/controller.md)
-      // Force at the operating point: the static part when the PI regulates its own slippage.
-      const double f_op = s_.static_equivalent_slippage && s_.dynamic_enabled && last_.static_force > 0.0
-                              ? std::min(last_.static_force, command_)
-                              : command_;
-      const double s_f = n_slope * s_.s_ref / f_op;
+      const double s_f = n_slope * s_.s_ref / command_;
       k_p = s_.loop_gain_p / s_f;
       k_i = s_.loop_gain_i / s_f;
     } else {
-      const double scale = s_.gain_schedule_force > 0.0 ? command_ / s_.gain_schedule_force : 1.0;
-      k_p = s_.k_p * scale;
-      k_i = s_.k_i * scale;
+      k_p = s_.k_p;
+      k_i = s_.k_i;
     }
     if (init_static_) {  // bumpless (re)start from the last command
       integrator_ = command_ - k_p * e;
@@ -510,7 +526,7 @@ void GraspController::issue_command(bool valid, double slip) noexcept {
       if (s_.slope_gain) integrator_ += (last_kp_ - k_p) * last_e_;  // gain change without a jump of f_ns
       // The trend's lift that the period's load did not confirm; only a sticking contact's
       // load can refute it (while sliding, f_t is capped at mu f_n).
-      if (s_.feedforward_trend_check && trend_lift_ > 0.0 && c.peak_slippage < s_.reflex_slippage)
+      if (trend_lift_ > 0.0 && c.peak_slippage < s_.reflex_slippage)
         integrator_ -= std::min(trend_lift_, std::max(0.0, trend_force_ - floor_measured_));
     }
     trend_lift_ = 0.0;
@@ -529,7 +545,13 @@ void GraspController::issue_command(bool valid, double slip) noexcept {
         if (s_.anti_windup) integrator_ = f_ns - k_p * e;  // back-calculation, static part only
       }
     }
-    integrator_ += k_i * t_cmd_ * e_i;  // forward Euler
+    // The grip probe raises the static part above the PI's for two periods; the integrator
+    // does not see them (a probe is not the load's demand).
+    if (probe_started) probe_base_ = f_ns;
+    const bool probing = probe_left_ > 0;
+    c.probing = probing;
+    if (probing) f_ns = std::min(std::max(f_ns, probe_base_ * (1.0 + s_.mu_probe)), s_.f_max);
+    else integrator_ += k_i * t_cmd_ * e;  // forward Euler
     last_kp_ = k_p;
     last_e_ = e;
     c.gain_p = k_p;
@@ -543,6 +565,7 @@ void GraspController::issue_command(bool valid, double slip) noexcept {
     // tau_p df/dt = -f + k_f (S - s_pivot), exact discretisation at the command rate; output is
     // the state before the update, so the first pivoting command equals the last command.
     clear_period();
+    c.probing = false;
     c.gain_p = c.gain_i = 0.0;
     e = slip - s_.s_pivot;
     if (init_static_) {
@@ -567,6 +590,9 @@ void GraspController::issue_command(bool valid, double slip) noexcept {
   f_est_ = command_ + (f_est_ - command_) * lag;
 
   c.force = f;
+  c.mu_belief = mu_;
+  c.probe_slip = probe_slip_;
+  probe_slip_ = false;
   c.static_force = f_ns;
   c.dynamic_force = f_nd;
   c.slippage = slip;
@@ -576,6 +602,10 @@ void GraspController::issue_command(bool valid, double slip) noexcept {
 
 void GraspController::clear_period() noexcept {
   sum_f_t_.fill(0.0);
+  sum_f_n_.fill(0.0);
+  sum_ft2_.fill(0.0);
+  sum_tau2_.fill(0.0);
+  fn_ok_.fill(true);
   sum_tau_.fill(0.0);
   sum_kf_.fill(0.0);
   sum_kt_.fill(0.0);
@@ -586,6 +616,123 @@ void GraspController::clear_period() noexcept {
   n_s_ = 0;
   count_s_ = 0;
   reflex_armed_ = false;
+}
+
+GraspController::PeriodLoad GraspController::period_load(int i) const noexcept {
+  PeriodLoad l;
+  if (n_load_[i] == 0 || !fn_ok_[i]) return l;
+  const double n = n_load_[i];
+  l.n = n_load_[i];
+  l.fn = sum_f_n_[i] / n;
+  l.ft = sum_f_t_[i] / n;
+  l.tau = sum_tau_[i] / n;
+  // Noise: the residual variance about the period's least-squares line (a load ramp within
+  // the period is no noise).
+  const double sxx = sum_kk_[i] - sum_k_[i] * sum_k_[i] / n;
+  if (n > 2.0 && sxx > 0.0) {
+    const double sff = sum_ft2_[i] - sum_f_t_[i] * sum_f_t_[i] / n;
+    const double stt = sum_tau2_[i] - sum_tau_[i] * sum_tau_[i] / n;
+    const double sxf = sum_kf_[i] - sum_k_[i] * sum_f_t_[i] / n;
+    const double sxt = sum_kt_[i] - sum_k_[i] * sum_tau_[i] / n;
+    l.var_ft = std::max(0.0, (sff - sxf * sxf / sxx) / (n - 2.0));
+    l.var_tau = std::max(0.0, (stt - sxt * sxt / sxx) / (n - 2.0));
+  }
+  return l;
+}
+
+void GraspController::probe_evaluate(double slip_mean) noexcept {
+  if (probe_left_ <= 0) return;
+  --probe_left_;
+  if (probe_left_ == 1) {  // the probe's second period: kept for the answer
+    for (int i = 0; i < kMaxFingers; ++i) probe_a_[i] = period_load(i);
+    return;
+  }
+  if (probe_left_ > 0) return;
+  // End of a probe: the mean of its last two periods against the mean of the two periods
+  // before it. Elasticity E = d ln(load) / d ln(f_n) of each finger's dominant load component
+  // (a twist's divided by 1 + gamma): ~0 for a sticking contact, ~1 for a sliding one.
+  const double x_min = 0.25 * s_.mu_probe;
+  bool slip = false, answered = false;
+  double r_slip = 0.0;
+  for (int i = 0; i < kMaxFingers; ++i) {
+    const PeriodLoad a = ref_a_[i], b = ref_b_[i], c = probe_a_[i], d = period_load(i);
+    if (a.n < 3 || b.n < 3 || c.n < 3 || d.n < 3) continue;
+    const double fn0 = 0.5 * (a.fn + b.fn), fn1 = 0.5 * (c.fn + d.fn);
+    if (!(fn0 > 0.0 && fn1 > 0.0)) continue;
+    const double x = std::log(fn1 / fn0);
+    if (!(x >= x_min)) continue;  // the gripper did not follow the probe (range, rate)
+    const double ft0 = 0.5 * (a.ft + b.ft), tau0 = 0.5 * (a.tau + b.tau);
+    const double util_t = ft0 / (mu_ * fn0);
+    const double tmax = solver_.model().tau_max(fn0);
+    const double util_r = tmax > 0.0 ? std::fabs(tau0) / tmax : 0.0;
+    double y, sd;
+    if (util_t >= util_r) {
+      const double ft1 = 0.5 * (c.ft + d.ft);
+      if (!(ft0 > 0.0 && ft1 > 0.0)) continue;
+      y = std::log(ft1 / ft0);
+      // standard error of the log ratio of the two four-period means
+      sd = 0.5 * std::sqrt(a.var_ft / a.n + b.var_ft / b.n + c.var_ft / c.n + d.var_ft / d.n) *
+           std::sqrt(1.0 / (ft0 * ft0) + 1.0 / (ft1 * ft1));
+    } else {
+      const double tau1 = 0.5 * (c.tau + d.tau);
+      if (!(tau0 * tau1 > 0.0)) continue;
+      const double k = 1.0 + gamma_;
+      y = std::log(tau1 / tau0) / k;
+      sd = 0.5 * std::sqrt(a.var_tau / a.n + b.var_tau / b.n + c.var_tau / c.n + d.var_tau / d.n) *
+           std::sqrt(1.0 / (tau0 * tau0) + 1.0 / (tau1 * tau1)) / k;
+    }
+    if (!std::isfinite(y) || !std::isfinite(sd)) continue;
+    answered = true;
+    const double band = kProbeSigmas * sd;
+    if (y >= kProbeElasticity * x + band) {
+      slip = true;
+      // The friction the contact slid at: S_static of the load before the probe against mu = 1.
+      const double s0 = solver_.slippage(fn0, ft0, tau0);
+      if (std::isfinite(s0)) r_slip = std::max(r_slip, s0 * mu_);
+    }
+  }
+  if (slip && r_slip > 0.0) {
+    const double next = std::max({r_slip, kProbeStepDown * mu_, kMuFloor * mu0_});
+    if (next < mu_) {
+      mu_ = next;
+      solver_.set_mu(mu_);
+    }
+    probe_slip_ = true;
+    reflex_armed_ = true;  // a confirmed slip: the reflex raises the static part now
+    probe_gap_ = kProbeGapMin;
+  } else if (answered) {
+    // Stick at this S: back off while S stays at or below the last stick answer's, probe soon
+    // when it has risen above it.
+    probe_gap_ = slip_mean < probe_s_ + kProbeSameS
+                     ? std::min(2 * probe_gap_, std::max(kProbeGapMin, static_cast<int>(kProbeGapMax / t_cmd_)))
+                     : kProbeGapMin;
+    probe_s_ = slip_mean;
+  }
+  probe_wait_ = probe_gap_;
+}
+
+bool GraspController::probe_start(double slip_mean, bool reacting) noexcept {
+  const double prev = prev_s_;
+  prev_s_ = slip_mean;
+  std::array<PeriodLoad, kMaxFingers> now{};
+  for (int i = 0; i < kMaxFingers; ++i) now[i] = period_load(i);
+  const std::array<PeriodLoad, kMaxFingers> before = prev_load_;
+  prev_load_ = now;
+  if (s_.mu_probe <= 0.0 || probe_left_ > 0) return false;
+  if (probe_wait_ > 0) {
+    --probe_wait_;
+    return false;
+  }
+  if (reacting || !(slip_mean >= kProbeMinS) || slip_mean < prev - kProbeFall) return false;
+  bool any = false;
+  for (int i = 0; i < kMaxFingers; ++i) {
+    ref_a_[i] = before[i];
+    ref_b_[i] = now[i];
+    any = any || (before[i].n >= 3 && now[i].n >= 3);
+  }
+  if (!any) return false;
+  probe_left_ = 3;
+  return true;
 }
 
 double GraspController::reaction_floor(double& slope_exponent, GraspControllerOutput& c) noexcept {
@@ -622,7 +769,7 @@ double GraspController::static_floor(double& slope_exponent) noexcept {
     const double ft = sum_f_t_[i] / n, tau = sum_tau_[i] / n;
     if (s_.feedforward) {
       double f = f_mean[i];
-      const double f_ref = s_.feedforward_trend_grasp ? f_grasp : f;
+      const double f_ref = f_grasp;  // a light finger's extrapolated noise is no edge
       const double den = n * sum_kk_[i] - sum_k_[i] * sum_k_[i];
       if (s_.feedforward_horizon > 0.0 && n_load_[i] >= 3 && den > 0.0 && std::isfinite(f)) {
         // Least-squares trend of the period's load, extrapolated from the last sample's index

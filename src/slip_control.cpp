@@ -79,6 +79,7 @@ Status SlipControl::observe(const SlipControlInput& in, SlipControlOutput& out) 
     f.c_tilde = o.c_tilde;
     f.f_t = oin.f_t;
     f.tau = oin.tau;
+    f.f_n = oin.f_n;
     f.status = o.status;
     if (!is_valid(o.status) && (worst == Status::Ok || static_cast<int>(o.status) > static_cast<int>(worst)))
       worst = o.status;
@@ -111,13 +112,13 @@ void SlipControl::reset(double force) noexcept {
   repeats_ = {};
 }
 
-void SlipControl::set_mu(double mu) {
-  ContactParams p = params();
-  p.mu = mu;
-  validate_or_throw(p);
-  const ContactModel model(p);
-  ctrl_.set_contact_model(model);
-  for (auto& o : obs_) o = Observer(model, s_.observer);
+bool SlipControl::set_mu(double mu) noexcept {
+  if (!ctrl_.set_mu(mu)) return false;
+  for (auto& o : obs_) {
+    o.set_mu(mu);
+    o.reset();
+  }
+  return true;
 }
 
 }  // namespace lugrip

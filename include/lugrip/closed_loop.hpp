@@ -215,6 +215,7 @@ struct ClosedLoopSample {
   int status = 0;               //!< Status code of the cycle (what step() returned)
   bool fault_active = false;    //!< an injected fault acted on this sample
   double actuator_command = 0.0;  //!< command reaching the gripper after actuator faults [N]
+  double mu_belief = 0.0;  //!< friction coefficient lugrip's controller believes (Lugrip; else the told mu) [-]
 };
 
 //! Arrays of a batch run, one entry per sample (columns of ClosedLoopSample).
@@ -228,7 +229,7 @@ struct ClosedLoopLog {
   std::vector<uint8_t> command_issued, pivot_finished, supported, dropped, finite;
   std::vector<int32_t> status;
   std::vector<uint8_t> fault_active;
-  std::vector<double> actuator_command;
+  std::vector<double> actuator_command, mu_belief;
 
   void reserve(size_t n);
   void append(const ClosedLoopSample& s);

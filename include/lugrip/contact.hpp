@@ -9,8 +9,9 @@
 
 namespace lugrip {
 
-//! Limit surface plus the parameter-dependent maps of one contact. Immutable after
-//! construction; every method is noexcept and allocation-free.
+//! Limit surface plus the parameter-dependent maps of one contact. Every method is noexcept and
+//! allocation-free. The tables depend on k and gamma only; mu is a factor of every map, so
+//! set_mu() is real-time safe.
 class ContactModel {
  public:
   //! Validates `params` (throws std::invalid_argument naming every bad field) and builds the
@@ -19,6 +20,9 @@ class ContactModel {
 
   const ContactParams& params() const noexcept { return p_; }
   const LimitSurface& limit_surface() const noexcept { return ls_; }
+  //! Replaces the friction coefficient (every map scales with it; no table changes). Returns
+  //! false and changes nothing unless 0 < mu <= 10 (ContactParams::mu). No allocation.
+  bool set_mu(double mu) noexcept;
   double xi() const noexcept { return ls_.xi(); }
 
   double rho(double f_n) const noexcept;      //!< contact radius delta f_n^gamma [m]
@@ -146,6 +150,8 @@ class CorEstimator {
 
   const ContactModel& model() const noexcept { return model_; }
   const CorSettings& settings() const noexcept { return s_; }
+  //! ContactModel::set_mu on the estimator's model; the held estimate is kept. No allocation.
+  bool set_mu(double mu) noexcept { return model_.set_mu(mu); }
 
  private:
   ContactModel model_;

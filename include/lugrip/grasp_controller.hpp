@@ -33,25 +33,6 @@ struct GraspControllerSettings {
   double k_p = 4.0;    //!< (*) [N] proportional gain (e > 0 raises the force), > 0
   double k_i = 10.0;   //!< (*) [N/s] integral gain, > 0
   bool anti_windup = true;  //!< (*) back-calculation I = f_ns,clipped - k_p e when clipped
-  //! (*) [N] the older gain scheduling, not in the paper; 0 = off. When > 0 (needs slope_gain
-  //! off), k_p and k_i are scaled by (last command / gain_schedule_force), which also keeps the
-  //! loop gain k_p |dS/df_n| (S ~ 1/f_n) the same at every force, at a level set by the chosen
-  //! force instead of the loop gain itself (slope_gain). With constant gains the 50 Hz loop on a
-  //! quasi-static S(f_n) is unstable when (k_p - k_i T) |dS/df_n| > 1, i.e. below ~3 N for a
-  //! translational load (S = 0.8 f*/f_n), and limit-cycles there (tests: ControllerClosedLoop.*,
-  //! ControllerSlopeGain.*). >= 0, finite.
-  double gain_schedule_force = 0.0;
-  //! (*) not in the paper (default false = paper; superseded by feedforward, which holds f_ns
-  //! at the measured load's static force from the wrench itself). When true the PI integrates the
-  //! slippage the static part alone would give, S_s = S ((f_ns + f_nd) / f_ns)^(1 + gamma) (g
-  //! grows as f_n^(1 + gamma) at a fixed CoR; f_ns, f_nd of the last command), instead of S; the
-  //! proportional term keeps S. While f_nd holds the object after a slip, S is low because of
-  //! f_nd, and the paper's PI unwinds f_ns, so the object slips again when f_nd has decayed (a
-  //! slip / force-spike cycle on heavy rotational loads); with S_s, f_ns keeps rising to the
-  //! force the load needs. Identical to the paper when f_nd = 0. It uses the commanded forces,
-  //! which the gripper's force lags after a slip: f_ns overshoots (+2 % mean force on the paper's
-  //! scenarios with feedforward on).
-  bool static_equivalent_slippage = false;
   //! (*) not in the paper (default 1; 0 = off = paper). Dead band of the dynamic part in multiples of each
   //! finger's FingerInput::omega_resolution: C_d sees sign(w) max(0, |w| - band) with
   //! band = omega_deadband * omega_resolution. The slip speed enters the wrench only through
@@ -66,8 +47,7 @@ struct GraspControllerSettings {
   //! at low force. With slope_gain the gains follow the slope at the operating point,
   //! k_p = loop_gain_p / s_f, k_i = loop_gain_i / s_f, s_f = n s_ref / f (f: last command; n:
   //! -d ln S_static / d ln f_n of the contact model for the load measured over the last command
-  //! period, clamped to [1, 1 + gamma]); the gains change bumplessly (velocity form). Cannot be
-  //! combined with gain_schedule_force > 0.
+  //! period, clamped to [1, 1 + gamma]); the gains change bumplessly (velocity form).
   bool slope_gain = true;
   double loop_gain_p = 0.5;  //!< (*) [-] k_p |dS/df_n| with slope_gain, finite, > 0
   double loop_gain_i = 2.0;  //!< (*) [1/s] k_i |dS/df_n| with slope_gain, finite, > 0
@@ -100,8 +80,9 @@ struct GraspControllerSettings {
   double reserve_torque = 0.0;  //!< (*) [N m] default 0 = off; the twist to absorb, as reserve_force. >= 0, finite.
 
   // --- slip reflex (not in the paper) ---------------------------------------------------------
-  //! (*) default true; false = paper. When S = max_i S_i stays at or above reflex_slippage on
-  //! reflex_samples consecutive valid samples (the dry capacity is used up: the contact slides or
+  //! (*) default true; false = paper. When S = max_i S_i is at or above reflex_slippage on
+  //! reflex_samples valid samples of one command period, anywhere in it (a chattering slide of a
+  //! compliant pad alternates S between the bound and below it; the dry capacity is used up: the contact slides or
   //! is about to), the next command raises the static part to at least reflex_factor x the static
   //! part of the last command and restarts the integrator there. It acts whether or not the slip speed is observable (with
   //! Coulomb-like contacts omega_hat carries no speed and C_d adds nothing). Not applied while
@@ -110,15 +91,11 @@ struct GraspControllerSettings {
   //! (*) [-] threshold on the peak of S, in (0, 1]. A translational slip with the CoR at the
   //! c_max = 1.5 clip reads S = 0.95 at f_t = mu f_n, hence a threshold below 0.95.
   double reflex_slippage = 0.93;
-  //! (*) consecutive samples at or above the threshold, >= 1 (a run of S at the projection
-  //! bound S = 1 while sliding, not a single noisy sample); <= command_ratio keeps the reaction
-  //! within one command period.
+  //! (*) samples of one command period at or above the threshold, >= 1 (S at the projection
+  //! bound S = 1 while sliding, not a single noisy sample); <= command_ratio, or the reflex
+  //! never fires.
   int reflex_samples = 3;
   double reflex_factor = 1.25;  //!< (*) [-] raise of the static part per period of detected slip, > 1
-  //! (*) default true; false = consecutive samples (the earlier rule). The reflex_samples samples
-  //! at or above reflex_slippage may lie anywhere in the command period: a chattering slide
-  //! (stick-slip of a compliant pad) alternates S between the bound and below it.
-  bool reflex_in_period = true;
 
   // --- reaction to fast load changes (not in the paper; docs/controller.md §6) ----------------
   //! (*) [s] default 0.03; 0 = off (paper: the load of the period only). The feed-forward also
@@ -127,19 +104,12 @@ struct GraspControllerSettings {
   //! (a pulse's edge) is met with the force it will need when the command has reached the
   //! fingers. >= 0, finite.
   double feedforward_horizon = 0.03;
-  //! (*) [-] the extrapolated load is used only when its static force exceeds that of the
-  //! period's mean load by more than this fraction (a trend, not sensor noise). >= 0, finite.
+  //! (*) [-] the extrapolated load is used only when its static force exceeds the grasp's
+  //! mean-load force (the largest over the fingers) by more than this fraction (a trend, not
+  //! sensor noise). The next command checks the prediction: the part of the trend's lift that
+  //! the new period's mean load does not confirm is taken back from the integrator, while the
+  //! contact sticks. >= 0, finite.
   double feedforward_trend = 0.5;
-  //! (*) default true; false = each finger's own mean-load force (the earlier rule). The trend's
-  //! force must exceed the largest mean-load force over the fingers (the grasp's) by
-  //! feedforward_trend: a lightly loaded finger's extrapolated noise is no edge.
-  bool feedforward_trend_grasp = true;
-  //! (*) default true; false = the PI keeps the trend's lift (the earlier rule). When the trend
-  //! lifted the static part above the mean load's force, the next command checks the prediction:
-  //! the part of the lift that the new period's mean load does not confirm (its feed-forward
-  //! force below the predicted one) is taken back from the integrator, so a predicted rise that
-  //! did not come (half a cycle of a rocking object) is not left for the PI to drain.
-  bool feedforward_trend_check = true;
   //! (*) [s] default 0.03; 0 = off (paper). Time constant of the gripper's force lag assumed by the
   //! reaction: when the feed-forward or the reflex lifts the static part above the force the
   //! gripper is estimated to apply, the command overshoots the target by the lag's shortfall over
@@ -147,11 +117,22 @@ struct GraspControllerSettings {
   //! the target within one period instead of ~3 tau; f_est follows the issued commands through
   //! that lag. >= 0, finite.
   double reaction_lag = 0.03;
-  //! (*) default true; false = hold only (the earlier behaviour). A command due while a present
-  //! finger's input is invalid (NoContact while its pad loses contact as the object slides out,
-  //! InvalidSample, SensorFault) still takes the raise-only reactions computed from the valid
-  //! fingers' samples of the period (feed-forward, armed reflex); it never lowers the command.
-  bool react_when_invalid = true;
+
+  // --- friction learned online (not in the paper; docs/controller.md "Friction learned") -------
+  //! (*) [-] default 0.08; 0 = off (paper: mu as told). Relative size of the grip probe, which
+  //! learns mu online. While S is at least 0.5 and not falling, and no reaction is under way,
+  //! the static part is raised by this fraction for three command periods (the integrator does
+  //! not see it). The measured load's answer tells stick from slip with no speed signal: a
+  //! sticking contact's load does not follow the grip (elasticity d ln load / d ln f_n ~ 0), a
+  //! sliding one's does (~ 1: its load is its friction; a twist's after dividing by 1 + gamma).
+  //! The test: the mean of the probe's last two periods against the mean of the two periods
+  //! before it, elasticity >= 0.5 beyond two standard errors of the measured load (residuals
+  //! about each period's line). A slip found so is a measurement of mu (the load's friction
+  //! coefficient before the probe): the belief moves down to it, by at most 30 % per probe,
+  //! never below half the told mu; the belief never rises above the told mu. Probes repeat 3
+  //! commands apart while S rises above the last stick answer's, and back off (doubling, up to
+  //! 1 s) otherwise. Needs each finger's f_n (FingerInput::f_n). In [0, 0.5].
+  double mu_probe = 0.08;
 
   // --- force range and rate limits (docs/model.md 9.5) --------------------------------------------
   double f_min = 0.1;   //!< [N] minimum force (keeps contact), > 0
@@ -222,6 +203,7 @@ struct FingerInput {
   //! the dead band (GraspControllerSettings::omega_deadband); 0: none
   double omega_resolution = 0.0;
   double tau = 0.0;  //!< measured torsional moment [N m] (signed; feed-forward and slope)
+  double f_n = 0.0;  //!< measured normal force [N] (grip probe, mu_probe); 0: unknown, no probe
 };
 
 //! Input of one step(): the two fingertips at one sensor sample.
@@ -244,6 +226,9 @@ struct GraspControllerOutput {
   double feedforward_force = 0.0;  //!< feed-forward force at the last command [N] (0: none)
   double peak_slippage = 0.0;  //!< peak of max_i S_i over the period before the last command [-]
   bool reflex = false;         //!< last command: the slip reflex raised the static part
+  double mu_belief = 0.0;      //!< friction coefficient the controller believes now [-]
+  bool probing = false;        //!< last command: a grip probe raised the static part
+  bool probe_slip = false;     //!< last command: a probe found the contact sliding (mu lowered)
   //! signed C_d omega_hat_i of each finger at this sample [N] (0 for absent fingers)
   std::array<double, kMaxFingers> dynamic_sample{};
   double dynamic_peak = 0.0;   //!< peak of max_i |C_d omega_hat_i| since the last command [N]
@@ -315,6 +300,8 @@ class StaticForceSolver {
   StaticForceResult solve(double f_t, double tau, double s_ref = 0.8) noexcept;
 
   const ContactModel& model() const noexcept { return est_.model(); }
+  //! ContactModel::set_mu on the solver's model (no allocation); false: mu out of range.
+  bool set_mu(double mu) noexcept { return est_.set_mu(mu); }
 
  private:
   CorEstimator est_;
@@ -376,10 +363,10 @@ class GraspController {
   //! Replaces the settings marked (*) (rates, C_d and force range must not change); throws
   //! std::invalid_argument when invalid or when a fixed field differs.
   void set_settings(const GraspControllerSettings& settings);
-  //! Replaces the friction coefficient used by the pivoting floor and the static grasp force
-  //! (rebuilds the contact tables: allocates, not real-time); throws std::invalid_argument
-  //! unless 0 < mu <= 10 (ContactParams::mu).
-  void set_mu(double mu);
+  //! Replaces the told friction coefficient (the one the observers' S is normalised with) and
+  //! restarts the belief from it. Real-time safe: no allocation, noexcept; returns false and
+  //! changes nothing unless 0 < mu <= 10 (ContactParams::mu).
+  bool set_mu(double mu) noexcept;
   //! Replaces the contact model (mu, feed-forward, slope) by a copy of `model`'s (allocates).
   void set_contact_model(const ContactModel& model);
 
@@ -388,7 +375,8 @@ class GraspController {
   double command_period() const noexcept { return t_cmd_; }  //!< [s]
   const GraspControllerSettings& settings() const noexcept { return s_; }
   const LagFilter& dynamic_filter(int finger) const noexcept { return cd_[finger]; }
-  double mu() const noexcept { return mu_; }
+  double mu() const noexcept { return mu0_; }                //!< told mu [-]
+  double mu_belief() const noexcept { return mu_; }         //!< believed mu (learned) [-]
   const ContactModel& contact_model() const noexcept { return solver_.model(); }
 
  private:
@@ -400,10 +388,25 @@ class GraspController {
   // static_floor() raised by the armed slip reflex; records both in c (feedforward_force, reflex)
   double reaction_floor(double& slope_exponent, GraspControllerOutput& c) noexcept;
   void clear_period() noexcept;
+  // The grip probe (mu_probe): probe_evaluate() counts a running probe down and, at its end,
+  // compares the period's load with the reference period's (slip lowers mu_); probe_start()
+  // takes this period as the reference of a new probe when one is due (true: started).
+  void probe_evaluate(double slip_mean) noexcept;
+  bool probe_start(double slip_mean, bool reacting) noexcept;
+  void reset_probe() noexcept;
+  static constexpr int kProbeGapMin = 3;  // [commands] between probes while S rises
+  // One finger's load over one command period (the probe's measurements).
+  struct PeriodLoad {
+    double fn = 0.0, ft = 0.0, tau = 0.0;  // means [N], [N], [N m]
+    double var_ft = 0.0, var_tau = 0.0;    // sample variances [N^2], [N^2 m^2]
+    int n = 0;                             // samples (0: none usable)
+  };
+  PeriodLoad period_load(int finger) const noexcept;
 
   GraspControllerSettings s_;
   StaticForceSolver solver_;  // feed-forward force and slope exponent
-  double mu_ = 1.0;
+  double mu_ = 1.0;   // believed mu (the solver's)
+  double mu0_ = 1.0;  // told mu (the observers' normalisation of S)
   double gamma_ = 0.25;
   double dt_ = 0.002, t_cmd_ = 0.02, pivot_decay_ = 0.0;
   std::array<LagFilter, kMaxFingers> cd_{};
@@ -437,9 +440,23 @@ class GraspController {
   double peak_s_ = 0.0;       // peak of max_i S_i since the last command
   double sum_s_ = 0.0;        // sum of max_i S_i over the valid samples since the last command
   int n_s_ = 0;
-  int run_s_ = 0;              // consecutive valid samples with S >= reflex_slippage
   int count_s_ = 0;            // valid samples with S >= reflex_slippage since the last command
   bool reflex_armed_ = false;  // such a run reached reflex_samples since the last command
+  // grip probe (mu_probe)
+  std::array<double, kMaxFingers> sum_f_n_{};  // sum of f_n over the load samples of the period
+  std::array<bool, kMaxFingers> fn_ok_{{true, true}};  // every load sample of the period had f_n
+  std::array<double, kMaxFingers> sum_ft2_{}, sum_tau2_{};   // sums of squares (variances)
+  std::array<PeriodLoad, kMaxFingers> prev_load_{};  // the previous period's
+  std::array<PeriodLoad, kMaxFingers> ref_a_{}, ref_b_{};  // the two periods before the probe
+  std::array<PeriodLoad, kMaxFingers> probe_a_{};          // the probe's second period
+  int probe_left_ = 0;        // commands of the running probe still to issue (0: none)
+  int probe_wait_ = 0;        // commands until the next probe may start
+  int probe_gap_ = 3;         // current back-off [commands]
+  double probe_s_ = 0.0;      // S at which the last probe found stick
+  double prev_s_ = 0.0;       // mean S of the previous command period
+  double probe_base_ = 0.0;   // static part when the probe started [N]
+  bool probe_slip_ = false;   // the last evaluated probe found slip
+
   GraspControllerOutput last_{};  // command fields of the last command
 };
 

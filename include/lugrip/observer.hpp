@@ -200,6 +200,9 @@ class Observer {
   Status step(const ObserverInput& in, ObserverOutput& out) noexcept;
   //! Forgets the state; the next valid sample re-initialises.
   void reset() noexcept;
+  //! ContactModel::set_mu on the observer's model (no allocation; the state is kept, reset() to
+  //! restart). False: mu out of range, nothing changed.
+  bool set_mu(double mu) noexcept { return cor_.set_mu(mu); }
 
   double omega_hat() const noexcept { return omega_; }
   double z_hat() const noexcept { return z_; }

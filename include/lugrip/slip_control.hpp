@@ -71,7 +71,7 @@ struct SlipControlOutput {
 //! SensorFault (its observer keeps running) until the wrench changes.
 //!
 //! Lifecycle: construct (validates, allocates the contact tables) -> step() / the run-time
-//! calls (noexcept, no allocation) -> reset(). set_mu() rebuilds the tables: not real-time.
+//! calls (noexcept, no allocation; set_mu() included) -> reset().
 //! Thread safety: none inside; use one object per thread (or guard it with your own lock).
 class SlipControl {
  public:
@@ -100,12 +100,12 @@ class SlipControl {
     s_.controller.dynamic_enabled = enabled;
   }
 
-  //! Replaces the friction coefficient of the observers and the controller (the per-object
-  //! refit, docs/model.md §8.1). Rebuilds the contact tables (allocates, a few ms): call it
-  //! between cycles, not inside a real-time loop. The observers restart at the next sample;
-  //! the controller keeps its mode and its last command. Throws std::invalid_argument for an
-  //! invalid mu (nothing changed then).
-  void set_mu(double mu);
+  //! Replaces the told friction coefficient of the observers and the controller (the
+  //! per-object refit, docs/model.md §8.1); the controller's learned belief restarts from it.
+  //! Real-time safe (mu scales every contact map; no table is rebuilt): noexcept, no
+  //! allocation. The observers restart at the next sample; the controller keeps its mode and
+  //! its last command. Returns false and changes nothing unless 0 < mu <= 10.
+  bool set_mu(double mu) noexcept;
 
   //! Replaces the controller settings marked (*) in GraspControllerSettings (validated).
   void set_controller_settings(const GraspControllerSettings& settings) {

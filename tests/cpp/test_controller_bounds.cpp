@@ -31,8 +31,8 @@ TEST(ControllerBounds, RejectsSettingsThatOverflow) {
     void (*set)(GraspControllerSettings&);
   };
   const Case cases[] = {
-      {"gain_schedule_force", [](GraspControllerSettings& s) { s.gain_schedule_force = kDenorm; }},
-      {"gain_schedule_force", [](GraspControllerSettings& s) { s.gain_schedule_force = 1e-306; }},
+      {"mu_probe", [](GraspControllerSettings& s) { s.mu_probe = 0.5000000001; }},
+      {"mu_probe", [](GraspControllerSettings& s) { s.mu_probe = -kDenorm; }},
       {"k_p", [](GraspControllerSettings& s) { s.k_p = 1e306; }},
       {"k_i", [](GraspControllerSettings& s) { s.k_i = 1e308; }},
       {"sensor_rate", [](GraspControllerSettings& s) { s.sensor_rate = 9e307; }},
@@ -56,16 +56,9 @@ TEST(ControllerBounds, RejectsSettingsThatOverflow) {
 
 TEST(ControllerBounds, EdgesAreInsideAndJustOutsideIsNot) {
   GraspControllerSettings s;
-  s.slope_gain = false;  // gain_schedule_force is the other gain law
-  s.gain_schedule_force = 1e-6;
+  s.mu_probe = 0.5;
   EXPECT_TRUE(accepted(s));
-  s.gain_schedule_force = std::nextafter(1e-6, 0.0);
-  EXPECT_FALSE(accepted(s));
-  s = {};
-  s.slope_gain = false;
-  s.gain_schedule_force = 1e6;
-  EXPECT_TRUE(accepted(s));
-  s.gain_schedule_force = std::nextafter(1e6, 2e6);
+  s.mu_probe = std::nextafter(0.5, 1.0);
   EXPECT_FALSE(accepted(s));
   s = {};
   s.sensor_rate = 1e9;
@@ -107,7 +100,7 @@ TEST(ControllerBounds, EdgesAreInsideAndJustOutsideIsNot) {
 TEST(ControllerBounds, WorstEdgeSettingsKeepTheCommandFinite) {
   for (int variant = 0; variant < 8; ++variant) {
     GraspControllerSettings s;
-    // variants 0-3: constant gains scheduled with the force; 4-7: gains from the slope dS/df
+    // variants 0-3: constant gains; 4-7: gains from the slope dS/df
     // with every addition of the default law at its extreme
     s.slope_gain = variant >= 4;
     s.sensor_rate = variant % 2 ? 1e9 : 1e-3;
@@ -118,7 +111,7 @@ TEST(ControllerBounds, WorstEdgeSettingsKeepTheCommandFinite) {
     s.k_p = 1e9;
     s.k_i = 1e9;
     s.anti_windup = false;
-    s.gain_schedule_force = s.slope_gain ? 0.0 : 1e-6;
+    s.mu_probe = variant % 2 ? 0.5 : 0.0;
     s.loop_gain_p = s.loop_gain_i = 1e9;
     s.s_ref = s.feedforward_slippage = s.reflex_slippage = 1e-3;
     s.reflex_factor = 1e3;

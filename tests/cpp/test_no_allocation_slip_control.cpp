@@ -1,4 +1,4 @@
-// SlipControl::step() and its run-time calls never allocate: this binary replaces the global
+// SlipControl::step() and its run-time calls (set_mu included) never allocate: this binary replaces the global
 // operator new and counts calls while stepping (random wrenches, NaN, contact loss, requests).
 #include <gtest/gtest.h>
 
@@ -37,6 +37,8 @@ TEST(NoAllocation, SlipControlStep) {
     if (n % 5000 == 2600) sc.request_slipping_avoidance();
     if (n % 20000 == 7) sc.set_dynamic_enabled(n % 40000 != 7);
     if (n % 30000 == 9) sc.reset(2.0);
+    if (n % 7000 == 11) sc.set_mu(0.3 + u(rng));  // the per-object refit, mid-loop
+    if (n % 9000 == 13) sc.set_mu(nan);           // refused, nothing changed
     sc.step(in, out);
     single.step(in, out1);
   }

@@ -159,7 +159,7 @@ TEST(SlipControl, SameNumbersAsTheHandWiredPathWithStatuses) {
       const FingerWrench& w = in.fingers[i];
       const ObserverInput oin = ObserverInput::from_force_vector(w.f_n, w.f_x, w.f_y, w.tau);
       obs[i].step(oin, o);
-      cin.fingers[i] = FingerInput{o.omega_hat, o.S, o.c_tilde, oin.f_t, o.status, true, o.omega_resolution, oin.tau};
+      cin.fingers[i] = FingerInput{o.omega_hat, o.S, o.c_tilde, oin.f_t, o.status, true, o.omega_resolution, oin.tau, oin.f_n};
     }
     ctrl.step(cin, ref);
     sc.step(in, out);
@@ -250,6 +250,7 @@ TEST(SlipControl, SetMuChangesObserversAndControllerKeepsTheCommand) {
   sc.set_mu(0.5 * can().mu);  // the refit finds half the friction
   EXPECT_EQ(sc.params().mu, 0.5 * can().mu);
   EXPECT_EQ(sc.controller().mu(), 0.5 * can().mu);
+  EXPECT_EQ(sc.controller().mu_belief(), 0.5 * can().mu);  // the belief restarts from it
   EXPECT_EQ(sc.observer(1).model().params().mu, 0.5 * can().mu);
   EXPECT_EQ(sc.command(), before);
   const double after = settle(sc, grip, 4000).force;
@@ -257,8 +258,11 @@ TEST(SlipControl, SetMuChangesObserversAndControllerKeepsTheCommand) {
   half.mu *= 0.5;
   EXPECT_NEAR(after, static_grasp_force(half, grip.f_t, grip.tau, GraspControllerSettings{}.s_ref), 0.02 * after);
   EXPECT_GT(after, 1.5 * before);
-  EXPECT_THROW(sc.set_mu(0.0), std::invalid_argument);
+  EXPECT_FALSE(sc.set_mu(0.0));  // refused, nothing changed
+  EXPECT_FALSE(sc.set_mu(std::numeric_limits<double>::quiet_NaN()));
+  EXPECT_FALSE(sc.set_mu(10.5));
   EXPECT_EQ(sc.params().mu, 0.5 * can().mu);
+  EXPECT_EQ(sc.controller().mu(), 0.5 * can().mu);
 }
 
 TEST(SlipControl, ClosedLoopOnThePatchPlantMatchesTheHandWiredLoop) {
@@ -287,7 +291,7 @@ TEST(SlipControl, ClosedLoopOnThePatchPlantMatchesTheHandWiredLoop) {
       const ObserverInput oin = ObserverInput::from_force_vector(f.f_n, f.f_x, f.f_y, f.tau);
       ObserverOutput o;
       obs[i].step(oin, o);
-      cin.fingers[i] = FingerInput{o.omega_hat, o.S, o.c_tilde, oin.f_t, o.status, true, o.omega_resolution, oin.tau};
+      cin.fingers[i] = FingerInput{o.omega_hat, o.S, o.c_tilde, oin.f_t, o.status, true, o.omega_resolution, oin.tau, oin.f_n};
     }
     ctrl.step(cin, ref);
     plant.set_command(ref.force);

@@ -251,6 +251,7 @@ def run_mujoco_loop(
     ):
         col(name, np.int64)
     col("actuator_command")
+    col("mu_belief")
     for k in (0, 1):
         for name in (
             "f_n_meas",
@@ -453,6 +454,7 @@ def run_mujoco_loop(
         lug = kind == "lugrip" and started and out is not None
         cols["static_force"][i] = out.controller.static_force if lug else command
         cols["dynamic_force"][i] = out.controller.dynamic_force if lug else 0.0
+        cols["mu_belief"][i] = out.controller.mu_belief if lug else est.mu
         cols["mode"][i] = (
             int(getattr(out.controller.mode, "value", out.controller.mode)) if lug else 0
         )
