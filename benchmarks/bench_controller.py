@@ -41,7 +41,7 @@ SINGLE_OFF = {
     "no_average_S": {"average_slippage": False},
     # the reaction to loads faster than one command (trend feed-forward, lag overshoot, reactions
     # on samples with an invalid finger) off together: the controller before it
-    "no_fast_reaction": {"feedforward_horizon": 0.0, "reaction_lag": 0.0, "react_when_invalid": False},
+    "no_fast_reaction": {"feedforward_horizon": 0.0, "reaction_lag": 0.0},
     # the standing reserve the unseen scenes derive from their pulses (the paper's scenes have none)
     "no_reserve": {"reserve_force": 0.0, "reserve_torque": 0.0},
 }

@@ -23,8 +23,7 @@ constexpr double kProbeElasticity = 0.5;  // d ln load / d ln f_n at or above: t
 constexpr double kProbeSigmas = 2.0;      // ... beyond this many standard errors of the load
 constexpr double kProbeStepDown = 0.7;    // the belief falls by at most 30 % per probe
 constexpr double kMuFloor = 0.5;          // ... and never below half the told mu
-constexpr double kProbeSameS = 0.05;      // S within this of the last stick answer: back off
-constexpr double kProbeGapMax = 1.0;      // [s] longest back-off
+constexpr double kProbeRise = 0.05;       // a new probe once S exceeds the highest stick answer by this
 
 // Shortest of %.15g / %.17g that reads back exactly.
 std::string fmt(double v) { return detail::format_number(v); }
@@ -249,10 +248,10 @@ void GraspController::reset(double current_force) noexcept {
 void GraspController::reset_probe() noexcept {
   probe_left_ = 0;
   probe_wait_ = 0;
-  probe_gap_ = kProbeGapMin;
-  probe_s_ = prev_s_ = 0.0;
+  probe_s_ = prev_s_ = probe_f_ = 0.0;
   probe_base_ = 0.0;
   probe_slip_ = false;
+  probe_disturbed_ = false;
   prev_load_ = {};
 }
 
@@ -549,6 +548,8 @@ void GraspController::issue_command(bool valid, double slip) noexcept {
     // does not see them (a probe is not the load's demand).
     if (probe_started) probe_base_ = f_ns;
     const bool probing = probe_left_ > 0;
+    // A reaction during the probe (the load moved: feed-forward lift, reflex) spoils its answer.
+    if (probing && !probe_started && c.reflex) probe_disturbed_ = true;  // the reflex moved it
     c.probing = probing;
     if (probing) f_ns = std::min(std::max(f_ns, probe_base_ * (1.0 + s_.mu_probe)), s_.f_max);
     else integrator_ += k_i * t_cmd_ * e;  // forward Euler
@@ -648,6 +649,11 @@ void GraspController::probe_evaluate(double slip_mean) noexcept {
     return;
   }
   if (probe_left_ > 0) return;
+  if (probe_disturbed_) {  // the load moved during the probe: no answer
+    probe_disturbed_ = false;
+    probe_wait_ = kProbeGapMin;
+    return;
+  }
   // End of a probe: the mean of its last two periods against the mean of the two periods
   // before it. Elasticity E = d ln(load) / d ln(f_n) of each finger's dominant load component
   // (a twist's divided by 1 + gamma): ~0 for a sticking contact, ~1 for a sliding one.
@@ -686,9 +692,13 @@ void GraspController::probe_evaluate(double slip_mean) noexcept {
     const double band = kProbeSigmas * sd;
     if (y >= kProbeElasticity * x + band) {
       slip = true;
-      // The friction the contact slid at: S_static of the load before the probe against mu = 1.
+      // The friction the contact slid at: S_static against mu = 1 of the load before the probe
+      // and during it (both are the friction while it slides; the larger errs on the safe side
+      // of a load that was still rising).
       const double s0 = solver_.slippage(fn0, ft0, tau0);
+      const double s1 = solver_.slippage(fn1, 0.5 * (c.ft + d.ft), 0.5 * (c.tau + d.tau));
       if (std::isfinite(s0)) r_slip = std::max(r_slip, s0 * mu_);
+      if (std::isfinite(s1)) r_slip = std::max(r_slip, s1 * mu_);
     }
   }
   if (slip && r_slip > 0.0) {
@@ -699,16 +709,15 @@ void GraspController::probe_evaluate(double slip_mean) noexcept {
     }
     probe_slip_ = true;
     reflex_armed_ = true;  // a confirmed slip: the reflex raises the static part now
-    probe_gap_ = kProbeGapMin;
+    probe_s_ = probe_f_ = 0.0;  // stick is proven again from the start
   } else if (answered) {
-    // Stick at this S: back off while S stays at or below the last stick answer's, probe soon
-    // when it has risen above it.
-    probe_gap_ = slip_mean < probe_s_ + kProbeSameS
-                     ? std::min(2 * probe_gap_, std::max(kProbeGapMin, static_cast<int>(kProbeGapMax / t_cmd_)))
-                     : kProbeGapMin;
-    probe_s_ = slip_mean;
+    // Stick proven up to the S before the probe, at the grip of then: the next probe waits
+    // until S rises above it, or the grip has fallen below it (a slide keeps S flat while the
+    // PI lowers the grip; a sticking contact's S rises).
+    probe_s_ = std::max(probe_s_, probe_ref_s_);
+    probe_f_ = probe_base_;
   }
-  probe_wait_ = probe_gap_;
+  probe_wait_ = kProbeGapMin;
 }
 
 bool GraspController::probe_start(double slip_mean, bool reacting) noexcept {
@@ -724,6 +733,9 @@ bool GraspController::probe_start(double slip_mean, bool reacting) noexcept {
     return false;
   }
   if (reacting || !(slip_mean >= kProbeMinS) || slip_mean < prev - kProbeFall) return false;
+  if (probe_s_ > 0.0 && slip_mean < probe_s_ + kProbeRise &&
+      std::min(last_.static_force, command_) > (1.0 - s_.mu_probe) * probe_f_)
+    return false;  // stick proven there
   bool any = false;
   for (int i = 0; i < kMaxFingers; ++i) {
     ref_a_[i] = before[i];
@@ -731,6 +743,8 @@ bool GraspController::probe_start(double slip_mean, bool reacting) noexcept {
     any = any || (before[i].n >= 3 && now[i].n >= 3);
   }
   if (!any) return false;
+  probe_ref_s_ = slip_mean;
+  probe_disturbed_ = false;
   probe_left_ = 3;
   return true;
 }

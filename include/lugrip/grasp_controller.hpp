@@ -394,7 +394,7 @@ class GraspController {
   void probe_evaluate(double slip_mean) noexcept;
   bool probe_start(double slip_mean, bool reacting) noexcept;
   void reset_probe() noexcept;
-  static constexpr int kProbeGapMin = 3;  // [commands] between probes while S rises
+  static constexpr int kProbeGapMin = 3;  // [commands] at least between two probes
   // One finger's load over one command period (the probe's measurements).
   struct PeriodLoad {
     double fn = 0.0, ft = 0.0, tau = 0.0;  // means [N], [N], [N m]
@@ -451,8 +451,10 @@ class GraspController {
   std::array<PeriodLoad, kMaxFingers> probe_a_{};          // the probe's second period
   int probe_left_ = 0;        // commands of the running probe still to issue (0: none)
   int probe_wait_ = 0;        // commands until the next probe may start
-  int probe_gap_ = 3;         // current back-off [commands]
-  double probe_s_ = 0.0;      // S at which the last probe found stick
+  double probe_s_ = 0.0;      // highest S at which a probe found stick (0: none since a slip)
+  double probe_ref_s_ = 0.0;  // S of the running probe's reference period
+  double probe_f_ = 0.0;      // static part at the start of the last probe that found stick [N]
+  bool probe_disturbed_ = false;  // a reaction acted during the running probe
   double prev_s_ = 0.0;       // mean S of the previous command period
   double probe_base_ = 0.0;   // static part when the probe started [N]
   bool probe_slip_ = false;   // the last evaluated probe found slip

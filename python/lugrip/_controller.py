@@ -49,15 +49,11 @@ PAPER_SETTINGS: dict[str, Any] = {
     "slope_gain": False,
     "feedforward": False,
     "slip_reflex": False,
-    "reflex_in_period": False,
     "average_slippage": False,
-    "static_equivalent_slippage": False,
     "omega_deadband": 0.0,
     "feedforward_horizon": 0.0,
-    "feedforward_trend_grasp": False,
-    "feedforward_trend_check": False,
     "reaction_lag": 0.0,
-    "react_when_invalid": False,
+    "mu_probe": 0.0,
     "reserve_force": 0.0,
     "reserve_torque": 0.0,
     "pivot_end_filter": 0.0,
@@ -193,15 +189,14 @@ class GraspController:
             contact model for the feed-forward and the slope).
         **settings: any GraspControllerSettings field (see :func:`controller_settings` for the
             names and defaults): rates (sensor_rate [Hz], command_ratio), C_d (k_cd [N s/rad],
-            p_cd, z_cd [rad/s], dynamic_enabled), PI (s_ref, k_p [N], k_i [N/s], anti_windup,
-            gain_schedule_force [N], 0 = off; static_equivalent_slippage: regulate the S of the
-            static part alone; omega_deadband: dead band of C_d in omega resolutions, 0 = off),
+            p_cd, z_cd [rad/s], dynamic_enabled), PI (s_ref, k_p [N], k_i [N/s], anti_windup;
+            omega_deadband: dead band of C_d in omega resolutions, 0 = off),
             slope_gain, loop_gain_p [-], loop_gain_i [1/s]: PI gains from the plant's slope
             dS/df_n; feedforward, feedforward_slippage: static part floored at the static grasp
-            force of the measured load (feedforward_trend_grasp, feedforward_trend_check: the
-            trend's reference and the check of its prediction); slip_reflex, reflex_slippage,
-            reflex_factor, reflex_in_period: raise the command when the peak of S reaches the
-            threshold (see
+            force of the measured load (feedforward_horizon, feedforward_trend: the load's
+            trend); slip_reflex, reflex_slippage, reflex_samples, reflex_factor: raise the
+            command when S reaches the threshold; mu_probe: the grip probe that learns mu
+            (needs f_n; output mu_belief) (see
             :data:`PAPER_SETTINGS` for the paper's law),
             range (f_min, f_max [N]), rate
             limits (max_rate_up, max_rate_down [N/s], inf = off), invalid_raise_step [N], pivoting

@@ -97,7 +97,9 @@ TEST(ControllerProbe, FindsASlideThatSIndicatesAsStickAndLearnsMu) {
 
 TEST(ControllerProbe, BoundedStepPerProbe) {
   // mu believed 1.8x too high (S ~ 0.53 while sliding): one probe lowers the belief by at most
-  // 30 %, so the slide takes two probes; the belief ends at the friction it slid at.
+  // 30 %. The reflex then lifts the grip and the next probe, on the way up, finds stick; the PI
+  // lowers the grip again with S flat (a slide), and once the grip is a probe's size below the
+  // grip stick was proven at, a probe finds the slide again: the belief ends at the friction.
   const double mu_true = 0.2;
   const ContactParams p = told(1.8 * mu_true);
   const Result r = run(p, mu_true, 1.0, 0.08, 4.0);
@@ -106,6 +108,8 @@ TEST(ControllerProbe, BoundedStepPerProbe) {
   EXPECT_GT(r.mu_belief, 0.85 * mu_true);
   EXPECT_LT(r.mu_belief, 1.02 * mu_true);
   EXPECT_GE(r.mu_belief, 0.5 * p.mu);  // never below half the told mu
+  EXPECT_LT(r.slide_time, 1.5);
+  EXPECT_GT(r.last_force, 1.0 / mu_true);
 }
 
 TEST(ControllerProbe, LeavesAStickingContactAloneAndCostsLittle) {

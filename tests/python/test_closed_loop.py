@@ -179,7 +179,7 @@ def test_python_and_core_agree():
     cog_x=st.floats(-0.005, 0.005),
     cog_y=st.floats(-0.05, 0.0),
     f_min=st.floats(0.05, 1.0),
-    gs=st.sampled_from([0.0, 3.0]),
+    slope=st.booleans(),
     contact=st.sampled_from(
         ["big_resin_block", "small_resin_block", "plastic_bottle", "aluminium_can"]
     ),
@@ -188,7 +188,7 @@ def test_python_and_core_agree():
     pivot=st.booleans(),
 )
 def test_property_command_finite_in_limits(
-    mass, cog_x, cog_y, f_min, gs, contact, kind, push, pivot
+    mass, cog_x, cog_y, f_min, slope, contact, kind, push, pivot
 ):
     """Any object, load and setting: every value finite, the command in [f_min, f_max], S in
     [0, 1] (docs/model.md 10.3 criterion 6)."""
@@ -201,7 +201,7 @@ def test_property_command_finite_in_limits(
         ],
         drop={"rotation_limit": math.inf},
     )
-    ctrl = {"f_min": f_min, "f_max": 15.0, "gain_schedule_force": gs, "slope_gain": gs == 0.0}
+    ctrl = {"f_min": f_min, "f_max": 15.0, "slope_gain": slope}
     r = run_closed_loop(d, ctrl, OBS, [(2.0, "pivot")] if pivot else None, 3.0, kind=kind)
     assert np.all(r.finite.astype(bool))
     for v in r.values():
@@ -227,7 +227,7 @@ def test_estimator_parameters_feed_the_observers_and_default_to_the_plants():
     with pytest.raises(ValueError):
         closed_loop_config(p, None, OBS, estimator=3.0)
     # without the fast reaction to load changes, which also catches the late-seen lift-off
-    slow = {"feedforward_horizon": 0.0, "reaction_lag": 0.0, "react_when_invalid": False}
+    slow = {"feedforward_horizon": 0.0, "reaction_lag": 0.0}
     own = run_closed_loop(p, slow, OBS, None, 4.0)
     table1 = run_closed_loop(p, slow, OBS, None, 4.0, estimator={"sigma_z": 2.0})
     rot_own = np.degrees(np.max(np.abs(own["rotation"])))

@@ -305,7 +305,7 @@ def test_closed_loop_settles_at_the_static_force(obj, ft, tau):
 def test_dead_band_ignores_speeds_below_the_observer_resolution():
     """omega_deadband (in multiples of the observer's omega_resolution) removes the noise-level
     speeds from C_d: no dynamic force below the band, the force of the shrunk speed above it."""
-    kw = {"omega_deadband": 2.0, "static_equivalent_slippage": False}
+    kw = {"omega_deadband": 2.0}
     below = lugrip.GraspController("aluminium_can", **kw).run(
         np.full(40, 0.015), 0.8, omega_resolution=0.01
     )
@@ -385,10 +385,13 @@ def test_new_settings_are_validated(name, value):
             GraspController(CAN, **{name: value})
 
 
-def test_slope_gain_and_the_old_schedule_are_exclusive():
-    with pytest.raises(ValueError, match="gain_schedule_force"):
-        GraspController(CAN, gain_schedule_force=3.0)
-    GraspController(CAN, gain_schedule_force=3.0, slope_gain=False)
+def test_removed_settings_are_refused_by_name():
+    """The superseded settings and the 'earlier rule' switches are gone: naming one is an
+    error that names it (no silent acceptance of a setting that does nothing)."""
+    for name in ("gain_schedule_force", "static_equivalent_slippage", "reflex_in_period",
+                 "feedforward_trend_grasp", "feedforward_trend_check", "react_when_invalid"):
+        with pytest.raises(ValueError, match=name):
+            GraspController(CAN, **{name: 1.0})
 
 
 def _steady_ptp(run, t0, t1):

@@ -12,7 +12,7 @@ import pytest
 import lugrip
 
 #: the settings that turn the fast reaction off (the controller before it)
-NO_FAST_REACTION = {"feedforward_horizon": 0.0, "reaction_lag": 0.0, "react_when_invalid": False}
+NO_FAST_REACTION = {"feedforward_horizon": 0.0, "reaction_lag": 0.0}
 
 
 def _cup_down_pulse(over):
