@@ -426,6 +426,8 @@ def test_frontier_report_and_replay_of_a_fragile_run(tmp_path, capsys):
     fr = data["frontier"]
     assert fr["runs"] == 2 and set(fr["controllers"]) == {"constant_force", "friction_cone"}
     assert (out / "frontier.png").is_file()
+    chk = fr["constant_force_check"]
+    assert chk["force"] == 2.0 and chk["runs"] == 2 and chk["agree"] == 2
     md = (out / "report.md").read_text()
     assert "## Constant-force frontier" in md and "mean force / min static" in md
     for r in rows:

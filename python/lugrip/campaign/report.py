@@ -68,7 +68,9 @@ def frontier_summary(rows: Sequence[dict], campaign: Campaign, summary: dict | N
     n = len(runs)
     fp = [r.get("frontier_force") for r in runs]
     cr = [r.get("crush_force") for r in runs]
-    f_max = float(campaign.base_scenario().controller.get("f_max", 20.0))
+    from .._controller import controller_settings
+
+    f_max = float(campaign.base_scenario().controller.get("f_max", controller_settings()["f_max"]))
     passing = sorted(float(v) for v, c in zip(fp, cr) if v is not None and (c is None or v <= c))
     out: dict[str, Any] = {
         "runs": n,
@@ -114,6 +116,22 @@ def frontier_summary(rows: Sequence[dict], campaign: Campaign, summary: dict | N
             ),
         }
     out["controllers"] = points
+    # the simulated constant_force controller against the frontier's verdict for its force,
+    # run by run: a direct check of the monotonicity the frontier assumes
+    if "constant_force" in campaign.controllers:
+        force = float(campaign.controllers["constant_force"]["force"])
+        sim = {int(r["run"]): bool(r["success"]) for r in rows
+               if r["controller"] == "constant_force"}
+        verdict = {int(r["run"]): bool(frontier_rate([r.get("frontier_force")],
+                                                     [r.get("crush_force")], force)[0])
+                   for r in runs if not r.get("frontier_error")}
+        both = sorted(set(sim) & set(verdict))
+        out["constant_force_check"] = {
+            "force": force,
+            "runs": len(both),
+            "agree": sum(sim[i] == verdict[i] for i in both),
+            "disagree_runs": [i for i in both if sim[i] != verdict[i]],
+        }
     return out
 
 
@@ -391,6 +409,15 @@ def markdown(data: dict[str, Any], figure: str | None = None,
             "mean force | difference | minus frontier max |",
             "|---|---:|---|---:|---:|---:|---:|",
         ]
+        chk = fr.get("constant_force_check")
+        if chk:
+            lines[-3:-3] = [
+                f"- Check of the monotonicity the frontier assumes: the simulated constant_force "
+                f"controller ({_fmt(chk['force'])} N) and the frontier's verdict for that force "
+                f"agree on {chk['agree']} of {chk['runs']} runs"
+                + (f" (they differ on runs {', '.join(map(str, chk['disagree_runs'][:10]))})"
+                   if chk["disagree_runs"] else "") + ".",
+            ]
         for c, pt in fr["controllers"].items():
             w = pt["wilson95"] or [math.nan, math.nan]
             lines.append(
