@@ -19,7 +19,7 @@ import yaml
 from lugrip import cli, static_grasp_force
 from lugrip.campaign import Campaign, CampaignError, load_campaign, run_one, wilson
 from lugrip.campaign.report import frontier_rate, frontier_summary
-from lugrip.campaign.runner import _criteria, _simulate, constant_frontier
+from lugrip.campaign.runner import _criteria, _simulate, constant_frontier, search_constant
 
 ROOT = Path(__file__).resolve().parents[2]
 EVERYDAY = ROOT / "campaigns" / "everyday_patch.yaml"
@@ -165,6 +165,7 @@ def test_frontier_bisection_finds_the_smallest_passing_constant():
         lim = c.run_limits(scn, p)
         fr = constant_frontier(c, scn, lim)
         assert fr["found"] and fr["error"] is None and not fr["floor_passed"]
+        assert fr["fail_above"] is None  # the top passed
         f = fr["force"]
         assert lim["min_static_force"] * 0.5 < f <= fr["high"] == pytest.approx(lim["crush_force"])
         assert 2 <= fr["evaluations"] <= c.frontier["max_evaluations"]
@@ -180,16 +181,53 @@ def test_frontier_bisection_finds_the_smallest_passing_constant():
 
 
 def test_frontier_top_failing_means_no_constant_passes():
-    """A push of 3x the weight downward: no constant up to the crush force holds, the bracket's
-    top is the only simulation and the run records no force."""
+    """A push of 3x the weight downward: no constant up to the crush force holds; the top and
+    the downward scan below it all fail and the run records no force."""
     d = _short(push_count=1, push_weight_fraction=3.0, push_angle=-90.0, push_duration=0.2,
                crush_factor=1.5, mass=0.3, mu=0.5)
     d["frontier"] = True
     c = _campaign(d)
     (row,) = run_one(c, 0)
     assert row["frontier_force"] is None and row["frontier_found"] is False
-    assert row["frontier_evaluations"] == 1
-    assert json.loads(row["frontier_history"]) == [[pytest.approx(row["crush_force"]), False]]
+    assert row["frontier_fail_above"] is None
+    hist = json.loads(row["frontier_history"])
+    assert hist[0][0] == pytest.approx(row["crush_force"])
+    assert len(hist) == row["frontier_evaluations"] >= 2 and not any(ok for _, ok in hist)
+    # the scan stops at the bracket's bottom (half the minimum static force)
+    assert min(f for f, _ in hist) > 0.5 * row["min_static_force"]
+
+
+@pytest.mark.parametrize(
+    ("name", "passes", "expect", "fail_above"),
+    [
+        ("monotone", lambda f: f >= 3.0, 3.0, None),
+        # a window, as MuJoCo's torsional chatter makes: the top and the scan's first steps fail
+        # (38.7, 38.7 / 2^0.5, 38.7 / 2 fail; 38.7 / 2^1.5 = 13.7 fails; 9.7 passes)
+        ("window", lambda f: 9.4 <= f <= 10.0, 9.4, 38.7 / 2.0**1.5),
+        ("never", lambda f: False, None, None),
+        ("always", lambda f: True, 4.0, None),
+    ],
+)
+def test_search_constant_on_known_pass_sets(name, passes, expect, fail_above):
+    """The search against pass sets whose answer is known: the smallest passing force within
+    the tolerance, the failing force above it when the top fails, the floor when all pass."""
+    calls = []
+
+    def counted(f):
+        calls.append(f)
+        return passes(f)
+
+    r = search_constant(counted, 4.0 if name == "always" else 1.0, 38.7, tolerance=0.02,
+                        max_evaluations=12)
+    assert len(calls) == len(r["history"]) <= 13
+    if expect is None:
+        assert r["force"] is None and not r["found"]
+        assert min(calls) > 1.0  # scanned down to the bottom, not below it
+        return
+    assert r["found"] and expect <= r["force"] <= expect * 1.02 + 1e-12
+    assert passes(r["force"])
+    assert r["floor_passed"] is (name == "always")
+    assert r["fail_above"] == (None if fail_above is None else pytest.approx(fail_above))
 
 
 def test_frontier_rate_against_a_brute_force_count():
@@ -235,6 +273,13 @@ def test_frontier_summary_on_hand_made_rows():
     assert fr["controllers"]["lugrip"]["minus_constant_same_mean_force"] == pytest.approx(0.4)
     assert fr["controllers"]["paper"]["constant_same_mean_force"] == 0.4
     assert fr["controllers"]["paper"]["minus_frontier_max"] == pytest.approx(-0.2)
+    # a run whose force above its smallest passing one failed counts only below that force
+    assert list(frontier_rate([2.0, 2.0], [10.0, 10.0], [2.0, 2.9, 3.0, 5.0], [3.0, None])) \
+        == [1.0, 1.0, 0.5, 0.5]
+    rows[2]["frontier_fail_above"] = rows[3]["frontier_fail_above"] = 3.0  # run 1 fails at 3 N
+    fr = frontier_summary(rows, c, summary)
+    assert fr["non_monotone"] == 1
+    assert fr["controllers"]["paper"]["constant_same_mean_force"] == 0.4  # 2 N < 3 N
 
 
 def test_wilson_against_a_hand_computed_interval():

@@ -33,18 +33,22 @@ def wilson(successes: int, n: int, z: float = 1.959964) -> tuple[float, float]:
 
 
 def frontier_rate(f_pass: Sequence[float | None], crush: Sequence[float | None],
-                  forces: Sequence[float] | float) -> np.ndarray:
+                  forces: Sequence[float] | float,
+                  fail_above: Sequence[float | None] | None = None) -> np.ndarray:
     """Success rate of a constant force F over the runs, for each F in `forces`: the fraction
-    of runs with f_pass <= F <= crush (f_pass: the run's smallest passing constant, None when
-    none passes; crush: its crush force, None for no limit). Success of a constant is taken as
-    monotone in the force below the crush force (runner.constant_frontier)."""
+    of runs with f_pass <= F <= crush and F < fail_above (f_pass: the run's smallest passing
+    constant, None when none passes; crush: its crush force, None for no limit; fail_above: a
+    larger force found to fail, None when none was). Success of a constant is taken as monotone
+    in the force between f_pass and the first of those limits (runner.constant_frontier)."""
     n = len(f_pass)
     fp = np.array([math.inf if v is None else float(v) for v in f_pass], dtype=float)
     cr = np.array([math.inf if v is None else float(v) for v in crush], dtype=float)
+    fa = np.array([math.inf if v is None else float(v) for v in (fail_above or [None] * n)],
+                  dtype=float)
     f = np.atleast_1d(np.asarray(forces, dtype=float))
     if n == 0:
         return np.full(f.shape, np.nan)
-    ok = (fp[None, :] <= f[:, None]) & (f[:, None] <= cr[None, :])
+    ok = (fp[None, :] <= f[:, None]) & (f[:, None] <= cr[None, :]) & (f[:, None] < fa[None, :])
     return ok.sum(axis=1) / n
 
 
@@ -68,6 +72,7 @@ def frontier_summary(rows: Sequence[dict], campaign: Campaign, summary: dict | N
     n = len(runs)
     fp = [r.get("frontier_force") for r in runs]
     cr = [r.get("crush_force") for r in runs]
+    fa = [r.get("frontier_fail_above") for r in runs]
     from .._controller import controller_settings
 
     f_max = float(campaign.base_scenario().controller.get("f_max", controller_settings()["f_max"]))
@@ -76,13 +81,15 @@ def frontier_summary(rows: Sequence[dict], campaign: Campaign, summary: dict | N
         "runs": n,
         "f_max": f_max,
         "no_constant_passes": sum(v is None for v in fp),
+        # a force above the smallest passing one failed: success is not monotone there
+        "non_monotone": sum(v is not None for v in fa),
         "floor_passed": sum(bool(r.get("frontier_floor_passed")) for r in runs),
         "errors": sum(bool(r.get("frontier_error")) for r in runs),
         "evaluations_mean": float(np.mean([r.get("frontier_evaluations") or 0 for r in runs])),
     }
     if passing:
         at = np.asarray(passing)
-        rates = frontier_rate(fp, cr, at)
+        rates = frontier_rate(fp, cr, at, fa)
         k = int(np.argmax(rates))  # the smallest force reaching the maximum
         best = int(round(rates[k] * n))
         lo_grid = max(min(passing) / 1.5, 1e-3)
@@ -93,7 +100,7 @@ def frontier_summary(rows: Sequence[dict], campaign: Campaign, summary: dict | N
             max_force=float(at[k]),
             # selected after the fact: the interval is optimistic for the best constant
             max_wilson95=list(wilson(best, n)),
-            curve={"force": grid.tolist(), "rate": frontier_rate(fp, cr, grid).tolist()},
+            curve={"force": grid.tolist(), "rate": frontier_rate(fp, cr, grid, fa).tolist()},
         )
     else:
         out.update(max_rate=0.0, max_successes=0, max_force=None, max_wilson95=list(wilson(0, n)),
@@ -101,7 +108,7 @@ def frontier_summary(rows: Sequence[dict], campaign: Campaign, summary: dict | N
     points = {}
     for c, s in (summary or {}).items():
         mf = s.get("mean_force")
-        same = float(frontier_rate(fp, cr, mf)[0]) if mf is not None else None
+        same = float(frontier_rate(fp, cr, mf, fa)[0]) if mf is not None else None
         points[c] = {
             "success_rate": s.get("success_rate"),
             "wilson95": s.get("wilson95"),
@@ -123,7 +130,8 @@ def frontier_summary(rows: Sequence[dict], campaign: Campaign, summary: dict | N
         sim = {int(r["run"]): bool(r["success"]) for r in rows
                if r["controller"] == "constant_force"}
         verdict = {int(r["run"]): bool(frontier_rate([r.get("frontier_force")],
-                                                     [r.get("crush_force")], force)[0])
+                                                     [r.get("crush_force")], force,
+                                                     [r.get("frontier_fail_above")])[0])
                    for r in runs if not r.get("frontier_error")}
         both = sorted(set(sim) & set(verdict))
         out["constant_force_check"] = {
@@ -399,7 +407,10 @@ def markdown(data: dict[str, Any], figure: str | None = None,
             f"{fr['runs']} runs; {fr['evaluations_mean']:.1f} simulations per run"
             + (f"; {fr['errors']} frontier errors" if fr["errors"] else "")
             + (f"; on {fr['floor_passed']} runs the bracket's bottom passed too (their force is "
-               "an upper bound)" if fr["floor_passed"] else "") + ".",
+               "an upper bound)" if fr["floor_passed"] else "")
+            + (f"; on {fr['non_monotone']} runs a force above the smallest passing one failed "
+               "(success not monotone in the force there: such a run counts as held only below "
+               "that failing force)" if fr.get("non_monotone") else "") + ".",
             "",
             f"- Frontier maximum: **{_fmt(fr['max_rate'])}** ({fr['max_successes']}/{fr['runs']}"
             f", Wilson [{lo:.3f}, {hi:.3f}], optimistic: the best constant is chosen after the "

@@ -123,25 +123,87 @@ def simulate_run(campaign: Campaign, index: int, controllers: Sequence[str] | No
     return scn, params, out
 
 
+def search_constant(passes: Callable[[float], bool], low: float, high: float, *,
+                    tolerance: float = 0.02, max_evaluations: int = 12,
+                    scan: float = math.sqrt(2.0)) -> dict[str, Any]:
+    """The smallest force in [low, high] for which ``passes(force)`` is true, by bisection on
+    log(force); `passes` is called at most `max_evaluations` times, plus once at `low` (below).
+
+    1. ``high`` first. When it fails, forces below it are scanned downward by factors of
+       `scan` (not below `low`): on a plant where more force can lose a grasp (MuJoCo's pads
+       chatter in torsion at high grip forces) a force below the top may still pass. The
+       smallest force tried above the first passing one that failed is ``fail_above``; when no
+       force passes, ``force`` is None.
+    2. Bisection between the largest failing force below the passing one (else ``low``, assumed
+       to fail) and the passing one, to a bracket of relative width `tolerance`.
+    3. When every force tried passed, ``low`` itself is tried (``floor_passed``: the force is
+       then only an upper bound).
+
+    Returns {force, found, fail_above, floor_passed, history: [[force, passed], ...]}.
+    """
+    history: list[list[Any]] = []
+
+    def test(f: float) -> bool:
+        ok = bool(passes(f))
+        history.append([float(f), ok])
+        return ok
+
+    out: dict[str, Any] = {"force": None, "found": False, "fail_above": None,
+                           "floor_passed": False, "history": history}
+    if high <= low:
+        return out
+    hi = high
+    if not test(hi):
+        fail = hi
+        f = hi / scan
+        while f > low * (1.0 + tolerance) and len(history) < max_evaluations:
+            if test(f):
+                hi = f
+                out["fail_above"] = fail
+                break
+            fail = f
+            f /= scan
+        else:
+            return out
+        if out["fail_above"] is None:
+            return out
+    lo = max([f for f, ok in history if not ok and f < hi], default=low)
+    while hi / lo > 1.0 + tolerance and len(history) < max_evaluations:
+        mid = math.sqrt(lo * hi)
+        if test(mid):
+            hi = mid
+        else:
+            lo = mid
+    if all(ok for _, ok in history) and test(low):
+        hi = low  # every force tried passed, and so does the bottom assumed to fail
+        out["floor_passed"] = True
+    out.update(force=float(hi), found=True)
+    return out
+
+
 def constant_frontier(campaign: Campaign, scn, limits: Mapping[str, Any],
                       criteria: Mapping[str, Any] | None = None) -> dict[str, Any]:
     """The smallest constant grasp force [N] that passes the run `scn` (every criterion of the
-    campaign, as the constant_force controller is judged), by bisection on log(force).
+    campaign, as the constant_force controller is judged), by :func:`search_constant`.
 
     The bracket: top ``min(crush force, f_max)`` (f_max: the gripper's range in the run's
-    controller block), bottom ``max(f_min, low_fraction x min_static_force)``. The top is
-    simulated first; when it fails no constant passes the run (``force`` None). The bottom is
-    assumed to fail (below the static force the hanging load alone makes the object slide) and
-    is simulated only when every force above it passed. Then ``max_evaluations`` simulations at
-    most, to a bracket of relative width ``tolerance``.
+    controller block), bottom ``max(f_min, low_fraction x min_static_force)`` (assumed to fail:
+    below the static force the hanging load alone makes the object slide); ``max_evaluations``
+    simulations at most, to a bracket of relative width ``tolerance``.
 
     Assumption: below the crush force, success of a constant force is monotone in the force
-    (more force never loses a grasp that less force held). Not exact on every plant (a
-    stiffer grasp can change how a pad's spring rings under a push), but the tests check it on
-    sampled runs; under it the success of ANY constant F on this run is F_pass <= F <= crush.
+    (more force never loses a grasp that less force held); then the success of ANY constant F
+    on this run is F_pass <= F <= crush. It does not hold on every plant: on MuJoCo the pads'
+    torsional contact can chatter at high grip forces and ratchet the object round, so a high
+    constant fails where a lower one holds. The search therefore scans down from a failing top,
+    and records the failing force above the passing one (``fail_above``): the report then counts
+    the run as held by F only for F_pass <= F < fail_above (the true upper end lies between the
+    largest passing and that failing force: the count errs toward the constant). Where the top
+    passes, forces between F_pass and the top are not all tried; the report compares the
+    simulated constant_force controller with this verdict run by run.
 
-    Returns {force, found, low, high, evaluations, history: [[force, passed], ...],
-    floor_passed (the bottom itself passed: force is then only an upper bound), error}.
+    Returns {force (None when no constant passes), found, fail_above, low, high, evaluations,
+    history: [[force, passed], ...], floor_passed, error}.
     """
     opt = campaign.frontier or dict(FRONTIER_DEFAULTS)
     crit = dict(campaign.criteria if criteria is None else criteria)
@@ -151,37 +213,26 @@ def constant_frontier(campaign: Campaign, scn, limits: Mapping[str, Any],
     crush = limits.get("crush_force")
     hi = f_max if crush is None else min(float(crush), f_max)
     lo = max(f_min, opt["low_fraction"] * float(limits["min_static_force"]))
-    history: list[list[Any]] = []
-    out = {"force": None, "found": False, "low": lo, "high": hi, "evaluations": 0,
-           "history": history, "floor_passed": False, "error": None}
     shadow = types.SimpleNamespace(criteria=crit)
+    history: list[list[Any]] = []
 
     def passes(f: float) -> bool:
         _, m = _simulate(campaign, scn, cfg, "constant_force", {"force": f})
-        m = dict(m, crush_force=crush)
-        ok = all(_criteria(shadow, m).values())
+        ok = all(_criteria(shadow, dict(m, crush_force=crush)).values())
         history.append([float(f), bool(ok)])
         return ok
 
+    out = {"force": None, "found": False, "fail_above": None, "low": lo, "high": hi,
+           "evaluations": 0, "history": history, "floor_passed": False, "error": None}
     try:
-        if hi <= lo or not passes(hi):
-            return out
-        while hi / lo > 1.0 + opt["tolerance"] and len(history) < opt["max_evaluations"]:
-            mid = math.sqrt(lo * hi)
-            if passes(mid):
-                hi = mid
-            else:
-                lo = mid
-        if all(ok for _, ok in history) and passes(lo):
-            # every force tried passed, and so does the bottom assumed to fail
-            hi = lo
-            out["floor_passed"] = True
-        out.update(force=float(hi), found=True)
+        res = search_constant(passes, lo, hi, tolerance=opt["tolerance"],
+                              max_evaluations=opt["max_evaluations"])
+        out.update(force=res["force"], found=res["found"], fail_above=res["fail_above"],
+                   floor_passed=res["floor_passed"])
     except Exception as err:  # noqa: BLE001 (a rejected simulation is recorded, not raised)
         out["error"] = f"{type(err).__name__}: {str(err).splitlines()[0] if str(err) else ''}"
-        out["force"], out["found"] = None, False
-    finally:
-        out["evaluations"] = len(history)
+        out["force"], out["found"], out["fail_above"] = None, False, None
+    out["evaluations"] = len(history)
     return out
 
 
@@ -193,10 +244,10 @@ def run_one(campaign: Campaign, index: int) -> list[dict[str, Any]]:
     Every row also carries the run's ``set`` (tuning or evaluation), ``min_static_force`` and
     ``crush_force`` (:meth:`Campaign.run_limits`) and, with the campaign's ``frontier``, the
     run's smallest passing constant force (:func:`constant_frontier`: ``frontier_force``, None
-    when no constant passes, ``frontier_found``, ``frontier_low``, ``frontier_high``,
-    ``frontier_evaluations``, ``frontier_floor_passed``, ``frontier_history`` as JSON,
-    ``frontier_error``, ``frontier_elapsed_s``). A pure function of (campaign, index) but for
-    the times."""
+    when no constant passes, ``frontier_found``, ``frontier_fail_above``, ``frontier_low``,
+    ``frontier_high``, ``frontier_evaluations``, ``frontier_floor_passed``,
+    ``frontier_history`` as JSON, ``frontier_error``, ``frontier_elapsed_s``). A pure function
+    of (campaign, index) but for the times."""
     rows = []
     t0 = time.perf_counter()
     c0 = time.process_time()
@@ -229,6 +280,7 @@ def run_one(campaign: Campaign, index: int) -> list[dict[str, Any]]:
         run_cols.update(
             frontier_force=f.get("force"),
             frontier_found=bool(f.get("found", False)),
+            frontier_fail_above=f.get("fail_above"),
             frontier_low=f.get("low"),
             frontier_high=f.get("high"),
             frontier_evaluations=int(f.get("evaluations", 0)),
