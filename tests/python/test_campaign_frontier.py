@@ -69,7 +69,7 @@ def _cli(*args) -> int:
     return cli.main(list(map(str, args)))
 
 
-# --- the shipped files ---------------------------------------------------------------------------
+# --- the shipped files ----------------------------------------------------------------------------
 
 
 def test_new_campaign_files_load_with_their_options():
@@ -105,7 +105,7 @@ def test_worst_minimum_static_force_fits_the_stated_gripper_range():
     assert worst < c.base_scenario().controller["f_max"] == 40.0
 
 
-# --- fragile objects -------------------------------------------------------------------------------
+# --- fragile objects ------------------------------------------------------------------------------
 
 
 def test_min_static_force_is_the_true_contact_at_the_hanging_load():
@@ -314,7 +314,8 @@ def test_counted_pushes_are_reproducible_sized_and_at_random_phases():
         for k, q in enumerate(pushes):
             assert q["shape"] == "trapezoid"
             assert q["t_start"] == p[f"push_start_{k}"] >= end  # sorted, no overlap
-            assert math.hypot(*q["force"]) == pytest.approx(p[f"push_weight_fraction_{k}"] * m * 9.81)
+            f = p[f"push_weight_fraction_{k}"] * m * 9.81
+            assert math.hypot(*q["force"]) == pytest.approx(f)
             assert q["torque"] == pytest.approx(p[f"push_twist_fraction_{k}"] * tau_ref)
             assert q["edge"] == p[f"push_edge_{k}"]
             assert q["duration"] == pytest.approx(p[f"push_duration_{k}"] + 2 * q["edge"])
@@ -359,7 +360,7 @@ def test_original_single_push_unchanged():
     assert c.columns() == list(c.parameters)
 
 
-# --- refused definitions ---------------------------------------------------------------------------
+# --- refused definitions --------------------------------------------------------------------------
 
 
 @pytest.mark.parametrize(
@@ -411,7 +412,7 @@ def test_bad_definitions_refused_at_load_naming_the_field(tmp_path, capsys, chan
     assert not (tmp_path / "o").exists()
 
 
-# --- tuning and evaluation ---------------------------------------------------------------------------
+# --- tuning and evaluation ------------------------------------------------------------------------
 
 
 def test_evaluation_set_is_drawn_apart_and_labelled(tmp_path, capsys):

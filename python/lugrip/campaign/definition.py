@@ -676,7 +676,8 @@ class Campaign:
         push with the largest force (weight fraction, then force, then twist)."""
         names = [k for k in PUSH_PARAMETERS if k in self.parameters]
         raw = [
-            {name: self.parameters[name].draw(_stream(seed, index, f"{name}#{k}")) for name in names}
+            {name: self.parameters[name].draw(_stream(seed, index, f"{name}#{k}"))
+             for name in names}
             for k in range(n)
         ]
         base = self.base_scenario()
@@ -709,7 +710,8 @@ class Campaign:
         cols = list(self.parameters)
         if self.counted_pushes:
             names = [k for k in PUSH_PARAMETERS if k in self.parameters]
-            cols += [f"{name}_{k}" for k in range(self.max_pushes) for name in (*names, "push_start")]
+            cols += [f"{name}_{k}" for k in range(self.max_pushes)
+                     for name in (*names, "push_start")]
         return cols
 
     def run_scenario(self, index: int):
