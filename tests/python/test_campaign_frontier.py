@@ -485,3 +485,35 @@ def test_frontier_report_and_replay_of_a_fragile_run(tmp_path, capsys):
     rep = json.loads((out / "replay_1.json").read_text())
     stored = {r["controller"]: r["success"] for r in rows if r["run"] == 1}
     assert {k: v["success"] for k, v in rep["controllers"].items()} == stored
+
+
+# --- MuJoCo ---------------------------------------------------------------------------------------
+
+
+@pytest.mark.parametrize(("mass", "mu", "offset_x", "force"), [(0.03, 1.0, 0.0, 0.45),
+                                                                (0.6, 0.3, 0.006, 30.0)])
+def test_mujoco_plant_takes_the_campaign_mass_range(mass, mu, offset_x, force):
+    """MuJoCo's gripper (its own contact solver and compliant pads: an independent plant) with
+    the lightest and the heaviest object of the new campaigns: the scene works and a constant
+    force above the run's minimum static force (3.2x for 30 g at mu 1; 30 N, inside the raised
+    40 N f_max, for 0.6 kg at mu 0.3 with the CoG 6 mm off) holds it, pushes of 10 % of the
+    weight included."""
+    pytest.importorskip("mujoco")
+    path = ROOT / "campaigns" / "everyday_mujoco.yaml"
+    d = _doc(path)
+    d["duration"] = 5.0
+    d["steady_window"] = [2.0, 2.4]
+    d["overrides"]["plant"]["lift"] = {"t_start": 0.5, "duration": 1.0, "height": 0.05}
+    fixed = {"mass": mass, "mu": mu, "offset_x": offset_x, "offset_y": 0.0, "push_count": 1,
+             "push_time": 2.6, "push_duration": 0.1, "push_edge": 0.05,
+             "push_weight_fraction": 0.1, "push_twist_fraction": 0.1, "pad_k_slide": 4000.0,
+             "pad_k_twist": 2.0, "mismatch_mu": 0.0}
+    for k, v in fixed.items():
+        d["parameters"][k] = {"distribution": "constant", "value": v}
+    d["parameters"]["crush_factor"] = {"distribution": "constant", "value": 5.0}
+    d["controllers"] = {"constant_force": {"force": force}}
+    c = Campaign.from_dict(d, path)
+    (row,) = run_one(c, 0)
+    assert row["error"] is None and row["m_scene_status"] == "ok"
+    assert row["min_static_force"] < force < row["crush_force"]
+    assert row["success"], {k: v for k, v in row.items() if k.startswith(("pass_", "m_hold"))}
