@@ -163,9 +163,7 @@ def search_constant(passes: Callable[[float], bool], low: float, high: float, *,
                 break
             fail = f
             f /= scan
-        else:
-            return out
-        if out["fail_above"] is None:
+        else:  # no force in the scan passed
             return out
     lo = max([f for f, ok in history if not ok and f < hi], default=low)
     while hi / lo > 1.0 + tolerance and len(history) < max_evaluations:
