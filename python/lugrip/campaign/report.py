@@ -364,7 +364,7 @@ def frontier_figure(data: dict[str, Any]):
         ax.set_ylim(-0.03, 1.03)
         ax.set_xlabel(plot.axis_label("mean grip force", None, "N"))
         ax.set_ylabel("success rate")
-        ax.legend(fontsize=7, loc="lower right")
+        ax.legend(fontsize=7, loc="upper left", framealpha=0.85)
     return fig
 
 
