@@ -270,6 +270,13 @@ def test_frontier_summary_on_hand_made_rows():
     assert list(frontier_rate([r[0] for r in table], [r[1] for r in table], [0.5, 1.0, 2.0, 3.0])) \
         == [0.2, 0.4, 0.4, 0.4]
     assert fr["controllers"]["lugrip"]["constant_same_mean_force"] == 0.2
+    # paired: lugrip holds runs 0, 1, 2; the constant of 1.6 N holds run 4 only
+    assert fr["controllers"]["lugrip"]["paired_runs"] == 5
+    assert fr["controllers"]["lugrip"]["holds_constant_fails"] == 3
+    assert fr["controllers"]["lugrip"]["constant_holds_it_fails"] == 1
+    # paper holds run 4; the constant of 2 N holds runs 1 and 4
+    assert fr["controllers"]["paper"]["holds_constant_fails"] == 0
+    assert fr["controllers"]["paper"]["constant_holds_it_fails"] == 1
     assert fr["controllers"]["lugrip"]["minus_constant_same_mean_force"] == pytest.approx(0.4)
     assert fr["controllers"]["paper"]["constant_same_mean_force"] == 0.4
     assert fr["controllers"]["paper"]["minus_frontier_max"] == pytest.approx(-0.2)

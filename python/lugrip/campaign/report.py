@@ -109,7 +109,18 @@ def frontier_summary(rows: Sequence[dict], campaign: Campaign, summary: dict | N
     for c, s in (summary or {}).items():
         mf = s.get("mean_force")
         same = float(frontier_rate(fp, cr, mf, fa)[0]) if mf is not None else None
+        # paired, run by run: the controller against the constant of its own mean force
+        held = {int(r["run"]): bool(r["success"]) for r in rows if r["controller"] == c}
+        const = {} if mf is None else {
+            int(r["run"]): bool(frontier_rate([r.get("frontier_force")], [r.get("crush_force")],
+                                              mf, [r.get("frontier_fail_above")])[0])
+            for r in runs
+        }
+        both = sorted(set(held) & set(const))
         points[c] = {
+            "paired_runs": len(both),
+            "holds_constant_fails": sum(held[i] and not const[i] for i in both),
+            "constant_holds_it_fails": sum(const[i] and not held[i] for i in both),
             "success_rate": s.get("success_rate"),
             "wilson95": s.get("wilson95"),
             "mean_force": mf,
@@ -417,8 +428,9 @@ def markdown(data: dict[str, Any], figure: str | None = None,
             f"fact) at F = {_fmt(fr['max_force'])} N.",
             "",
             "| controller | success | 95 % interval | mean force [N] | constant of the same "
-            "mean force | difference | minus frontier max |",
-            "|---|---:|---|---:|---:|---:|---:|",
+            "mean force | difference | it holds, that constant fails | that constant holds, it "
+            "fails | minus frontier max |",
+            "|---|---:|---|---:|---:|---:|---:|---:|---:|",
         ]
         chk = fr.get("constant_force_check")
         if chk:
@@ -435,6 +447,8 @@ def markdown(data: dict[str, Any], figure: str | None = None,
                 f"| {c} | {_fmt(pt['success_rate'])} | [{w[0]:.3f}, {w[1]:.3f}] | "
                 f"{_fmt(pt['mean_force'])} | {_fmt(pt['constant_same_mean_force'])} | "
                 f"{_fmt(pt['minus_constant_same_mean_force'])} | "
+                f"{pt.get('holds_constant_fails', '-')} | "
+                f"{pt.get('constant_holds_it_fails', '-')} | "
                 f"{_fmt(pt['minus_frontier_max'])} |"
             )
     if data["paired_with_lugrip"]:
