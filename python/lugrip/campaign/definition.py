@@ -21,11 +21,40 @@ A campaign file (``campaigns/<name>.yaml``)::
     parameters:                        # any of PARAMETERS, each with one distribution
       mass: {distribution: uniform, low: 0.1, high: 0.4}
       mismatch_mu: {distribution: normal, mean: 0.0, std: 0.1, low: -0.5, high: 0.5}
+      crush_factor: {distribution: uniform, low: 1.5, high: 5.0}   # fragile objects
+      push_count: {distribution: choice, values: [1, 2, 3]}         # randomized pushes
+    evaluation_seed: 20271201          # optional: the seed of the evaluation set (--evaluation)
+    frontier: true                     # optional: per run, the smallest passing constant force
+    gripper: {f_max: 40.0}             # optional: the gripper's range on top of the scenario's
+    twist_lever: 0.005                 # [m] optional: lever of the twist reference (below)
 
 Run ``i`` draws every parameter from its own random stream seeded by (seed, i, parameter name),
 so a run is reproducible from (campaign, run index) alone, whatever ran before it, on whichever
 worker; adding a parameter does not change the draws of the others. The plant's noise seed is
 drawn the same way, and every controller of a run sees the same plant and the same noise.
+
+Tuning and evaluation: ``seed`` draws the tuning set; ``evaluation_seed`` (when given) draws the
+evaluation set, which a campaign run with ``set="evaluation"`` (``lugrip campaign
+--evaluation``) uses instead. The two sets are the same distributions with independent draws.
+
+Pushes: without any of PUSH_NEW, the ``push_*`` parameters describe one half-sine push (the
+original form). With ``push_count`` (or any other of PUSH_NEW) every ``push_*`` parameter is
+drawn once per push, push ``k`` from its own stream named ``<parameter>#<k>``; the pushes are
+sorted by their drawn ``push_time``, each starts no earlier than the end of the one before, and
+with ``push_phase`` the start is moved to that fraction of the 50 Hz command period after the
+next command instant (the grid of ``plant.actuator.command_rate`` from t = 0). A push's force is
+``push_force`` + ``push_weight_fraction`` m g along ``push_angle``; its torque ``push_torque`` +
+``push_twist_fraction`` m g max(|offset_x|, twist_lever) (a fraction of the gravity torque about
+the grasp point, or of m g times the lever when the CoG lies near the grasp point). With
+``push_edge`` a push is a trapezoid (rise and fall over the edge, flat for ``push_duration`` in
+between), else a half-sine of length ``push_duration``.
+
+Fragile objects: with ``crush_factor`` drawn, a run's crush force is crush_factor times its
+minimum static force, the per-finger static grasp force at S = 1 of the plant's TRUE contact
+(the drawn mu, not the controller's belief) for the load each finger carries while the object
+hangs still: half its weight and half the gravity torque m g |offset_x| about the grasp point
+(:meth:`Campaign.run_limits`). The criterion ``no_crush`` (on by default then) fails a run whose
+command exceeds the crush force at any time.
 """
 
 from __future__ import annotations
@@ -47,7 +76,9 @@ __all__ = [
     "CONTROLLERS",
     "CRITERIA",
     "DISTRIBUTIONS",
+    "FRONTIER_DEFAULTS",
     "PARAMETERS",
+    "SETS",
     "Campaign",
     "CampaignError",
     "Distribution",
@@ -61,6 +92,8 @@ class _Param:
     lower: float | None  # None: unbounded below
     strict: bool  # lower bound excluded (> instead of >=)
     meaning: str
+    upper: float | None = None  # None: unbounded above; else the support must stay <= upper
+    integer: bool = False  # only integer values (choice or constant)
 
 
 #: Parameters a campaign may draw: unit, lower bound of the support and meaning.
@@ -87,7 +120,23 @@ PARAMETERS: dict[str, _Param] = {
     "push_angle": _Param("deg", None, False, "direction of the push from +x (-90: down)"),
     "push_torque": _Param("N m", None, False, "pure torque of the push"),
     "push_time": _Param("s", 0.0, False, "start of the push"),
-    "push_duration": _Param("s", 0.0, True, "length of the (half-sine) push"),
+    "push_duration": _Param(
+        "s", 0.0, True,
+        "length of the half-sine push, or of the trapezoid's flat top (with push_edge)",
+    ),
+    "push_count": _Param("-", 1.0, False, "number of pushes per run", integer=True),
+    "push_phase": _Param(
+        "-", 0.0, False, "push start as a fraction of the command period after a command instant",
+        upper=1.0,
+    ),
+    "push_weight_fraction": _Param("-", 0.0, False, "push force as a fraction of m g"),
+    "push_twist_fraction": _Param(
+        "-", None, False, "push torque as a fraction of m g max(|offset_x|, twist_lever)"
+    ),
+    "push_edge": _Param("s", 0.0, True, "rise and fall time of a trapezoid push"),
+    "crush_factor": _Param(
+        "-", 1.0, True, "crush force over the run's minimum static force (fragile objects)"
+    ),
     "force_noise": _Param("N", 0.0, False, "white noise std of the force sensors"),
     "torque_noise": _Param("N m", 0.0, False, "white noise std of the torque sensors"),
     "normal_bias": _Param("N", None, False, "offset of both fingers' normal force"),
@@ -101,6 +150,11 @@ for _f in MISMATCH_FIELDS:
     PARAMETERS[f"mismatch_{_f}"] = _Param(
         "-", -1.0, True, f"relative error of the controller's {_f} against the plant's"
     )
+
+#: The push parameters (drawn once per push when pushes are counted, see the module docstring).
+PUSH_PARAMETERS = tuple(k for k in PARAMETERS if k.startswith("push_") and k != "push_count")
+#: Their presence selects the counted pushes (without them: the original single half-sine push).
+PUSH_NEW = ("push_count", "push_phase", "push_weight_fraction", "push_twist_fraction", "push_edge")
 
 #: Distributions and their fields (required, optional).
 DISTRIBUTIONS: dict[str, tuple[tuple[str, ...], tuple[str, ...]]] = {
@@ -136,6 +190,10 @@ CRITERIA = {
     "max_hold_slip_mm": "max translational slip from the lift start on [mm] <= limit",
     "max_hold_rotation_deg": "max rotation from the lift start on [deg] <= limit",
     "scene_ok": "MuJoCo plant: both pads reached the object and kept contact",
+    "no_crush": (
+        "the command never exceeds the run's crush force (from t = 0; default true when "
+        "crush_factor is drawn)"
+    ),
 }
 _DEFAULT_CRITERIA = {
     "no_drop": True,
@@ -148,7 +206,18 @@ _DEFAULT_CRITERIA = {
 _KEYS = {
     "name", "description", "scenario", "plant", "seed", "duration", "steady_window",
     "hold_start", "overrides", "controllers", "criteria", "parameters",
+    "evaluation_seed", "set", "frontier", "gripper", "twist_lever",
 }
+#: Result sets: which seed draws the runs.
+SETS = ("tuning", "evaluation")
+#: Options of the constant-force frontier (``frontier:``) and their defaults.
+FRONTIER_DEFAULTS = {
+    "tolerance": 0.02,  # relative width of the final bracket
+    "max_evaluations": 12,  # constant-force simulations per run at most
+    "low_fraction": 0.5,  # bottom of the bracket: this times the minimum static force
+}
+#: The gripper's range a campaign may set on top of the scenario's controller block.
+GRIPPER_KEYS = ("f_min", "f_max", "max_rate_up", "max_rate_down")
 
 
 class CampaignError(ValueError):
@@ -241,9 +310,25 @@ class Distribution:
                     f"{where}: [low, high] lies more than 3 std from the mean (almost no mass)"
                 )
         p = PARAMETERS[name]
+        lo, hi = self.support()
+        if p.integer:
+            vals = a["values"] if self.kind == "choice" else [a.get("value")]
+            if self.kind not in ("choice", "constant") or any(v != int(v) for v in vals):
+                raise CampaignError(
+                    f"{where}: {name} takes whole numbers: use distribution choice or constant "
+                    "with integer values"
+                )
+        if p.upper is not None and hi > p.upper:
+            field = "high" if self.kind in ("uniform", "loguniform", "normal") else (
+                "values" if self.kind == "choice" else "value"
+            )
+            what = f"can be {hi:g}" if math.isfinite(hi) else "is unbounded above (set high)"
+            raise CampaignError(
+                f"{where}.{field}: {name} must be <= {p.upper:g} [{p.unit}], but the "
+                f"distribution {what}"
+            )
         if p.lower is None:
             return
-        lo, _ = self.support()
         bad = lo <= p.lower if p.strict else lo < p.lower
         if bad:
             rel = ">" if p.strict else ">="
@@ -297,6 +382,42 @@ class Campaign:
     scenario_overrides: dict
     description: str = ""
     source: Path | None = None
+    evaluation_seed: int | None = None
+    result_set: str = "tuning"  # which seed draws the runs (SETS)
+    frontier: dict | None = None  # FRONTIER_DEFAULTS filled in, or None: no frontier
+    gripper: dict = dataclasses.field(default_factory=dict)  # GRIPPER_KEYS on the scenario's
+    twist_lever: float = 0.005  # [m] the twist reference's smallest lever
+
+    @property
+    def draw_seed(self) -> int:
+        """The seed the runs are drawn with: ``seed`` (tuning) or ``evaluation_seed``."""
+        if self.result_set == "evaluation":
+            assert self.evaluation_seed is not None
+            return self.evaluation_seed
+        return self.seed
+
+    def for_set(self, name: str) -> Campaign:
+        """The same campaign drawing the tuning or the evaluation set (``name`` in SETS)."""
+        if name not in SETS:
+            raise CampaignError(f"set {name!r}: expected one of {', '.join(SETS)}")
+        if name == "evaluation" and self.evaluation_seed is None:
+            raise CampaignError(
+                "evaluation_seed: missing (the campaign has no evaluation set; add "
+                "evaluation_seed: <integer> to the campaign file)"
+            )
+        return dataclasses.replace(self, result_set=name)
+
+    @property
+    def counted_pushes(self) -> bool:
+        """The pushes are counted (drawn once per push; see the module docstring)."""
+        return any(k in self.parameters for k in PUSH_NEW)
+
+    @property
+    def max_pushes(self) -> int:
+        if not self.counted_pushes:
+            return 1 if any(k in self.parameters for k in ("push_force", "push_torque")) else 0
+        d = self.parameters.get("push_count")
+        return int(d.support()[1]) if d is not None else 1
 
     @classmethod
     def from_dict(cls, data: Any, source: Path | None = None) -> Campaign:
@@ -356,6 +477,8 @@ class Campaign:
         if pads and plant != "mujoco":
             raise CampaignError(f"parameters.{pads[0]}: only for plant mujoco (MuJoCo's pads)")
         crit = dict(_DEFAULT_CRITERIA)
+        if "crush_factor" in parameters:
+            crit["no_crush"] = True
         given = data.get("criteria") or {}
         if not isinstance(given, Mapping):
             raise CampaignError("criteria: expected a mapping")
@@ -370,8 +493,40 @@ class Campaign:
             elif not isinstance(v, bool):
                 raise CampaignError(f"criteria.{k}: expected true or false")
         crit.update(given)
+        if crit.get("no_crush") and "crush_factor" not in parameters:
+            raise CampaignError(
+                "criteria.no_crush: needs a crush force per run (draw parameters.crush_factor)"
+            )
         if plant == "mujoco":
             crit.setdefault("scene_ok", True)
+        eval_seed = data.get("evaluation_seed")
+        if eval_seed is not None and (
+            isinstance(eval_seed, bool) or not isinstance(eval_seed, int) or eval_seed < 0
+        ):
+            raise CampaignError(f"evaluation_seed: {eval_seed!r} must be an integer >= 0")
+        if eval_seed is not None and eval_seed == seed:
+            raise CampaignError("evaluation_seed: must differ from seed (the tuning set's)")
+        result_set = str(data.get("set", "tuning"))
+        if result_set not in SETS:
+            raise CampaignError(f"set: {result_set!r}: expected one of {', '.join(SETS)}")
+        if result_set == "evaluation" and eval_seed is None:
+            raise CampaignError("set: evaluation needs evaluation_seed")
+        frontier = cls._frontier(data.get("frontier", False))
+        gripper = data.get("gripper") or {}
+        if not isinstance(gripper, Mapping):
+            raise CampaignError(f"gripper: expected a mapping of {', '.join(GRIPPER_KEYS)}")
+        bad = sorted(set(gripper) - set(GRIPPER_KEYS))
+        if bad:
+            raise CampaignError(
+                f"gripper.{bad[0]}: unknown; expected any of {', '.join(GRIPPER_KEYS)}"
+            )
+        gripper = {str(k): _num(v, f"gripper.{k}") for k, v in gripper.items()}
+        for k, v in gripper.items():
+            if v <= 0.0:
+                raise CampaignError(f"gripper.{k}: must be > 0, got {v:g}")
+        lever = _num(data.get("twist_lever", 0.005), "twist_lever")
+        if lever <= 0.0:
+            raise CampaignError(f"twist_lever: must be > 0 [m], got {lever:g}")
         over = dict(data.get("overrides") or {})
         for key in ("duration", "steady_window", "hold_start"):
             if key in data:
@@ -390,9 +545,62 @@ class Campaign:
             scenario_overrides=over,
             description=str(data.get("description") or "").strip(),
             source=source,
+            evaluation_seed=None if eval_seed is None else int(eval_seed),
+            result_set=result_set,
+            frontier=frontier,
+            gripper=gripper,
+            twist_lever=lever,
         )
-        c.base_scenario()  # the base scenario exists and the overrides are valid
+        base = c.base_scenario()  # the base scenario exists and the overrides are valid
+        c._check_pushes(base)
         return c
+
+    @staticmethod
+    def _frontier(value: Any) -> dict | None:
+        if value is False or value is None:
+            return None
+        if value is True:
+            return dict(FRONTIER_DEFAULTS)
+        if not isinstance(value, Mapping):
+            raise CampaignError("frontier: expected true, false or a mapping of options")
+        bad = sorted(set(value) - set(FRONTIER_DEFAULTS))
+        if bad:
+            raise CampaignError(
+                f"frontier.{bad[0]}: unknown option; expected any of {', '.join(FRONTIER_DEFAULTS)}"
+            )
+        out = dict(FRONTIER_DEFAULTS)
+        for k, v in value.items():
+            out[k] = _num(v, f"frontier.{k}")
+        if not 0.0 < out["tolerance"] < 1.0:
+            raise CampaignError("frontier.tolerance: must lie in (0, 1)")
+        if not 0.0 < out["low_fraction"] < 1.0:
+            raise CampaignError("frontier.low_fraction: must lie in (0, 1)")
+        if out["max_evaluations"] < 2 or out["max_evaluations"] != int(out["max_evaluations"]):
+            raise CampaignError("frontier.max_evaluations: must be an integer >= 2")
+        out["max_evaluations"] = int(out["max_evaluations"])
+        return out
+
+    def _check_pushes(self, base) -> None:
+        """Counted pushes must end inside the scenario, even all drawn at their latest."""
+        if not self.counted_pushes:
+            return
+        par = self.parameters
+        t_last = par["push_time"].support()[1] if "push_time" in par else 0.5 * base.duration
+        dur = par["push_duration"].support()[1] if "push_duration" in par else 0.3
+        edge = par["push_edge"].support()[1] if "push_edge" in par else 0.0
+        period = 1.0 / self._command_rate(base.to_dict())
+        end = t_last + self.max_pushes * (dur + 2.0 * edge + period)
+        if end > base.duration:
+            raise CampaignError(
+                f"parameters.push_time: {self.max_pushes} push(es) starting as late as "
+                f"{t_last:g} s and lasting up to {dur + 2.0 * edge:g} s each may end at "
+                f"{end:g} s, after the scenario's end ({base.duration:g} s): shorten them or "
+                "lengthen duration"
+            )
+
+    @staticmethod
+    def _command_rate(d: Mapping) -> float:
+        return float(((d.get("plant") or {}).get("actuator") or {}).get("command_rate", 50.0))
 
     # --- the base scenario and one run's scenario ----------------------------------------
     def _scenario_path(self) -> str | Path:
@@ -429,6 +637,14 @@ class Campaign:
             raise CampaignError(f"scenario: {err}") from None
         d = _merge(base.to_dict(), self.scenario_overrides)
         d["short"] = {}
+        if self.gripper:
+            d["controller"] = dict(d.get("controller") or {}) | self.gripper
+            if "f_max" in self.gripper:  # the actuator saturates no lower than the range
+                plant = dict(d["plant"])
+                act = dict(plant.get("actuator") or {})
+                act["f_max"] = max(float(act.get("f_max", 80.0)), self.gripper["f_max"])
+                plant["actuator"] = act
+                d["plant"] = plant
         try:
             scn = Scenario.from_dict(d, base.source)
         except ValueError as err:
@@ -440,9 +656,63 @@ class Campaign:
         """The drawn parameters of run `index` (name -> value) and ``plant_seed``."""
         if isinstance(index, bool) or int(index) != index or index < 0:
             raise ValueError(f"run index {index!r}: must be an integer >= 0")
-        out = {name: d.draw(_stream(self.seed, index, name)) for name, d in self.parameters.items()}
-        out["plant_seed"] = int(_stream(self.seed, index, "plant_seed").integers(2**31 - 1))
+        seed = self.draw_seed
+        counted = self.counted_pushes
+        out: dict[str, Any] = {
+            name: d.draw(_stream(seed, index, name))
+            for name, d in self.parameters.items()
+            if not (counted and name in PUSH_PARAMETERS)
+        }
+        if counted:
+            out.update(self._draw_pushes(seed, index, int(out.get("push_count", 1))))
+        out["plant_seed"] = int(_stream(seed, index, "plant_seed").integers(2**31 - 1))
         return out
+
+    def _draw_pushes(self, seed: int, index: int, n: int) -> dict[str, Any]:
+        """Counted pushes: push k's parameters from the streams ``<name>#<k>``, sorted by time,
+        started no earlier than the previous push's end and, with push_phase, at that fraction
+        of the command period after the next command instant. Returns ``<name>_<k>`` and
+        ``push_start_<k>`` for k < max_pushes (None beyond n) and ``<name>``: the value of the
+        push with the largest force (weight fraction, then force, then twist)."""
+        names = [k for k in PUSH_PARAMETERS if k in self.parameters]
+        raw = [
+            {name: self.parameters[name].draw(_stream(seed, index, f"{name}#{k}"))
+             for name in names}
+            for k in range(n)
+        ]
+        base = self.base_scenario()
+        t_default = 0.5 * float(base.duration)
+        raw.sort(key=lambda q: q.get("push_time", t_default))
+        period = 1.0 / self._command_rate(base.to_dict())
+        prev_end = -math.inf
+        for q in raw:
+            t = max(q.get("push_time", t_default), prev_end)
+            if "push_phase" in q:
+                t = (math.ceil(t / period - 1e-9) + q["push_phase"]) * period
+            q["push_start"] = t
+            prev_end = t + q.get("push_duration", 0.3) + 2.0 * q.get("push_edge", 0.0)
+        out: dict[str, Any] = {}
+        for k in range(self.max_pushes):
+            for name in (*names, "push_start"):
+                out[f"{name}_{k}"] = raw[k][name] if k < n else None
+        if n:
+            def size(q):
+                return (q.get("push_weight_fraction", 0.0), q.get("push_force", 0.0),
+                        abs(q.get("push_twist_fraction", 0.0)))
+
+            big = max(range(n), key=lambda k: size(raw[k]))
+            out.update({name: raw[big][name] for name in names})
+        return out
+
+    def columns(self) -> list[str]:
+        """The drawn values a result row carries as ``p_<column>`` (every parameter, and with
+        counted pushes each push's values and start)."""
+        cols = list(self.parameters)
+        if self.counted_pushes:
+            names = [k for k in PUSH_PARAMETERS if k in self.parameters]
+            cols += [f"{name}_{k}" for k in range(self.max_pushes)
+                     for name in (*names, "push_start")]
+        return cols
 
     def run_scenario(self, index: int):
         """(scenario, drawn parameters) of run `index`: the base scenario with the draws
@@ -496,7 +766,31 @@ class Campaign:
             ]
             sensor["bias"] = [row, row]
         plant["sensor"] = sensor
-        if "push_force" in p or "push_torque" in p:
+        if self.counted_pushes:
+            g = float(plant.get("gravity", 9.81))
+            tau_ref = mass * g * max(abs(cog[0]), self.twist_lever)
+            pushes = []
+            for k in range(int(p.get("push_count", 1))):
+                def v(name, default, k=k):
+                    x = p.get(f"{name}_{k}")
+                    return default if x is None else x
+
+                f = v("push_force", 0.0) + v("push_weight_fraction", 0.0) * mass * g
+                ang = math.radians(v("push_angle", -90.0))
+                push = {
+                    "t_start": p[f"push_start_{k}"],
+                    "force": [f * math.cos(ang), f * math.sin(ang)],
+                    "torque": v("push_torque", 0.0) + v("push_twist_fraction", 0.0) * tau_ref,
+                }
+                edge = p.get(f"push_edge_{k}")
+                if edge is not None:
+                    push.update(shape="trapezoid", edge=edge,
+                                duration=v("push_duration", 0.3) + 2.0 * edge)
+                else:
+                    push.update(shape="half_sine", duration=v("push_duration", 0.3))
+                pushes.append(push)
+            plant["disturbances"] = [*list(plant.get("disturbances") or []), *pushes]
+        elif "push_force" in p or "push_torque" in p:
             ang = math.radians(p.get("push_angle", -90.0))
             f = p.get("push_force", 0.0)
             push = {
@@ -543,6 +837,25 @@ class Campaign:
             est = est.replace(mu=plant_contact.mu)
         return est.replace(**{k: getattr(est, k) * (1.0 + e) for k, e in mism.items()}).to_dict()
 
+    def run_limits(self, scenario, params: Mapping[str, Any]) -> dict[str, float | None]:
+        """``min_static_force``: the per-finger static grasp force at S = 1 [N] of the plant's
+        TRUE contact (drawn mu; for MuJoCo the contact the scene is built from) for the steady
+        hanging load of each finger, half the weight and half the gravity torque m g |cog_x|
+        about the grasp point; ``crush_force`` [N]: crush_factor times it (None when
+        crush_factor is not drawn). `scenario`, `params`: a run's scenario and draws
+        (:meth:`run_scenario`)."""
+        from .._controller import static_grasp_force
+
+        cfg = scenario.plant_config(self.plant)
+        obj = cfg.object
+        g = float(cfg.gravity)
+        f_t = 0.5 * obj.mass * g
+        tau = 0.5 * obj.mass * g * abs(float(obj.cog[0]))
+        f_min = float(static_grasp_force(cfg.contact, f_t, tau, s_ref=1.0))
+        factor = params.get("crush_factor")
+        crush = None if factor is None else float(factor) * f_min
+        return {"min_static_force": f_min, "crush_force": crush}
+
     # --- identity ---------------------------------------------------------------------------
     def to_dict(self) -> dict:
         return {
@@ -558,6 +871,13 @@ class Campaign:
             "criteria": dict(self.criteria),
             "parameters": {k: v.to_dict() for k, v in self.parameters.items()},
             "overrides": copy.deepcopy(self.scenario_overrides),
+            # the later keys only when used: older campaigns keep their fingerprint
+            **({"evaluation_seed": self.evaluation_seed} if self.evaluation_seed is not None
+               else {}),
+            **({"set": self.result_set} if self.result_set != "tuning" else {}),
+            **({"frontier": dict(self.frontier)} if self.frontier is not None else {}),
+            **({"gripper": dict(self.gripper)} if self.gripper else {}),
+            **({"twist_lever": self.twist_lever} if self.twist_lever != 0.005 else {}),
         }
 
     def portable(self) -> dict:

@@ -45,9 +45,11 @@ def replay(directory: str | Path, index: int, *, controllers=None, out: str | Pa
     out_dir.mkdir(parents=True, exist_ok=True)
     stored = {r["controller"]: r for r in ResultStore(directory, campaign).rows()
               if int(r["run"]) == index}
-    doc: dict[str, Any] = {"run": index, "parameters": params, "controllers": {}}
+    limits = campaign.run_limits(scn, params)
+    doc: dict[str, Any] = {"run": index, "parameters": params, "limits": limits,
+                           "controllers": {}}
     for name, (_, m) in runs.items():
-        crit = _criteria(campaign, m)
+        crit = _criteria(campaign, dict(m, crush_force=limits["crush_force"]))
         row = stored.get(name)
         same = None
         if row is not None:

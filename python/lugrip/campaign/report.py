@@ -1,8 +1,9 @@
 """Campaign report: success rate per controller with Wilson intervals, paired comparison with
-lugrip, failure maps (success and mean force against each drawn parameter), the worst runs with
-the command that replays each one.
+lugrip, the constant-force frontier (campaigns with ``frontier``), failure maps (success and
+mean force against each drawn parameter), the worst runs with the command that replays each one.
 
-Writes DIR/report.md, DIR/report.json and DIR/failure_map.png.
+Writes DIR/report.md, DIR/report.json, DIR/failure_map.png and, with the frontier,
+DIR/frontier.png.
 """
 
 from __future__ import annotations
@@ -17,7 +18,7 @@ import numpy as np
 
 from .definition import PARAMETERS, Campaign
 
-__all__ = ["summarise", "wilson", "write_report"]
+__all__ = ["frontier_rate", "frontier_summary", "summarise", "wilson", "write_report"]
 
 
 def wilson(successes: int, n: int, z: float = 1.959964) -> tuple[float, float]:
@@ -29,6 +30,128 @@ def wilson(successes: int, n: int, z: float = 1.959964) -> tuple[float, float]:
     centre = (p + z * z / (2 * n)) / den
     half = z * math.sqrt(p * (1.0 - p) / n + z * z / (4 * n * n)) / den
     return max(0.0, centre - half), min(1.0, centre + half)
+
+
+def frontier_rate(f_pass: Sequence[float | None], crush: Sequence[float | None],
+                  forces: Sequence[float] | float,
+                  fail_above: Sequence[float | None] | None = None) -> np.ndarray:
+    """Success rate of a constant force F over the runs, for each F in `forces`: the fraction
+    of runs with f_pass <= F <= crush and F < fail_above (f_pass: the run's smallest passing
+    constant, None when none passes; crush: its crush force, None for no limit; fail_above: a
+    larger force found to fail, None when none was). Success of a constant is taken as monotone
+    in the force between f_pass and the first of those limits (runner.constant_frontier)."""
+    n = len(f_pass)
+    fp = np.array([math.inf if v is None else float(v) for v in f_pass], dtype=float)
+    cr = np.array([math.inf if v is None else float(v) for v in crush], dtype=float)
+    fa = np.array([math.inf if v is None else float(v) for v in (fail_above or [None] * n)],
+                  dtype=float)
+    f = np.atleast_1d(np.asarray(forces, dtype=float))
+    if n == 0:
+        return np.full(f.shape, np.nan)
+    ok = (fp[None, :] <= f[:, None]) & (f[:, None] <= cr[None, :]) & (f[:, None] < fa[None, :])
+    return ok.sum(axis=1) / n
+
+
+def _run_rows(rows: Sequence[dict]) -> list[dict]:
+    """One row per run (the run-level columns are the same on each of its rows)."""
+    seen: dict[int, dict] = {}
+    for r in rows:
+        seen.setdefault(int(r["run"]), r)
+    return [seen[k] for k in sorted(seen)]
+
+
+def frontier_summary(rows: Sequence[dict], campaign: Campaign, summary: dict | None = None,
+                     n_grid: int = 200) -> dict[str, Any] | None:
+    """The constant-force frontier of stored rows: its curve (success rate against force on a
+    grid and at every run's smallest passing constant), its maximum and where, and for each
+    controller its success rate (Wilson 95 %), mean force, the success rate of the constant of
+    the same mean force and the difference. None without frontier columns."""
+    runs = _run_rows(rows)
+    if not runs or "frontier_force" not in runs[0]:
+        return None
+    n = len(runs)
+    fp = [r.get("frontier_force") for r in runs]
+    cr = [r.get("crush_force") for r in runs]
+    fa = [r.get("frontier_fail_above") for r in runs]
+    from .._controller import controller_settings
+
+    f_max = float(campaign.base_scenario().controller.get("f_max", controller_settings()["f_max"]))
+    passing = sorted(float(v) for v, c in zip(fp, cr) if v is not None and (c is None or v <= c))
+    out: dict[str, Any] = {
+        "runs": n,
+        "f_max": f_max,
+        "no_constant_passes": sum(v is None for v in fp),
+        # a force above the smallest passing one failed: success is not monotone there
+        "non_monotone": sum(v is not None for v in fa),
+        "floor_passed": sum(bool(r.get("frontier_floor_passed")) for r in runs),
+        "errors": sum(bool(r.get("frontier_error")) for r in runs),
+        "evaluations_mean": float(np.mean([r.get("frontier_evaluations") or 0 for r in runs])),
+    }
+    if passing:
+        at = np.asarray(passing)
+        rates = frontier_rate(fp, cr, at, fa)
+        k = int(np.argmax(rates))  # the smallest force reaching the maximum
+        best = int(round(rates[k] * n))
+        lo_grid = max(min(passing) / 1.5, 1e-3)
+        grid = np.unique(np.concatenate([np.geomspace(lo_grid, f_max, n_grid), at]))
+        out.update(
+            max_rate=float(rates[k]),
+            max_successes=best,
+            max_force=float(at[k]),
+            # selected after the fact: the interval is optimistic for the best constant
+            max_wilson95=list(wilson(best, n)),
+            curve={"force": grid.tolist(), "rate": frontier_rate(fp, cr, grid, fa).tolist()},
+        )
+    else:
+        out.update(max_rate=0.0, max_successes=0, max_force=None, max_wilson95=list(wilson(0, n)),
+                   curve={"force": [], "rate": []})
+    points = {}
+    for c, s in (summary or {}).items():
+        mf = s.get("mean_force")
+        same = float(frontier_rate(fp, cr, mf, fa)[0]) if mf is not None else None
+        # paired, run by run: the controller against the constant of its own mean force
+        held = {int(r["run"]): bool(r["success"]) for r in rows if r["controller"] == c}
+        const = {} if mf is None else {
+            int(r["run"]): bool(frontier_rate([r.get("frontier_force")], [r.get("crush_force")],
+                                              mf, [r.get("frontier_fail_above")])[0])
+            for r in runs
+        }
+        both = sorted(set(held) & set(const))
+        points[c] = {
+            "paired_runs": len(both),
+            "holds_constant_fails": sum(held[i] and not const[i] for i in both),
+            "constant_holds_it_fails": sum(const[i] and not held[i] for i in both),
+            "success_rate": s.get("success_rate"),
+            "wilson95": s.get("wilson95"),
+            "mean_force": mf,
+            "constant_same_mean_force": same,
+            "minus_constant_same_mean_force": (
+                s["success_rate"] - same if same is not None and s.get("success_rate") is not None
+                else None
+            ),
+            "minus_frontier_max": (
+                s["success_rate"] - out["max_rate"] if s.get("success_rate") is not None else None
+            ),
+        }
+    out["controllers"] = points
+    # the simulated constant_force controller against the frontier's verdict for its force,
+    # run by run: a direct check of the monotonicity the frontier assumes
+    if "constant_force" in campaign.controllers:
+        force = float(campaign.controllers["constant_force"]["force"])
+        sim = {int(r["run"]): bool(r["success"]) for r in rows
+               if r["controller"] == "constant_force"}
+        verdict = {int(r["run"]): bool(frontier_rate([r.get("frontier_force")],
+                                                     [r.get("crush_force")], force,
+                                                     [r.get("frontier_fail_above")])[0])
+                   for r in runs if not r.get("frontier_error")}
+        both = sorted(set(sim) & set(verdict))
+        out["constant_force_check"] = {
+            "force": force,
+            "runs": len(both),
+            "agree": sum(sim[i] == verdict[i] for i in both),
+            "disagree_runs": [i for i in both if sim[i] != verdict[i]],
+        }
+    return out
 
 
 def _severity(row: dict, campaign: Campaign) -> float:
@@ -65,6 +188,10 @@ def summarise(rows: Sequence[dict], campaign: Campaign, *, out_dir: str | Path |
         lo, hi = wilson(ok, len(rr))
         forces = [r["m_mean_force"] for r in rr if r.get("m_mean_force") is not None]
         held = [r["m_mean_force"] for r in rr if r["success"] and r.get("m_mean_force") is not None]
+        over_min = [
+            r["m_mean_force"] / r["min_static_force"] for r in rr
+            if r["success"] and r.get("m_mean_force") is not None and r.get("min_static_force")
+        ]
         fails: dict[str, int] = {}
         for r in rr:
             for k in campaign.criteria:
@@ -77,6 +204,9 @@ def summarise(rows: Sequence[dict], campaign: Campaign, *, out_dir: str | Path |
             "wilson95": [lo, hi],
             "mean_force": float(np.mean(forces)) if forces else None,
             "mean_force_successes": float(np.mean(held)) if held else None,
+            # mean over the held runs of (the run's mean force / its minimum static force)
+            "mean_force_over_min_static": float(np.mean(over_min)) if over_min else None,
+            "crushed": sum(1 for r in rr if r.get("pass_no_crush") is False),
             "errors": sum(1 for r in rr if r.get("error")),
             "failed_criteria": fails,
         }
@@ -145,8 +275,12 @@ def summarise(rows: Sequence[dict], campaign: Campaign, *, out_dir: str | Path |
     return {
         "campaign": campaign.name,
         "plant": campaign.plant,
-        "seed": campaign.seed,
+        "set": campaign.result_set,
+        "seed": campaign.draw_seed,
+        "tuning_seed": campaign.seed,
+        "evaluation_seed": campaign.evaluation_seed,
         "runs": len(runs),
+        "frontier": frontier_summary(rows, campaign, summary) if campaign.frontier else None,
         "criteria": campaign.criteria,
         "summary": summary,
         "paired_with_lugrip": paired,
@@ -210,23 +344,113 @@ def failure_map_figure(data: dict[str, Any]):
     return fig
 
 
-def markdown(data: dict[str, Any], figure: str | None = None) -> str:
+def frontier_figure(data: dict[str, Any]):
+    """Success rate against mean grip force: the constant-force frontier as a step curve, each
+    controller as a point with its 95 % Wilson interval."""
+    from .. import plot
+
+    fr = data.get("frontier")
+    if not fr:
+        return None
+    with plot.style():
+        fig, axes = plot.new_figure(
+            1, 1, col_width=6.0, row_height=3.8, squeeze=False,
+            title=f"{data['campaign']} ({data['plant']}, {data.get('set', 'tuning')} set, "
+            f"{data['runs']} runs)\nsuccess rate against mean grip force",
+        )
+        ax = axes[0, 0]
+        if fr["curve"]["force"]:
+            ax.step(fr["curve"]["force"], fr["curve"]["rate"], where="post", color="0.3", lw=1.4,
+                    label="constant force (frontier)")
+            if fr.get("max_force") is not None:
+                ax.plot([fr["max_force"]], [fr["max_rate"]], marker="v", color="0.3", ms=6)
+        for i, (c, pt) in enumerate(fr["controllers"].items()):
+            if pt["mean_force"] is None or pt["success_rate"] is None:
+                continue
+            lo, hi = pt["wilson95"]
+            r = pt["success_rate"]
+            ax.errorbar([pt["mean_force"]], [r], yerr=[[max(r - lo, 0.0)], [max(hi - r, 0.0)]],
+                        color=plot.color(i), marker="o", ms=5, capsize=3, lw=1.2, label=c)
+        ax.set_xscale("log")
+        ax.set_ylim(-0.03, 1.03)
+        ax.set_xlabel(plot.axis_label("mean grip force", None, "N"))
+        ax.set_ylabel("success rate")
+        ax.legend(fontsize=7, loc="upper left", framealpha=0.85)
+    return fig
+
+
+def markdown(data: dict[str, Any], figure: str | None = None,
+             frontier_fig: str | None = None) -> str:
+    which = data.get("set", "tuning")
+    seeds = f"seed {data['seed']}"
     lines = [
         f"# Campaign {data['campaign']}",
         "",
-        f"Plant: {data['plant']}; master seed {data['seed']}; {data['runs']} runs; success = "
+        f"Plant: {data['plant']}; **{which} set** ({seeds}"
+        + (f"; the evaluation set's seed is {data['evaluation_seed']}"
+           if which == "tuning" and data.get("evaluation_seed") is not None else "")
+        + f"); {data['runs']} runs; success = "
         + ", ".join(f"{k} ({v})" if v is not True else k for k, v in data["criteria"].items()
                     if v is not False),
         "",
-        "| controller | runs | success | rate | 95 % interval (Wilson) | mean force [N] | errors |",
-        "|---|---:|---:|---:|---|---:|---:|",
+        "| controller | runs | success | rate | 95 % interval (Wilson) | mean force [N] | "
+        "mean force / min static (held) | crushed | errors |",
+        "|---|---:|---:|---:|---|---:|---:|---:|---:|",
     ]
     for c, s in data["summary"].items():
         lo, hi = s["wilson95"]
         lines.append(
             f"| {c} | {s['runs']} | {s['successes']} | {_fmt(s['success_rate'])} | "
-            f"[{lo:.3f}, {hi:.3f}] | {_fmt(s['mean_force'])} | {s['errors']} |"
+            f"[{lo:.3f}, {hi:.3f}] | {_fmt(s['mean_force'])} | "
+            f"{_fmt(s.get('mean_force_over_min_static'))} | {s.get('crushed', 0)} | "
+            f"{s['errors']} |"
         )
+    fr = data.get("frontier")
+    if fr:
+        lines += ["", "## Constant-force frontier", ""]
+        if frontier_fig:
+            lines += [f"![frontier]({frontier_fig})", ""]
+        lo, hi = fr["max_wilson95"]
+        lines += [
+            f"Per run, the smallest constant force that passes it (bisection, bracket up to the "
+            f"crush force or f_max = {_fmt(fr['f_max'])} N); a constant F holds a run when that "
+            f"force <= F <= its crush force. No constant passes {fr['no_constant_passes']} of "
+            f"{fr['runs']} runs; {fr['evaluations_mean']:.1f} simulations per run"
+            + (f"; {fr['errors']} frontier errors" if fr["errors"] else "")
+            + (f"; on {fr['floor_passed']} runs the bracket's bottom passed too (their force is "
+               "an upper bound)" if fr["floor_passed"] else "")
+            + (f"; on {fr['non_monotone']} runs a force above the smallest passing one failed "
+               "(success not monotone in the force there: such a run counts as held only below "
+               "that failing force)" if fr.get("non_monotone") else "") + ".",
+            "",
+            f"- Frontier maximum: **{_fmt(fr['max_rate'])}** ({fr['max_successes']}/{fr['runs']}"
+            f", Wilson [{lo:.3f}, {hi:.3f}], optimistic: the best constant is chosen after the "
+            f"fact) at F = {_fmt(fr['max_force'])} N.",
+            "",
+            "| controller | success | 95 % interval | mean force [N] | constant of the same "
+            "mean force | difference | it holds, that constant fails | that constant holds, it "
+            "fails | minus frontier max |",
+            "|---|---:|---|---:|---:|---:|---:|---:|---:|",
+        ]
+        chk = fr.get("constant_force_check")
+        if chk:
+            lines[-3:-3] = [
+                f"- Check of the monotonicity the frontier assumes: the simulated constant_force "
+                f"controller ({_fmt(chk['force'])} N) and the frontier's verdict for that force "
+                f"agree on {chk['agree']} of {chk['runs']} runs"
+                + (f" (they differ on runs {', '.join(map(str, chk['disagree_runs'][:10]))})"
+                   if chk["disagree_runs"] else "") + ".",
+            ]
+        for c, pt in fr["controllers"].items():
+            w = pt["wilson95"] or [math.nan, math.nan]
+            lines.append(
+                f"| {c} | {_fmt(pt['success_rate'])} | [{w[0]:.3f}, {w[1]:.3f}] | "
+                f"{_fmt(pt['mean_force'])} | {_fmt(pt['constant_same_mean_force'])} | "
+                f"{_fmt(pt['minus_constant_same_mean_force'])} | "
+                f"{pt.get('holds_constant_fails', '-')} | "
+                f"{pt.get('constant_holds_it_fails', '-')} | "
+                f"{_fmt(pt['minus_frontier_max'])} |"
+            )
     if data["paired_with_lugrip"]:
         lines += ["", "Paired with lugrip (same grasp, same noise):", "",
                   "| controller | runs | lugrip holds, it fails | it holds, lugrip fails |",
@@ -262,8 +486,8 @@ def markdown(data: dict[str, Any], figure: str | None = None) -> str:
 
 def write_report(directory: str | Path, campaign: Campaign, rows: Sequence[dict] | None = None,
                  *, figures: bool = True) -> dict[str, Path]:
-    """Write report.md, report.json and failure_map.png into `directory` (rows: the stored
-    results by default). Returns {name: path}."""
+    """Write report.md, report.json, failure_map.png and (with the frontier) frontier.png into
+    `directory` (rows: the stored results by default). Returns {name: path}."""
     from .runner import ResultStore
 
     d = Path(directory)
@@ -271,16 +495,20 @@ def write_report(directory: str | Path, campaign: Campaign, rows: Sequence[dict]
         rows = ResultStore(d, campaign).rows()
     data = summarise(rows, campaign, out_dir=d)
     paths = {}
-    fig_name = None
+    fig_name = front_name = None
     if figures:
+        from .. import plot
+
         fig = failure_map_figure(data)
         if fig is not None:
-            from .. import plot
-
             paths["failure_map"] = plot.save(fig, d / "failure_map.png")
             fig_name = "failure_map.png"
+        fig = frontier_figure(data)
+        if fig is not None:
+            paths["frontier"] = plot.save(fig, d / "frontier.png")
+            front_name = "frontier.png"
     (d / "report.json").write_text(json.dumps(data, indent=1, default=str))
-    (d / "report.md").write_text(markdown(data, fig_name))
+    (d / "report.md").write_text(markdown(data, fig_name, front_name))
     paths["json"] = d / "report.json"
     paths["markdown"] = d / "report.md"
     return paths

@@ -21,12 +21,15 @@ import os
 import sys
 import time
 import traceback
-from collections.abc import Callable, Iterable, Sequence
+import types
+from collections.abc import Callable, Iterable, Mapping, Sequence
 from pathlib import Path
 from typing import Any
 
-from .._controller import PAPER_SETTINGS
-from .definition import Campaign, CampaignError
+import numpy as np
+
+from .._controller import PAPER_SETTINGS, controller_settings
+from .definition import FRONTIER_DEFAULTS, Campaign, CampaignError
 
 __all__ = ["BACKENDS", "ResultStore", "run_campaign", "run_one"]
 
@@ -49,6 +52,7 @@ METRICS = (
     "finite",
     "command_in_limits",
     "scene_status",
+    "peak_command",
 )
 
 
@@ -68,9 +72,15 @@ def _controller_call(name: str, opts: dict, scenario) -> tuple[str, dict, dict, 
 
 
 def _criteria(campaign: Campaign, m: dict) -> dict[str, bool]:
+    """Pass flags of the campaign's criteria for the metrics `m` (``no_crush`` reads the run's
+    ``crush_force`` from `m`)."""
     out = {}
     for k, limit in campaign.criteria.items():
         if limit is False:
+            continue
+        if k == "no_crush":
+            crush = m.get("crush_force")
+            out[k] = crush is None or m.get("peak_command", math.inf) <= crush
             continue
         if k == "no_drop":
             out[k] = not m["dropped"]
@@ -87,33 +97,164 @@ def _criteria(campaign: Campaign, m: dict) -> dict[str, bool]:
     return out
 
 
-def simulate_run(campaign: Campaign, index: int, controllers: Sequence[str] | None = None):
-    """Scenario, drawn parameters and {controller: (run, metrics)} of run `index`."""
+def _simulate(campaign: Campaign, scn, cfg, name: str, opts: dict):
+    """(run, metrics) of controller `name` with options `opts` on the run's scenario `scn`.
+    The metrics gain ``peak_command``: the largest command over the whole run, from t = 0 (the
+    metric ``peak_force`` starts at the lift), per finger [N]."""
     from ..sim.scenarios import Scenario, compute_metrics, simulate
 
+    kind, ctrl, obs, sim_opts = _controller_call(name, opts, scn)
+    s = Scenario.from_dict(scn.to_dict() | {"controller": ctrl, "observer": obs}, scn.source)
+    schedule = s.schedule if kind == "lugrip" else None
+    run = simulate(s, cfg, campaign.plant, schedule, kind=kind, **sim_opts)
+    m = compute_metrics(s, run, cfg=cfg, pivot=kind == "lugrip")
+    cmd = np.asarray(run["command"], dtype=float)
+    m["peak_command"] = float(np.max(cmd)) if np.all(np.isfinite(cmd)) else math.inf
+    return run, m
+
+
+def simulate_run(campaign: Campaign, index: int, controllers: Sequence[str] | None = None):
+    """Scenario, drawn parameters and {controller: (run, metrics)} of run `index`."""
     scn, params = campaign.run_scenario(index)
     cfg = scn.plant_config(campaign.plant)
     out = {}
     for name in controllers or campaign.controllers:
-        kind, ctrl, obs, opts = _controller_call(name, campaign.controllers[name], scn)
-        s = Scenario.from_dict(scn.to_dict() | {"controller": ctrl, "observer": obs}, scn.source)
-        schedule = s.schedule if kind == "lugrip" else None
-        run = simulate(s, cfg, campaign.plant, schedule, kind=kind, **opts)
-        out[name] = (run, compute_metrics(s, run, cfg=cfg, pivot=kind == "lugrip"))
+        out[name] = _simulate(campaign, scn, cfg, name, campaign.controllers[name])
     return scn, params, out
+
+
+def search_constant(passes: Callable[[float], bool], low: float, high: float, *,
+                    tolerance: float = 0.02, max_evaluations: int = 12,
+                    scan: float = math.sqrt(2.0)) -> dict[str, Any]:
+    """The smallest force in [low, high] for which ``passes(force)`` is true, by bisection on
+    log(force); `passes` is called at most `max_evaluations` times, plus once at `low` (below).
+
+    1. ``high`` first. When it fails, forces below it are scanned downward by factors of
+       `scan` (not below `low`): on a plant where more force can lose a grasp (MuJoCo's pads
+       chatter in torsion at high grip forces) a force below the top may still pass. The
+       smallest force tried above the first passing one that failed is ``fail_above``; when no
+       force passes, ``force`` is None.
+    2. Bisection between the largest failing force below the passing one (else ``low``, assumed
+       to fail) and the passing one, to a bracket of relative width `tolerance`.
+    3. When every force tried passed, ``low`` itself is tried (``floor_passed``: the force is
+       then only an upper bound).
+
+    Returns {force, found, fail_above, floor_passed, history: [[force, passed], ...]}.
+    """
+    history: list[list[Any]] = []
+
+    def test(f: float) -> bool:
+        ok = bool(passes(f))
+        history.append([float(f), ok])
+        return ok
+
+    out: dict[str, Any] = {"force": None, "found": False, "fail_above": None,
+                           "floor_passed": False, "history": history}
+    if high <= low:
+        return out
+    hi = high
+    if not test(hi):
+        fail = hi
+        f = hi / scan
+        while f > low * (1.0 + tolerance) and len(history) < max_evaluations:
+            if test(f):
+                hi = f
+                out["fail_above"] = fail
+                break
+            fail = f
+            f /= scan
+        else:  # no force in the scan passed
+            return out
+    lo = max([f for f, ok in history if not ok and f < hi], default=low)
+    while hi / lo > 1.0 + tolerance and len(history) < max_evaluations:
+        mid = math.sqrt(lo * hi)
+        if test(mid):
+            hi = mid
+        else:
+            lo = mid
+    if all(ok for _, ok in history) and test(low):
+        hi = low  # every force tried passed, and so does the bottom assumed to fail
+        out["floor_passed"] = True
+    out.update(force=float(hi), found=True)
+    return out
+
+
+def constant_frontier(campaign: Campaign, scn, limits: Mapping[str, Any],
+                      criteria: Mapping[str, Any] | None = None) -> dict[str, Any]:
+    """The smallest constant grasp force [N] that passes the run `scn` (every criterion of the
+    campaign, as the constant_force controller is judged), by :func:`search_constant`.
+
+    The bracket: top ``min(crush force, f_max)`` (f_max: the gripper's range in the run's
+    controller block), bottom ``max(f_min, low_fraction x min_static_force)`` (assumed to fail:
+    below the static force the hanging load alone makes the object slide); ``max_evaluations``
+    simulations at most, to a bracket of relative width ``tolerance``.
+
+    Assumption: below the crush force, success of a constant force is monotone in the force
+    (more force never loses a grasp that less force held); then the success of ANY constant F
+    on this run is F_pass <= F <= crush. It does not hold on every plant: on MuJoCo the pads'
+    torsional contact can chatter at high grip forces and ratchet the object round, so a high
+    constant fails where a lower one holds. The search therefore scans down from a failing top,
+    and records the failing force above the passing one (``fail_above``): the report then counts
+    the run as held by F only for F_pass <= F < fail_above (the true upper end lies between the
+    largest passing and that failing force: the count errs toward the constant). Where the top
+    passes, forces between F_pass and the top are not all tried; the report compares the
+    simulated constant_force controller with this verdict run by run.
+
+    Returns {force (None when no constant passes), found, fail_above, low, high, evaluations,
+    history: [[force, passed], ...], floor_passed, error}.
+    """
+    opt = campaign.frontier or dict(FRONTIER_DEFAULTS)
+    crit = dict(campaign.criteria if criteria is None else criteria)
+    cfg = scn.plant_config(campaign.plant)
+    f_min = float(scn.controller.get("f_min", controller_settings()["f_min"]))
+    f_max = float(scn.controller.get("f_max", controller_settings()["f_max"]))
+    crush = limits.get("crush_force")
+    hi = f_max if crush is None else min(float(crush), f_max)
+    lo = max(f_min, opt["low_fraction"] * float(limits["min_static_force"]))
+    shadow = types.SimpleNamespace(criteria=crit)
+    history: list[list[Any]] = []
+
+    def passes(f: float) -> bool:
+        _, m = _simulate(campaign, scn, cfg, "constant_force", {"force": f})
+        ok = all(_criteria(shadow, dict(m, crush_force=crush)).values())
+        history.append([float(f), bool(ok)])
+        return ok
+
+    out = {"force": None, "found": False, "fail_above": None, "low": lo, "high": hi,
+           "evaluations": 0, "history": history, "floor_passed": False, "error": None}
+    try:
+        res = search_constant(passes, lo, hi, tolerance=opt["tolerance"],
+                              max_evaluations=opt["max_evaluations"])
+        out.update(force=res["force"], found=res["found"], fail_above=res["fail_above"],
+                   floor_passed=res["floor_passed"])
+    except Exception as err:  # noqa: BLE001 (a rejected simulation is recorded, not raised)
+        out["error"] = f"{type(err).__name__}: {str(err).splitlines()[0] if str(err) else ''}"
+        out["force"], out["found"], out["fail_above"] = None, False, None
+    out["evaluations"] = len(history)
+    return out
 
 
 def run_one(campaign: Campaign, index: int) -> list[dict[str, Any]]:
     """The result rows of run `index` (one per controller): run, controller, seeds, drawn
     parameters (``p_<name>``), metrics (``m_<name>``), criteria (``pass_<name>``), success,
     error (the exception's last line when the simulation failed; then success is False), the
-    wall and CPU time of the run shared out over its controllers (``elapsed_s``, ``cpu_s``). A
-    pure function of (campaign, index) but for those two."""
+    wall and CPU time of the run shared out over its controllers (``elapsed_s``, ``cpu_s``).
+    Every row also carries the run's ``set`` (tuning or evaluation), ``min_static_force`` and
+    ``crush_force`` (:meth:`Campaign.run_limits`) and, with the campaign's ``frontier``, the
+    run's smallest passing constant force (:func:`constant_frontier`: ``frontier_force``, None
+    when no constant passes, ``frontier_found``, ``frontier_fail_above``, ``frontier_low``,
+    ``frontier_high``, ``frontier_evaluations``, ``frontier_floor_passed``,
+    ``frontier_history`` as JSON, ``frontier_error``, ``frontier_elapsed_s``). A pure function
+    of (campaign, index) but for the times."""
     rows = []
     t0 = time.perf_counter()
     c0 = time.process_time()
+    limits: dict[str, Any] = {"min_static_force": None, "crush_force": None}
+    frontier: dict[str, Any] | None = None
+    frontier_s = 0.0
     try:
-        _, params, runs = simulate_run(campaign, index)
+        scn, params, runs = simulate_run(campaign, index)
+        limits = campaign.run_limits(scn, params)
         error = None
     except Exception as err:  # noqa: BLE001 (a grasp the simulator rejects is a recorded failed run)
         params = campaign.draw(index)
@@ -123,17 +264,42 @@ def run_one(campaign: Campaign, index: int) -> list[dict[str, Any]]:
             traceback.print_exc()
     elapsed = time.perf_counter() - t0
     cpu = time.process_time() - c0
+    if campaign.frontier is not None and error is None:
+        t1 = time.perf_counter()
+        frontier = constant_frontier(campaign, scn, limits)
+        frontier_s = time.perf_counter() - t1
+    run_cols: dict[str, Any] = {
+        "set": campaign.result_set,
+        "min_static_force": limits["min_static_force"],
+        "crush_force": limits["crush_force"],
+    }
+    if campaign.frontier is not None:
+        f = frontier or {}
+        run_cols.update(
+            frontier_force=f.get("force"),
+            frontier_found=bool(f.get("found", False)),
+            frontier_fail_above=f.get("fail_above"),
+            frontier_low=f.get("low"),
+            frontier_high=f.get("high"),
+            frontier_evaluations=int(f.get("evaluations", 0)),
+            frontier_floor_passed=bool(f.get("floor_passed", False)),
+            frontier_history=json.dumps(f.get("history", [])),
+            frontier_error=f.get("error") if frontier is not None else error,
+            frontier_elapsed_s=frontier_s,
+        )
     for name in campaign.controllers:
         row: dict[str, Any] = {
             "run": int(index),
             "controller": name,
-            "campaign_seed": campaign.seed,
+            "campaign_seed": campaign.draw_seed,
             "plant_seed": int(params["plant_seed"]),
         }
-        for k in campaign.parameters:
-            row[f"p_{k}"] = float(params[k])
+        for k in campaign.columns():
+            v = params.get(k)
+            row[f"p_{k}"] = None if v is None else float(v)
+        row.update(run_cols)
         if name in runs:
-            m = runs[name][1]
+            m = dict(runs[name][1], crush_force=limits["crush_force"])
             for k in METRICS:
                 v = m.get(k)
                 row[f"m_{k}"] = v if v is None or isinstance(v, (bool, str)) else float(v)
@@ -182,7 +348,9 @@ class ResultStore:
             return
         self.parts.mkdir(parents=True, exist_ok=True)
         # the base scenario written out: the directory replays without the original files
-        doc = {"name": self.campaign.name, "fingerprint": fp, "campaign": self.campaign.portable()}
+        doc = {"name": self.campaign.name, "set": self.campaign.result_set,
+               "seed": self.campaign.draw_seed, "fingerprint": fp,
+               "campaign": self.campaign.portable()}
         tmp = self.meta.with_suffix(".tmp")
         tmp.write_text(json.dumps(doc, indent=1, default=str))
         os.replace(tmp, self.meta)

@@ -26,11 +26,29 @@ examples:
       --out out/mujoco_blocks
   lugrip campaign replay out/patch_blocks --run 17 --controller lugrip
   lugrip campaign report out/patch_blocks
+  lugrip campaign campaigns/everyday_patch.yaml --runs 20 --workers 1 --out out/everyday_tuning
+  lugrip campaign campaigns/everyday_patch.yaml --evaluation --runs 500 --out out/everyday_eval
+      (the evaluation set: drawn with the file's evaluation_seed; run once, after tuning)
 Ray: pip install 'lugrip[cluster]'; without --ray-address a local Ray instance with --workers
 CPUs is started. The same campaign and run index give the same results on either backend and
 any number of workers. Results: DIR/results.parquet (one row per run and controller: p_* drawn
-parameters, m_* metrics, pass_* criteria, success, seeds), DIR/report.md, report.json,
-failure_map.png.
+parameters, m_* metrics, pass_* criteria, success, seeds, set, min_static_force, crush_force,
+frontier_*), DIR/campaign.json (with the set: tuning or evaluation), DIR/report.md,
+report.json, failure_map.png, frontier.png.
+campaign file options beyond scenario, plant, seed, controllers, criteria and parameters
+(docs/campaigns.md):
+  evaluation_seed: N   the evaluation set's seed (--evaluation draws with it)
+  frontier: true       per run, the smallest constant force that passes (bisection up to the
+                       crush force or f_max); the report draws the constant-force frontier
+                       (success rate of every constant) with each controller as a point
+  gripper: {f_max: ..} the gripper's range on top of the base scenario's controller block
+  crush_factor         (parameter) crush force = factor x the run's minimum static force
+                       (true contact, hanging load at S = 1); criterion no_crush: the command
+                       never exceeds it
+  push_count, push_phase, push_weight_fraction, push_twist_fraction, push_edge
+                       (parameters) 1-N trapezoid pushes per run, each drawn on its own,
+                       sized by the object's weight and gravity torque, at random phases
+                       of the 50 Hz command period (twist_lever: the torque's smallest lever)
 """
 
 
@@ -77,6 +95,9 @@ def register(subparsers) -> None:
     p.add_argument("--ray-address", default=None, metavar="ADDR",
                    help="Ray cluster address ('auto' or host:port); default: a local instance")
     p.add_argument("--out", type=Path, metavar="DIR", help="results directory")
+    p.add_argument("--evaluation", action="store_true",
+                   help="draw the evaluation set (the campaign's evaluation_seed) instead of "
+                   "the tuning set (seed)")
     p.add_argument("--run", dest="run_id", type=_index, metavar="ID", help="replay: the run index")
     p.add_argument("--controller", action="append", default=None, metavar="NAME",
                    help="replay: only this controller (repeatable; default: all)")
@@ -100,6 +121,8 @@ def _run_campaign(args) -> int:
     if args.ray_address and args.backend != "ray":
         raise CliError("--ray-address needs --backend ray")
     campaign = load_campaign(args.target[0])
+    if args.evaluation:
+        campaign = campaign.for_set("evaluation")
     affinity = getattr(os, "sched_getaffinity", None)  # Linux; elsewhere every CPU
     workers = args.workers or max(len(affinity(0)) if affinity else (os.cpu_count() or 1), 1)
     info = run_campaign(
@@ -113,7 +136,8 @@ def _run_campaign(args) -> int:
     )
     rate = info["runs_per_s"]
     print(
-        f"{campaign.name}: {info['ran']} runs done, {info['skipped']} already in {args.out}"
+        f"{campaign.name} ({campaign.result_set} set, seed {campaign.draw_seed}): "
+        f"{info['ran']} runs done, {info['skipped']} already in {args.out}"
         + (f" ({rate:.2f} runs/s on {workers} {args.backend} worker(s))" if info["ran"] else "")
     )
     if not args.no_report:
@@ -124,7 +148,17 @@ def _run_campaign(args) -> int:
         for c, s in data["summary"].items():
             lo, hi = s["wilson95"]
             print(f"  {c}: {s['successes']}/{s['runs']} held ({100 * s['success_rate']:.1f} %, "
-                  f"95 % interval {100 * lo:.1f}-{100 * hi:.1f} %)")
+                  f"95 % interval {100 * lo:.1f}-{100 * hi:.1f} %), mean force "
+                  f"{s['mean_force'] if s['mean_force'] is not None else float('nan'):.2f} N")
+        fr = data.get("frontier")
+        if fr:
+            at = f" at {fr['max_force']:.2f} N" if fr["max_force"] is not None else ""
+            print(f"  constant-force frontier: best {fr['max_successes']}/{fr['runs']} "
+                  f"({100 * fr['max_rate']:.1f} %){at}")
+            for c, pt in fr["controllers"].items():
+                if pt["constant_same_mean_force"] is not None:
+                    print(f"    constant of {c}'s mean force: "
+                          f"{100 * pt['constant_same_mean_force']:.1f} %")
         print(f"report: {paths['markdown']}")
     return 0
 
