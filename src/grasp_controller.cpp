@@ -118,6 +118,8 @@ bool validate(const GraspControllerSettings& s, std::string* message) {
   within("loop_gain_i", s.loop_gain_i, 0.0, true, kGainMax, " [1/s]");
   if (!(std::isfinite(s.mu_probe) && s.mu_probe >= 0.0 && s.mu_probe <= 0.5))
     bad("mu_probe", s.mu_probe, "must be finite, >= 0 and <= 0.5");
+  if (!(s.ceiling_factor == 0.0 || (std::isfinite(s.ceiling_factor) && s.ceiling_factor >= 1.0 && s.ceiling_factor <= 1.0e3)))
+    bad("ceiling_factor", s.ceiling_factor, "must be 0 (off) or finite, >= 1 and <= 1000");
   if (!(s.feedforward_slippage >= kSlippageMin && s.feedforward_slippage <= 1.0))
     bad("feedforward_slippage", s.feedforward_slippage, "must satisfy 1e-03 <= feedforward_slippage <= 1");
   if (!(s.reflex_slippage >= kSlippageMin && s.reflex_slippage <= 1.0))
@@ -165,7 +167,7 @@ std::string to_string(const GraspControllerSettings& s) {
          ", reflex_samples=" + std::to_string(s.reflex_samples) + ", reflex_factor=" + num(s.reflex_factor) +
          ", average_slippage=" + flag(s.average_slippage) +
          ", feedforward_horizon=" + num(s.feedforward_horizon) + ", feedforward_trend=" + num(s.feedforward_trend) +
-         ", reaction_lag=" + num(s.reaction_lag) + ", mu_probe=" + num(s.mu_probe) +
+         ", reaction_lag=" + num(s.reaction_lag) + ", mu_probe=" + num(s.mu_probe) + ", ceiling_factor=" + num(s.ceiling_factor) +
          ", reserve_force=" + num(s.reserve_force) + ", reserve_torque=" + num(s.reserve_torque) + ")";
 }
 
@@ -449,6 +451,7 @@ Status GraspController::step(const GraspControllerInput& in, GraspControllerOutp
   out.peak_slippage = last_.peak_slippage;
   out.reflex = last_.reflex;
   out.mu_belief = last_.mu_belief;
+  out.ceiling = last_.ceiling;
   out.probing = last_.probing;
   out.probe_slip = last_.probe_slip;
   out.saturated = last_.saturated;
@@ -498,6 +501,8 @@ void GraspController::issue_command(bool valid, double slip) noexcept {
   c.held = false;
 
   double f_ns, f_nd = 0.0, e;
+  double hi = s_.f_max;  // ceiling of the command (ceiling_factor)
+  c.ceiling = hi;
   bool reacting = false;  // the feed-forward or the reflex lifted the static part
   if (mode_ == ControllerMode::SlippingAvoidance) {
     // Floor of the static part: feed-forward of the measured load and the slip reflex.
@@ -530,8 +535,18 @@ void GraspController::issue_command(bool valid, double slip) noexcept {
     }
     trend_lift_ = 0.0;
     const double u = k_p * e + integrator_;
-    const double lo = clamp(lift, s_.f_min, s_.f_max);
-    f_ns = clamp(u, lo, s_.f_max);
+    // Ceiling: the grip the measured load needs at S = 1, times ceiling_factor (while the
+    // contact slides its load is its friction, and this is the grip it slides at). It caps
+    // raises only: never below the last command (lowering is the PI's).
+    // The need is also read from S itself (S ~ 1/f_n: the grip at S = 1 is ~ f S), so a load
+    // given without its torque, or an S the load does not explain, never lowers the ceiling.
+    hi = s_.f_max;
+    const double need = std::max(ceiling_load_, f_est_ * slip);
+    if (s_.ceiling_factor > 0.0 && need > 0.0)
+      hi = clamp(std::max(s_.ceiling_factor * need, command_), s_.f_min, s_.f_max);
+    c.ceiling = hi;
+    const double lo = clamp(lift, s_.f_min, hi);
+    f_ns = clamp(u, lo, hi);
     if (f_ns != u) {
       if (u < lo && lo > s_.f_min) {
         reacting = true;
@@ -551,15 +566,23 @@ void GraspController::issue_command(bool valid, double slip) noexcept {
     // A reaction during the probe (the load moved: feed-forward lift, reflex) spoils its answer.
     if (probing && !probe_started && c.reflex) probe_disturbed_ = true;  // the reflex moved it
     c.probing = probing;
-    if (probing) f_ns = std::min(std::max(f_ns, probe_base_ * (1.0 + s_.mu_probe)), s_.f_max);
+    if (probing) {  // the probe is a measurement: it may exceed the ceiling by its own size
+      hi = std::min(std::max(hi, probe_base_ * (1.0 + s_.mu_probe)), s_.f_max);
+      f_ns = std::min(std::max(f_ns, probe_base_ * (1.0 + s_.mu_probe)), hi);
+    }
     else integrator_ += k_i * t_cmd_ * e;  // forward Euler
     last_kp_ = k_p;
     last_e_ = e;
     c.gain_p = k_p;
     c.gain_i = k_i;
     if (s_.dynamic_enabled) {
-      const double head_room = s_.f_max - f_ns;
-      f_nd = clamp(peak_, 0.0, head_room);
+      const double head_room = hi - f_ns;
+      // With the ceiling on, the dynamic part adds at most what one reflex step would
+      // (reflex_factor - 1 of the static part): it answers a slip's speed, not the load, and a
+      // lift-off's transfer slip would otherwise spike the grip to several times what the load
+      // needs.
+      const double cap = s_.ceiling_factor > 0.0 ? std::min(head_room, (s_.reflex_factor - 1.0) * f_ns) : head_room;
+      f_nd = clamp(peak_, 0.0, cap);
       if (peak_ > head_room) c.saturated = true;
     }
   } else {
@@ -583,7 +606,8 @@ void GraspController::issue_command(bool valid, double slip) noexcept {
 
   double target = f_ns + f_nd;
   // Reaction through the gripper's lag: overshoot so the force reaches the target in one period.
-  if (reacting && lag > 0.0 && target > f_est_) target += (std::min(target, s_.f_max) - f_est_) * lag / (1.0 - lag);
+  if (reacting && lag > 0.0 && target > f_est_)
+    target = std::min(target + (std::min(target, s_.f_max) - f_est_) * lag / (1.0 - lag), hi);
   double f = clamp(target, command_ - s_.max_rate_down * t_cmd_, command_ + s_.max_rate_up * t_cmd_);
   c.rate_limited = f != target;
   f = clamp(std::max(f, floor), s_.f_min, s_.f_max);
@@ -753,8 +777,16 @@ double GraspController::reaction_floor(double& slope_exponent, GraspControllerOu
   double lift = static_floor(slope_exponent);
   c.feedforward_force = lift;
   if (s_.slip_reflex && reflex_armed_) {
-    // On the static part: a transient f_nd would otherwise be multiplied into f_ns.
-    const double reflex = s_.reflex_factor * std::min(last_.static_force, command_);
+    // On the grip the contact slid at: the static part (a transient f_nd would otherwise be
+    // multiplied into f_ns), or the measured f_n when the gripper has not reached it yet (a
+    // raise still on its way is not a grip that failed; compounding the command while the
+    // force lags would overshoot the load several times).
+    double base = std::min(last_.static_force, command_);
+    double fn_meas = 0.0;
+    for (int i = 0; i < kMaxFingers; ++i)
+      if (n_load_[i] > 0 && fn_ok_[i]) fn_meas = std::max(fn_meas, sum_f_n_[i] / n_load_[i]);
+    if (fn_meas > 0.0) base = std::min(base, fn_meas);
+    const double reflex = s_.reflex_factor * base;
     lift = std::max(lift, reflex);
     floor_measured_ = std::max(floor_measured_, reflex);
     c.reflex = true;
@@ -777,10 +809,12 @@ double GraspController::static_floor(double& slope_exponent) noexcept {
     if (std::isfinite(f_mean[i])) f_grasp = std::max(f_grasp, f_mean[i]);
   }
   floor_measured_ = f_grasp;
+  ceiling_load_ = 0.0;
   for (int i = 0; i < kMaxFingers; ++i) {
     if (n_load_[i] == 0) continue;
     const double n = n_load_[i];
     const double ft = sum_f_t_[i] / n, tau = sum_tau_[i] / n;
+    double load_ft = ft, load_tau = tau;  // the load the feed-forward answers (mean or trend)
     if (s_.feedforward) {
       double f = f_mean[i];
       const double f_ref = f_grasp;  // a light finger's extrapolated noise is no edge
@@ -794,14 +828,23 @@ double GraspController::static_floor(double& slope_exponent) noexcept {
         const double slope_t = (n * sum_kt_[i] - sum_k_[i] * sum_tau_[i]) / den;
         const double fx = solver_.solve(std::max(0.0, ft + slope_f * ahead), tau + slope_t * ahead,
                                         s_.feedforward_slippage).force;
-        if (std::isfinite(fx) && fx > (1.0 + s_.feedforward_trend) * f_ref) f = fx;
+        if (std::isfinite(fx) && fx > (1.0 + s_.feedforward_trend) * f_ref) {
+          f = fx;
+          load_ft = std::max(0.0, ft + slope_f * ahead);
+          load_tau = tau + slope_t * ahead;
+        }
       }
       if (std::isfinite(f)) force = std::max(force, f);
+    }
+    if (s_.ceiling_factor > 0.0) {  // the grip this load needs at S = 1
+      const double f = solver_.solve(load_ft, load_tau, 1.0).force;
+      if (std::isfinite(f)) ceiling_load_ = std::max(ceiling_load_, f);
     }
     if (s_.reserve_force > 0.0 || s_.reserve_torque > 0.0) {
       // Standing reserve: the static force of the load plus the disturbance the task expects.
       const double f = solver_.solve(std::fabs(ft) + s_.reserve_force, std::fabs(tau) + s_.reserve_torque, 1.0).force;
       if (std::isfinite(f)) force = std::max(force, f);
+      if (std::isfinite(f)) ceiling_load_ = std::max(ceiling_load_, f);
     }
     if (s_.slope_gain) {
       const double s0 = solver_.slippage(command_, ft, tau), s1 = solver_.slippage(kStep * command_, ft, tau);

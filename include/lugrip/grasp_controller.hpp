@@ -134,6 +134,20 @@ struct GraspControllerSettings {
   //! 1 s) otherwise. Needs each finger's f_n (FingerInput::f_n). In [0, 0.5].
   double mu_probe = 0.08;
 
+  // --- ceiling from the measured load (not in the paper; docs/controller.md §10) -------------
+  //! (*) [-] default 1.7; 0 = off (paper). In slipping avoidance the command never exceeds this
+  //! factor times the grip the measured load needs at S = 1 (StaticForceSolver at S = 1 of each
+  //! finger's period-mean load, or of the trend's load when the feed-forward uses it, or of the
+  //! load plus the standing reserve; the largest over the fingers), nor f_max. It caps raises
+  //! only: a command above it (the load fell) is lowered by the PI, not by the ceiling; a grip
+  //! probe may exceed it by its own size. A sticking
+  //! contact's load is the object's: the ceiling is this factor over the least grip that holds
+  //! it, so reactions that pile up (C_d on a lift-off's transfer slip, the reflex while the
+  //! force lags, the lag overshoot) cannot crush a fragile object. A sliding contact's load is
+  //! its friction, so the ceiling is this factor over the grip it slides at: the reaction still
+  //! grows by this factor per command period. 0 or in [1, 1000].
+  double ceiling_factor = 1.7;
+
   // --- force range and rate limits (docs/model.md 9.5) --------------------------------------------
   double f_min = 0.1;   //!< [N] minimum force (keeps contact), > 0
   double f_max = 20.0;  //!< [N] maximum force (gripper limit), > f_min
@@ -227,6 +241,7 @@ struct GraspControllerOutput {
   double peak_slippage = 0.0;  //!< peak of max_i S_i over the period before the last command [-]
   bool reflex = false;         //!< last command: the slip reflex raised the static part
   double mu_belief = 0.0;      //!< friction coefficient the controller believes now [-]
+  double ceiling = 0.0;        //!< ceiling of the last command (ceiling_factor; f_max when off) [N]
   bool probing = false;        //!< last command: a grip probe raised the static part
   bool probe_slip = false;     //!< last command: a probe found the contact sliding (mu lowered)
   //! signed C_d omega_hat_i of each finger at this sample [N] (0 for absent fingers)
@@ -435,6 +450,7 @@ class GraspController {
   std::array<int, kMaxFingers> k_load_{};                // sample index in the period
   double f_est_ = 0.0;        // gripper force estimated through reaction_lag [N]
   double floor_measured_ = 0.0;  // reaction floor without the trend (mean load, reflex) [N]
+  double ceiling_load_ = 0.0;    // grip the period's load needs at S = 1 (ceiling_factor) [N]
   double trend_lift_ = 0.0;      // part of the last restart of the integrator due to the trend [N]
   double trend_force_ = 0.0;     // static part the trend lifted to at the last command [N]
   double peak_s_ = 0.0;       // peak of max_i S_i since the last command

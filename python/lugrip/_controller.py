@@ -54,6 +54,7 @@ PAPER_SETTINGS: dict[str, Any] = {
     "feedforward_horizon": 0.0,
     "reaction_lag": 0.0,
     "mu_probe": 0.0,
+    "ceiling_factor": 0.0,
     "reserve_force": 0.0,
     "reserve_torque": 0.0,
     "pivot_end_filter": 0.0,

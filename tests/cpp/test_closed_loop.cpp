@@ -190,6 +190,7 @@ TEST(ClosedLoop, ForceDecaysToTheFloorBeforeTheLiftAndRisesAtLiftOff) {
   ClosedLoopConfig c = lift_config();
   c.controller.slope_gain = c.controller.feedforward = c.controller.slip_reflex = false;
   c.controller.average_slippage = false;
+  c.controller.ceiling_factor = 0.0;  // the unloaded grip would go to f_min at once (below)
   ClosedLoop loop(c);
   const auto log = run(loop, 3.0);
   // At the floor f_min = 0.1 N: no load on the table. The mean sits a little above it: at 0.1 N
@@ -205,13 +206,40 @@ TEST(ClosedLoop, ForceDecaysToTheFloorBeforeTheLiftAndRisesAtLiftOff) {
 }
 
 TEST(ClosedLoop, DefaultControllerDrainsTheUnloadedCommandExponentiallyAndHoldsAfterTheLift) {
-  ClosedLoop loop(lift_config());
+  // The PI's drain alone: with the ceiling (below) no load means no grip at once.
+  ClosedLoopConfig c = lift_config();
+  c.controller.ceiling_factor = 0.0;
+  ClosedLoop loop(c);
   const auto log = run(loop, 3.0);
   const double f0 = mean_command(log, 0.0, 0.02);
   const double rate = GraspControllerSettings().loop_gain_i;  // [1/s]
   // f(t) = f0 exp(-loop_gain_i t) while S ~ 0 (within the S noise and the 20 ms steps)
   EXPECT_NEAR(mean_command(log, 0.4, 0.5), f0 * std::exp(-rate * 0.45), 0.15 * f0 * std::exp(-rate * 0.45));
   EXPECT_GT(mean_command(log, 2.5, 3.0), 0.5 * 0.5 * kG / 0.85) << "above the translational slip force";
+}
+
+TEST(ClosedLoop, CeilingKeepsTheLiftOffNearWhatTheLoadNeeds) {
+  // Plant: lugrip's own patch contact (a consistency test of the law, not of the physics). A
+  // 0.3 kg block lifted from 0.1 N: the reactions at lift-off (C_d on the transfer slip, the
+  // reflex while the force lags, the lag overshoot) pile up without the ceiling (12.4 N peak
+  // for a load that needs 1.65 N at S = 1); with it each command stays within ceiling_factor of
+  // the grip the period's measured load needs at S = 1, which while the block slides is the
+  // grip it slides at: the peak is less than half (5.5 N), and the block is held either way.
+  double peak[2] = {0.0, 0.0};
+  for (int on = 0; on < 2; ++on) {
+    ClosedLoopConfig c = lift_config(PlantModel::Patch, 0.3);
+    c.plant.actuator.f_init = 0.1;
+    if (!on) c.controller.ceiling_factor = 0.0;
+    ClosedLoop loop(c);
+    const auto log = run(loop, 3.0);
+    for (const auto& s : log) peak[on] = std::max(peak[on], s.command);
+    EXPECT_FALSE(log.back().dropped) << on;
+    double slip = 0.0;
+    for (const auto& s : log)
+      if (s.t > 2.0) slip = std::max(slip, s.slip);
+    EXPECT_LT(slip, 1e-3) << on;
+  }
+  EXPECT_LT(peak[1], 0.5 * peak[0]);
 }
 
 TEST(ClosedLoop, ScheduleSwitchesModesAtItsSamples) {

@@ -33,6 +33,7 @@ GraspControllerSettings paper_law(GraspControllerSettings s = {}) {
   s.feedforward_horizon = 0.0;
   s.reaction_lag = 0.0;
   s.mu_probe = 0.0;
+  s.ceiling_factor = 0.0;
   s.pivot_end_filter = 0.0;  // the paper's pivot end: pivot_end_samples from the first sample
   s.pivot_end_at_floor = false;
   s.pivot_floor_time = kInf;
@@ -1020,6 +1021,7 @@ TEST(ControllerReflex, RaisesWithinOneCommandPeriodWhenTheSpeedIsUnobservable) {
   // on three consecutive samples inside a period.
   GraspControllerSettings s;
   s.feedforward = false;
+  s.ceiling_factor = 0.0;  // the inputs' S is not their load's (the ceiling: ClosedLoop.Ceiling*)
   s.s_ref = 0.8;          // the set point of the inputs below
   s.reaction_lag = 0.0;   // the raise itself (the lag compensation: ControllerReaction.*)
   s.max_rate_up = s.max_rate_down = kInf;
@@ -1073,6 +1075,7 @@ TEST(ControllerReflex, RaisesWithinOneCommandPeriodWhenTheSpeedIsUnobservable) {
 TEST(ControllerReflex, RepeatsWhileSlidingAndStopsAtTheCeiling) {
   GraspControllerSettings s;
   s.feedforward = false;
+  s.ceiling_factor = 0.0;  // f_max is the ceiling here
   s.max_rate_up = s.max_rate_down = kInf;
   GraspController c(can(), s);
   c.reset(1.0);

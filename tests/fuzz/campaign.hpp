@@ -303,7 +303,7 @@ class Campaign {
     ctl_.reals = {LUGRIP_FUZZ_REAL(G, sensor_rate),   LUGRIP_FUZZ_REAL(G, k_cd),
                   LUGRIP_FUZZ_REAL(G, p_cd),          LUGRIP_FUZZ_REAL(G, z_cd),
                   LUGRIP_FUZZ_REAL(G, s_ref),         LUGRIP_FUZZ_REAL(G, k_p),
-                  LUGRIP_FUZZ_REAL(G, k_i),           LUGRIP_FUZZ_REAL(G, mu_probe),
+                  LUGRIP_FUZZ_REAL(G, k_i),           LUGRIP_FUZZ_REAL(G, mu_probe),      LUGRIP_FUZZ_REAL(G, ceiling_factor),
                   LUGRIP_FUZZ_REAL(G, omega_deadband), LUGRIP_FUZZ_REAL(G, f_min),
                   LUGRIP_FUZZ_REAL(G, f_max),         LUGRIP_FUZZ_REAL(G, max_rate_up),
                   LUGRIP_FUZZ_REAL(G, max_rate_down), LUGRIP_FUZZ_REAL(G, invalid_raise_step),
