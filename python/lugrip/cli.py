@@ -116,6 +116,31 @@ def _input_error(err: BaseException, args: argparse.Namespace) -> str | None:
     return None
 
 
+class _Terminated(BaseException):
+    """SIGTERM, raised in the main thread so that every ``finally`` block runs (the output
+    policy's temporary files are removed, commands/_output.py)."""
+
+
+def _on_sigterm(signum, frame):  # noqa: ARG001 (signal handler signature)
+    raise _Terminated()
+
+
+def _sigterm_handler():
+    """Installs the SIGTERM handler when SIGTERM has its default action and this is the main
+    thread; returns the previous handler to restore, or None."""
+    import signal
+    import threading
+
+    if threading.current_thread() is not threading.main_thread():
+        return None
+    try:
+        if signal.getsignal(signal.SIGTERM) is not signal.SIG_DFL:
+            return None
+        return signal.signal(signal.SIGTERM, _on_sigterm)
+    except (ValueError, OSError, AttributeError):
+        return None
+
+
 def main(argv: list[str] | None = None) -> int:
     """Entry point of the ``lugrip`` script; returns the exit code (0 ok, 2 user error)."""
     parser = build_parser()
@@ -128,8 +153,22 @@ def main(argv: list[str] | None = None) -> int:
         return exit_.code if isinstance(exit_.code, int) else 0
 
     prog = f"lugrip {args.command}"
+    previous = _sigterm_handler()
+    try:
+        return _run(args, prog)
+    finally:
+        if previous is not None:
+            import signal
+
+            signal.signal(signal.SIGTERM, previous)
+
+
+def _run(args: argparse.Namespace, prog: str) -> int:
     try:
         return int(args.run(args) or 0)
+    except _Terminated:
+        print(f"{prog}: terminated", file=sys.stderr)
+        return 143
     except BrokenPipeError:  # e.g. `lugrip ls | head`: not an error
         try:  # silence the second failure when Python flushes stdout at exit
             os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())

@@ -379,6 +379,9 @@ def _atomic_write(path: Path, overwrite: bool, body: Callable) -> None:
 
     if path.is_dir():
         raise IsADirectoryError(errno.EISDIR, "is a directory", str(path))
+    if path.exists() and not path.is_file():  # a device or FIFO: a rename would replace it
+        raise OSError(errno.EINVAL, "not a regular file, not replaced (also with "
+                      "overwrite=True)", str(path))
     if path.exists() and not overwrite:
         raise exists_error()
     fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=f".{path.name}.", suffix=".part")
