@@ -1,0 +1,210 @@
+"""The log readers verify what the format offers and refuse corrupted data per file, naming the
+file and the field (docs/reliability.md, "Readers"): MCAP chunk and data-section CRCs, the
+channel's schema name, encoding and definition against the standard message type. Files are
+generated in the tests; the user's files are checked byte for byte after each refusal."""
+
+from __future__ import annotations
+
+import hashlib
+import struct
+import sys
+import zlib
+
+import numpy as np
+import pytest
+
+pytest.importorskip("mcap")
+pytest.importorskip("rosbags")
+from mcap.writer import CompressionType, Writer  # noqa: E402  (imported before any monkeypatch)
+
+from lugrip import ContactParams, LogError, read_log, write_log  # noqa: E402
+from lugrip.cli import main  # noqa: E402
+from lugrip.sliding import simulate_maneuvers  # noqa: E402
+
+WRENCH = "geometry_msgs/msg/WrenchStamped"
+
+
+def _sha(path) -> str:
+    return hashlib.sha256(path.read_bytes()).hexdigest()
+
+
+@pytest.fixture(scope="module")
+def log():
+    return simulate_maneuvers(ContactParams.table1(), 2, seed=1).log
+
+
+def _uncompressed(path, log, monkeypatch):
+    """write_log without zstandard: an uncompressed chunk (the issue's case)."""
+    with monkeypatch.context() as m:
+        m.setitem(sys.modules, "zstandard", None)
+        write_log(log, path, overwrite=True)
+    return path
+
+
+def _flip_value(raw: bytearray, value: float, factor: float = 1000.0) -> int:
+    """Replace the first little-endian copy of ``value`` in ``raw`` by value * factor."""
+    i = raw.find(struct.pack("<d", value))
+    assert i > 0
+    raw[i:i + 8] = struct.pack("<d", value * factor)
+    return i
+
+
+def _exit_2(capsys, argv) -> str:
+    rc = main([str(a) for a in argv])
+    err = capsys.readouterr().err.strip()
+    assert rc == 2, err
+    assert len(err.splitlines()) == 1 and "Traceback" not in err, err
+    return err
+
+
+def test_chunk_crc_mismatch_is_refused(tmp_path, monkeypatch, capsys, log):
+    """Two values changed in an uncompressed chunk (f_n 1970 N for 1.97 N was read as valid):
+    exit 2 naming the file and Chunk.uncompressed_crc; the intact file still reads."""
+    good = _uncompressed(tmp_path / "good.mcap", log, monkeypatch)
+    assert len(read_log(good)) == len(log)
+    raw = bytearray(good.read_bytes())
+    _flip_value(raw, float(log.f_n[10]))
+    _flip_value(raw, float(log.f_n[11]))
+    bad = tmp_path / "bad.mcap"
+    bad.write_bytes(bytes(raw))
+    before = _sha(bad)
+    with pytest.raises(LogError, match="Chunk.uncompressed_crc"):
+        read_log(bad)
+    err = _exit_2(capsys, ["observe", bad, "--preset", "table1", "--out", tmp_path / "e.csv"])
+    assert "bad.mcap" in err and "uncompressed_crc" in err and "corrupted" in err
+    assert _sha(bad) == before and not (tmp_path / "e.csv").exists()
+
+
+def _unchunked(path, log):
+    """The wrench messages written outside chunks (only the data-section CRC covers them)."""
+    from rosbags.typesys import Stores, get_typestore
+
+    ts = get_typestore(Stores.ROS2_HUMBLE)
+    T = ts.types
+    V = T["geometry_msgs/msg/Vector3"]
+    with open(path, "wb") as fh:
+        w = Writer(fh, use_chunking=False, compression=CompressionType.NONE,
+                   enable_data_crcs=True)
+        w.start(profile="ros2", library="test")
+        sid = w.register_schema(name=WRENCH, encoding="ros2msg",
+                                data=ts.generate_msgdef(WRENCH, ros_version=2)[0].encode())
+        cid = w.register_channel(topic="/wrench", message_encoding="cdr", schema_id=sid)
+        for i in range(len(log)):
+            ns = 1_000_000_000 + int(round(log.t[i] * 1e9))
+            hdr = T["std_msgs/msg/Header"](
+                stamp=T["builtin_interfaces/msg/Time"](sec=ns // 10**9, nanosec=ns % 10**9),
+                frame_id="pad")
+            msg = T[WRENCH](header=hdr, wrench=T["geometry_msgs/msg/Wrench"](
+                force=V(0.0, float(log.f_t[i]), float(log.f_n[i])),
+                torque=V(0.0, 0.0, float(log.tau[i]))))
+            w.add_message(channel_id=cid, log_time=ns, publish_time=ns,
+                          data=bytes(ts.serialize_cdr(msg, WRENCH)), sequence=i)
+        w.finish()
+    return path
+
+
+def test_data_section_crc_mismatch_is_refused(tmp_path, log):
+    ok = _unchunked(tmp_path / "ok.mcap", log)
+    raw = ok.read_bytes()
+    marker = b"\x0f" + struct.pack("<Q", 4)  # the DataEnd record: opcode 0x0F, length 4
+    i = raw.rfind(marker)
+    stored = struct.unpack("<I", raw[i + 9:i + 13])[0]
+    assert stored == zlib.crc32(raw[:i]) != 0  # the file has a data-section CRC
+    assert len(read_log(ok)) == len(log)  # and it is accepted
+    bad_raw = bytearray(raw)
+    _flip_value(bad_raw, float(log.f_n[100]))
+    bad = tmp_path / "bad.mcap"
+    bad.write_bytes(bytes(bad_raw))
+    with pytest.raises(LogError, match="DataEnd.data_section_crc") as info:
+        read_log(bad)
+    assert info.value.file == str(bad)
+
+
+def _one_channel(path, *, schema_name=WRENCH, schema_encoding="ros2msg", schema_text="",
+                 message_encoding="cdr", payload=None, n=20):
+    from rosbags.typesys import Stores, get_typestore
+
+    ts = get_typestore(Stores.ROS2_HUMBLE)
+    F = ts.types["std_msgs/msg/Float64"]
+    payload = payload or (lambda i: bytes(ts.serialize_cdr(F(data=float(i)),
+                                                            "std_msgs/msg/Float64")))
+    with open(path, "wb") as fh:
+        w = Writer(fh, compression=CompressionType.NONE)
+        w.start(profile="ros2", library="test")
+        sid = w.register_schema(name=schema_name, encoding=schema_encoding,
+                                data=schema_text.encode())
+        cid = w.register_channel(topic="/wrench", message_encoding=message_encoding,
+                                 schema_id=sid)
+        for i in range(n):
+            w.add_message(channel_id=cid, log_time=2_000_000 * i, publish_time=2_000_000 * i,
+                          data=payload(i), sequence=i)
+        w.finish()
+    return path
+
+
+@pytest.mark.parametrize(
+    ("kwargs", "field"),
+    [
+        ({}, "message 1 on topic '/wrench'"),  # Float64 bytes under a WrenchStamped channel
+        ({"schema_text": "float64 data\n"}, "schema.data"),
+        ({"schema_text": "std_msgs/Header header\ngeometry_msgs/Vector3 wrench\n"},
+         "schema.data"),
+        ({"schema_encoding": "ros1msg"}, "schema.encoding"),
+        ({"schema_text": "this is not a message definition %%%\n"}, "schema.data"),
+    ],
+    ids=["float-bytes", "schema-float64", "schema-wrong-nested", "schema-ros1", "schema-junk"],
+)
+def test_channel_that_is_not_the_declared_type_is_refused(tmp_path, capsys, kwargs, field):
+    path = _one_channel(tmp_path / "w.mcap", **kwargs)
+    with pytest.raises(LogError) as info:
+        read_log(path)
+    assert field in str(info.value) and str(path) in str(info.value)
+    err = _exit_2(capsys, ["observe", path, "--preset", "table1", "--out", tmp_path / "e.csv"])
+    assert field in err
+
+
+def test_trailing_bytes_after_a_wrench_are_refused(tmp_path, log):
+    """A WrenchStamped payload with 8 extra bytes: the message size does not match the type."""
+    from rosbags.typesys import Stores, get_typestore
+
+    ts = get_typestore(Stores.ROS2_HUMBLE)
+    T = ts.types
+    V = T["geometry_msgs/msg/Vector3"]
+
+    def payload(i):
+        hdr = T["std_msgs/msg/Header"](stamp=T["builtin_interfaces/msg/Time"](
+            sec=1, nanosec=2_000_000 * i), frame_id="pad")
+        msg = T[WRENCH](header=hdr, wrench=T["geometry_msgs/msg/Wrench"](
+            force=V(0.0, 0.1, 2.0), torque=V(0.0, 0.0, 0.0)))
+        return bytes(ts.serialize_cdr(msg, WRENCH)) + b"\x00" * 8
+
+    path = _one_channel(tmp_path / "t.mcap",
+                        schema_text=ts.generate_msgdef(WRENCH, ros_version=2)[0],
+                        payload=payload)
+    with pytest.raises(LogError, match="size mismatch"):
+        read_log(path)
+
+
+def test_standard_schema_text_is_accepted(tmp_path, log):
+    """The standard definition (as recorders store it) passes the schema check."""
+    path = write_log(log, tmp_path / "ok.mcap")
+    out = read_log(path)
+    assert np.allclose(out.f_n, log.f_n)
+
+
+def test_a_recording_cut_short_still_reads_with_a_warning(tmp_path, log):
+    """Truncation (a crash) is not corruption: the complete chunks read, with a warning."""
+    from lugrip import LogWarning
+
+    path = tmp_path / "cut.mcap"
+    data = simulate_maneuvers(ContactParams.table1(), 6, seed=2).log
+    write_log(data, path)
+    raw = path.read_bytes()
+    # cut inside the summary section (after DataEnd): every message was read and checked
+    marker = b"\x0f" + struct.pack("<Q", 4)
+    end = raw.rfind(marker) + 13
+    cut = tmp_path / "cut2.mcap"
+    cut.write_bytes(raw[: end + 20])
+    with pytest.warns(LogWarning, match="truncated"):
+        out = read_log(cut)
+    assert len(out) == len(data)
