@@ -208,3 +208,93 @@ def test_a_recording_cut_short_still_reads_with_a_warning(tmp_path, log):
     with pytest.warns(LogWarning, match="truncated"):
         out = read_log(cut)
     assert len(out) == len(data)
+
+
+# --- ROS time stamps ----------------------------------------------------------------------------
+
+def _stamped(path, log, stamps_ns, log_ns=None):
+    """The log as WrenchStamped messages with the given header stamps; log times increasing
+    at the log's rate (what a recorder sees when the sensor's clock misbehaves)."""
+    from rosbags.typesys import Stores, get_typestore
+
+    ts = get_typestore(Stores.ROS2_HUMBLE)
+    T = ts.types
+    V = T["geometry_msgs/msg/Vector3"]
+    if log_ns is None:
+        log_ns = 1_000_000_000 + np.round(log.t * 1e9).astype(np.int64)
+    with open(path, "wb") as fh:
+        w = Writer(fh, compression=CompressionType.NONE)
+        w.start(profile="ros2", library="test")
+        sid = w.register_schema(name=WRENCH, encoding="ros2msg",
+                                data=ts.generate_msgdef(WRENCH, ros_version=2)[0].encode())
+        cid = w.register_channel(topic="/ft", message_encoding="cdr", schema_id=sid)
+        for i in range(len(log)):
+            s = int(stamps_ns[i])
+            hdr = T["std_msgs/msg/Header"](stamp=T["builtin_interfaces/msg/Time"](
+                sec=s // 10**9, nanosec=s % 10**9), frame_id="pad")
+            msg = T[WRENCH](header=hdr, wrench=T["geometry_msgs/msg/Wrench"](
+                force=V(0.0, float(log.f_t[i]), float(log.f_n[i])),
+                torque=V(0.0, 0.0, float(log.tau[i]))))
+            w.add_message(channel_id=cid, log_time=int(log_ns[i]), publish_time=int(log_ns[i]),
+                          data=bytes(ts.serialize_cdr(msg, WRENCH)), sequence=i)
+        w.finish()
+    return path
+
+
+def test_header_clock_jumping_back_is_an_error_with_a_log_time_option(tmp_path, capsys, log):
+    """The sensor clock jumps back 10 s at sample 500 (it interleaved samples 10 s apart with
+    a warning): exit 2 naming the topic and the count; --time-source log reads it in order."""
+    stamps = 5_000_000_000 + np.round(log.t * 1e9).astype(np.int64)
+    stamps[500:] -= 10_000_000_000
+    path = _stamped(tmp_path / "jump.mcap", log, stamps)
+    with pytest.raises(LogError, match=r"topic '/ft'.*go backwards at 1 of \d+ messages, "
+                                       r"first at message 501 \(by 9.998 s") as info:
+        read_log(path)
+    assert "time_source='log'" in str(info.value)
+    err = _exit_2(capsys, ["observe", path, "--preset", "table1", "--out", tmp_path / "e.csv"])
+    assert "'/ft'" in err and "--time-source log" in err
+    got = read_log(path, time_source="log")
+    assert len(got) == len(log) and np.all(np.diff(got.t) > 0)
+    np.testing.assert_allclose(got.t - got.t[0], log.t - log.t[0], atol=1e-9)
+    assert got.meta["time_source"] == "log"
+    assert main(["observe", str(path), "--preset", "table1", "--out", str(tmp_path / "e.csv"),
+                 "--time-source", "log"]) == 0
+
+
+def test_identical_stamps_are_an_error_not_one_sample(tmp_path, capsys, log):
+    """Every header stamp identical (the recording became one sample, exit 0): exit 2 naming
+    the topic and the count; by log time the recording reads whole."""
+    stamps = np.full(len(log), 7_000_000_000, dtype=np.int64)
+    path = _stamped(tmp_path / "same.mcap", log, stamps)
+    n = len(log)
+    with pytest.raises(LogError, match=rf"topic '/ft'.*{n - 1} of {n} messages"):
+        read_log(path)
+    _exit_2(capsys, ["observe", path, "--preset", "table1", "--out", tmp_path / "e.csv"])
+    assert len(read_log(path, time_source="log")) == n
+
+
+def test_duplicated_stamps_up_to_the_stated_fraction_are_dropped(tmp_path, log):
+    """1 % of the messages duplicated: dropped with a warning; one more: an error."""
+    from lugrip import LogWarning
+    from lugrip.io._ros import MAX_DUPLICATE_FRACTION
+
+    n = len(log)
+    allowed = int(MAX_DUPLICATE_FRACTION * n)
+    base = 5_000_000_000 + np.round(log.t * 1e9).astype(np.int64)
+    stamps = base.copy()
+    idx = np.arange(1, n, n // (allowed + 2))[: allowed + 1]
+    stamps[idx[:allowed]] = stamps[idx[:allowed] - 1]
+    with pytest.warns(LogWarning, match=rf"{allowed} message\(s\) with a duplicated time"):
+        got = read_log(_stamped(tmp_path / "few.mcap", log, stamps))
+    assert len(got) == n - allowed
+    stamps[idx] = base[idx - 1]
+    with pytest.raises(LogError, match=rf"{allowed + 1} of {n} messages"):
+        read_log(_stamped(tmp_path / "many.mcap", log, stamps))
+
+
+def test_time_source_applies_to_ros_sources_only(tmp_path, log):
+    path = write_log(log, tmp_path / "x.csv")
+    with pytest.raises(LogError, match="time_source"):
+        read_log(path, time_source="log")
+    with pytest.raises(LogError, match="time_source 'clock'"):
+        read_log(write_log(log, tmp_path / "x.mcap"), time_source="clock")
