@@ -205,16 +205,22 @@ def write_estimates(path: Path, log, run, *, force: bool = False) -> Path:
 
         def body(fh):
             n = len(cols["t"])
-            out = [",".join(OUTPUT_COLUMNS)]
-            reprs = {k: (v.tolist() if k != "status" else v) for k, v in cols.items()}
-            for i in range(n):
-                out.append(
-                    ",".join(
-                        repr(reprs[k][i]) if isinstance(reprs[k][i], float) else str(reprs[k][i])
-                        for k in OUTPUT_COLUMNS
+            fh.write((",".join(OUTPUT_COLUMNS) + "\n").encode())
+            chunk = 50_000  # rows per write: the text of the whole file is never in memory
+            for a in range(0, n, chunk):
+                b = min(a + chunk, n)
+                reprs = {k: (cols[k][a:b].tolist() if k != "status" else cols[k][a:b])
+                         for k in OUTPUT_COLUMNS}
+                out = []
+                for i in range(b - a):
+                    out.append(
+                        ",".join(
+                            repr(reprs[k][i]) if isinstance(reprs[k][i], float)
+                            else str(reprs[k][i])
+                            for k in OUTPUT_COLUMNS
+                        )
                     )
-                )
-            fh.write(("\n".join(out) + "\n").encode())
+                fh.write(("\n".join(out) + "\n").encode())
     elif suffix in (".parquet", ".pq"):
         try:
             import pyarrow as pa
