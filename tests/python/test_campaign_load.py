@@ -59,6 +59,7 @@ def _bad_estimator(tmp_path):
     ("make", "field"),
     [
         (lambda tmp: _doc(duration=-1), "duration"),
+        (lambda tmp: _doc(seed=2**80), "seed"),
         (_bad_estimator, "est.yaml"),
         (lambda tmp: _doc(parameters=_doc()["parameters"] | {
             "mass": {"distribution": "constant", "value": 1e-300}}), "parameters.mass"),
@@ -66,7 +67,7 @@ def _bad_estimator(tmp_path):
             "mass": {"distribution": "uniform", "low": 1e-300, "high": 0.4}}),
          "low bound of parameters.mass"),
     ],
-    ids=["duration-negative", "estimator-file", "mass-1e-300", "mass-range-to-1e-300"],
+    ids=["duration-negative", "seed-2**80", "estimator-file", "mass-1e-300", "mass-range-to-1e-300"],
 )
 def test_definition_errors_are_exit_2_at_load(tmp_path, capsys, make, field):
     """Each was 0 % success with exit 0 (every run stored as failed): now exit 2 naming the

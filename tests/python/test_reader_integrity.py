@@ -358,3 +358,35 @@ def test_clean_files_of_other_rigs_pass_the_block_checks(tmp_path):
         log = simulate_maneuvers(ContactParams.preset(name), 12, seed=10 + k,
                                  noise=(0.05, 1e-4)).log
         assert len(read_log(write_log(log, tmp_path / f"{name}.csv"))) == len(log)
+
+
+@pytest.mark.parametrize("t0", ["abc", "1e9", "99999999999999999999999999999"])
+def test_bad_metadata_t0_names_the_file_and_field(tmp_path, capsys, log, t0):
+    """lugrip's MCAP metadata record with a t0_ns that is not an integer (a ValueError that
+    named no file): exit 2 naming the file and the field."""
+    from rosbags.typesys import Stores, get_typestore
+
+    ts = get_typestore(Stores.ROS2_HUMBLE)
+    path = tmp_path / "meta.mcap"
+    T = ts.types
+    V = T["geometry_msgs/msg/Vector3"]
+    with open(path, "wb") as fh:
+        w = Writer(fh, compression=CompressionType.NONE)
+        w.start(profile="ros2", library="test")
+        sid = w.register_schema(name=WRENCH, encoding="ros2msg",
+                                data=ts.generate_msgdef(WRENCH, ros_version=2)[0].encode())
+        cid = w.register_channel(topic="/ft", message_encoding="cdr", schema_id=sid)
+        w.add_metadata("lugrip.sliding_log", {"wrench_topic": "/ft", "t0_ns": t0})
+        for i in range(20):
+            ns = 10**9 + 2_000_000 * i
+            hdr = T["std_msgs/msg/Header"](stamp=T["builtin_interfaces/msg/Time"](
+                sec=ns // 10**9, nanosec=ns % 10**9), frame_id="pad")
+            msg = T[WRENCH](header=hdr, wrench=T["geometry_msgs/msg/Wrench"](
+                force=V(0.0, 0.1, 2.0), torque=V(0.0, 0.0, 1e-4)))
+            w.add_message(channel_id=cid, log_time=ns, publish_time=ns,
+                          data=bytes(ts.serialize_cdr(msg, WRENCH)), sequence=i)
+        w.finish()
+    with pytest.raises(LogError, match="t0_ns"):
+        read_log(path)
+    err = _exit_2(capsys, ["observe", path, "--preset", "table1", "--out", tmp_path / "e.csv"])
+    assert "meta.mcap" in err and "t0_ns" in err

@@ -5,7 +5,7 @@ simulator accepts the grasps the distributions draw (a duration of -1 s, an esti
 is not a parameter file, a mass of 1e-300 kg were stored as failed runs, 0 % success, exit 0).
 :func:`validate_campaign` builds those grasps without simulating them:
 
-* the base scenario's duration;
+* the seed (stored as a 64-bit integer with the results) and the base scenario's duration;
 * run 0 with every controller: the plant, the estimator, the controller and the observer are
   built and the closed loop steps a few samples (patch and lumped plants) or the MuJoCo scene
   is specified (MuJoCo plant); the static grasp force of the object's weight, which the run's
@@ -98,6 +98,9 @@ def validate_campaign(campaign: Campaign) -> None:
     """Raise CampaignError (file and field named) when a run of ``campaign`` would fail for a
     reason in its definition; see the module docstring for what is built."""
     where = str(campaign.source) if campaign.source else "campaign"
+    if campaign.seed >= 2**63:  # stored in the results' int64 column (it failed there)
+        raise CampaignError(f"{where}: seed: an integer of {campaign.seed.bit_length()} bits; "
+                            "must be < 2**63 (the results store it as a 64-bit integer)")
     base = campaign.base_scenario()
     duration = float(base.duration)
     if not (math.isfinite(duration) and duration > 0.0):

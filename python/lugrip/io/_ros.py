@@ -277,6 +277,15 @@ def to_contact(f: np.ndarray, m: np.ndarray, offset: float) -> tuple[np.ndarray,
     return tau, np.c_[x, y]
 
 
+def _metadata_t0(src: RosSource) -> int:
+    """The ``t0_ns`` field of lugrip's MCAP metadata record (an integer of nanoseconds)."""
+    text = str(src.metadata["t0_ns"]).strip()
+    if len(text) > 24 or not text.lstrip("-").isdigit() or abs(int(text)) >= 2**63:
+        raise LogError(src.file, f"metadata record {_MCAP_META!r}: field t0_ns is not an "
+                       "integer of nanoseconds")
+    return int(text)
+
+
 def read_ros(src: RosSource, *, wrench_topic: str | None, omega_topic: str | None,
              maneuver_topic: str | None, flip_normal: bool, contact_offset: float | None,
              stacklevel: int, scalar_topics=None, time_source: str = "header"):
@@ -308,7 +317,7 @@ def read_ros(src: RosSource, *, wrench_topic: str | None, omega_topic: str | Non
     keep = ordered(file, wrench, stamps, "t", stacklevel + 1, used)
     stamps = stamps[keep]
     log_ns = np.asarray(wrench.log_ns, dtype=np.int64)[keep]
-    t0 = int(src.metadata["t0_ns"]) if "t0_ns" in src.metadata else int(stamps[0])
+    t0 = _metadata_t0(src) if "t0_ns" in src.metadata else int(stamps[0])
     t = (stamps - t0) / 1e9
     v = np.asarray(wrench.values, dtype=np.float64)[keep]
     sign = -1.0 if flip_normal else 1.0  # rotation by pi about x: y and z components flip
