@@ -179,6 +179,26 @@ def test_a_failed_write_leaves_the_old_file_and_no_temporary(tmp_path):
     assert _sha(out) == before and _leftovers(tmp_path) == []
 
 
+def test_disk_full_names_the_output_and_keeps_the_old_file(tmp_path):
+    """ENOSPC while writing: one line naming the output (not the temporary), the old file
+    intact, no temporary left."""
+    import errno
+
+    out = tmp_path / "o.csv"
+    out.write_text("old\n")
+    before = _sha(out)
+
+    def body(fh):
+        fh.write(b"partial")
+        raise OSError(errno.ENOSPC, os.strerror(errno.ENOSPC))
+
+    from lugrip.commands._output import atomic_write
+
+    with pytest.raises(OutputError, match=r"cannot write .*o\.csv: No space left on device"):
+        atomic_write(out, body, force=True)
+    assert _sha(out) == before and _leftovers(tmp_path) == []
+
+
 def test_a_file_created_during_the_work_is_not_replaced_without_force(tmp_path):
     out = tmp_path / "o.csv"
     check_file(out, force=False)

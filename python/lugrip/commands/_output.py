@@ -241,8 +241,13 @@ def staged_path(path: str | os.PathLike, what: str = "--out", *, force: bool,
     os.close(fd)
     try:
         yield Path(tmp)
-        with open(tmp, "rb+") as fh:  # on disk before the rename
-            os.fsync(fh.fileno())
+        try:
+            with open(tmp, "rb+") as fh:  # on disk before the rename
+                os.fsync(fh.fileno())
+        except OSError as err:
+            raise OutputError(f"argument {what}: cannot write {shown}: "
+                              f"{err.strerror or type(err).__name__}; nothing was changed"
+                              ) from None
         _commit(tmp, target, shown, what, force)
     finally:
         with contextlib.suppress(OSError):
@@ -254,8 +259,13 @@ def atomic_write(path: str | os.PathLike, body: Callable, what: str = "--out", *
     """Write ``path`` through ``body(fh)`` (``fh`` a binary file object) under the policy:
     temporary file, flushed and renamed into place; removed on any failure."""
     with staged_path(path, what, force=force, create_parent=create_parent) as tmp:
-        with open(tmp, "wb") as fh:
-            body(fh)
+        try:
+            with open(tmp, "wb") as fh:
+                body(fh)
+        except OSError as err:  # disk full, quota, I/O error: named for the output, not the temp
+            raise OutputError(f"argument {what}: cannot write {path}: "
+                              f"{err.strerror or type(err).__name__}; nothing was changed"
+                              ) from None
     return Path(path)
 
 
