@@ -390,3 +390,41 @@ def test_bad_metadata_t0_names_the_file_and_field(tmp_path, capsys, log, t0):
         read_log(path)
     err = _exit_2(capsys, ["observe", path, "--preset", "table1", "--out", tmp_path / "e.csv"])
     assert "meta.mcap" in err and "t0_ns" in err
+
+
+def _bag_with_definition(path, msgdef: str, payload):
+    from rosbags.rosbag1 import Writer as BagWriter
+    from rosbags.typesys import Stores, get_types_from_msg, get_typestore
+
+    own = get_typestore(Stores.EMPTY)
+    own.register(get_types_from_msg(msgdef, WRENCH))
+    with BagWriter(path) as w:
+        c = w.add_connection("/ft", WRENCH, msgdef=msgdef,
+                             md5sum=own.generate_msgdef(WRENCH)[1])
+        for i in range(30):
+            w.write(c, 10**9 + 2_000_000 * i, payload(i))
+    return path
+
+
+# WrenchStamped with float32 vectors: the field names of the standard message, other numbers
+_F32 = ("std_msgs/Header header\ngeometry_msgs/Wrench wrench\n" + "=" * 80 +
+        "\nMSG: std_msgs/Header\nuint32 seq\ntime stamp\nstring frame_id\n" + "=" * 80 +
+        "\nMSG: geometry_msgs/Wrench\ngeometry_msgs/Vector3 force\ngeometry_msgs/Vector3 torque\n"
+        + "=" * 80 + "\nMSG: geometry_msgs/Vector3\nfloat32 x\nfloat32 y\nfloat32 z\n")
+
+
+def test_bag_with_a_non_standard_definition_is_refused(tmp_path, capsys):
+    """A ROS 1 bag whose WrenchStamped definition has float32 vectors (the standard field
+    names, another layout): not the standard message, refused as in MCAP files, naming the
+    topic and the msgdef (it was read by its own definition)."""
+    pytest.importorskip("rosbags.rosbag1")
+
+    def payload(i):
+        head = struct.pack("<III", i, 1, 2_000_000 * i) + struct.pack("<I", 1) + b"p"
+        return head + struct.pack("<6f", 0.0, 0.1, 2.0, 0.0, 0.0, 1e-4)
+
+    path = _bag_with_definition(tmp_path / "f32.bag", _F32, payload)
+    with pytest.raises(LogError, match=r"topic '/ft'.*geometry_msgs/Vector3.*field msgdef"):
+        read_log(path)
+    err = _exit_2(capsys, ["observe", path, "--preset", "table1", "--out", tmp_path / "e.csv"])
+    assert "f32.bag" in err and "msgdef" in err
