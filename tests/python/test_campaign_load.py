@@ -185,3 +185,18 @@ def test_workers_die_with_a_killed_campaign(tmp_path):
             except OSError:
                 pass
     assert survivors == []
+
+
+@pytest.mark.parametrize("text", ["{not json", '{"name": "x"}', "[1, 2]", ""],
+                         ids=["broken", "no-campaign", "a-list", "empty"])
+def test_broken_campaign_json_is_named(tmp_path, capsys, text):
+    """A results folder whose campaign.json is broken: replay, report and a resumed run exit
+    2 naming the file (the message named no file)."""
+    d = tmp_path / "res"
+    d.mkdir()
+    (d / "campaign.json").write_text(text)
+    for argv in (["campaign", "report", d], ["campaign", "replay", d, "--run", 0]):
+        err = _exit_2(capsys, *argv)
+        assert "campaign.json" in err
+    err = _exit_2(capsys, "campaign", _write(tmp_path, _doc()), "--runs", 1, "--out", d)
+    assert "campaign.json" in err

@@ -19,8 +19,15 @@ def load_results_campaign(directory: str | Path) -> Campaign:
     meta = Path(directory) / "campaign.json"
     if not meta.is_file():
         raise CampaignError(f"{directory}: not a campaign results directory (no campaign.json)")
-    doc = json.loads(meta.read_text())
-    return campaign_from_doc(doc["campaign"])
+    try:
+        doc = json.loads(meta.read_text(encoding="utf-8"))
+        return campaign_from_doc(doc["campaign"])
+    except (ValueError, KeyError, TypeError) as err:  # broken JSON or not lugrip's document
+        if isinstance(err, CampaignError):
+            raise CampaignError(f"{meta}: {err}") from None
+        raise CampaignError(f"{meta}: not a campaign.json lugrip wrote ({type(err).__name__}"
+                            f"{': ' + str(err).splitlines()[0][:120] if str(err) else ''})"
+                            ) from None
 
 
 def replay(directory: str | Path, index: int, *, controllers=None, out: str | Path | None = None,

@@ -100,8 +100,10 @@ def check_campaign_out(out: Path, campaign, force: bool, inputs=()) -> bool:
         if fp == campaign.fingerprint():
             check_dir(out, "--out", force=True, results=REPORT_FILES, inputs=inputs)
             return True
+        name = doc.get("name") if isinstance(doc, dict) else None
         raise OutputError(f"argument --out: {out} holds results of another campaign definition "
-                          f"({doc.get('name')!s:.60}); use a new --out")
+                          f"({meta}: name {name!s:.60}, fingerprint {fp!s:.20}); use a new "
+                          "--out")
     stray = [n for n in RESULT_FILES if os.path.lexists(out / n)]
     if stray:
         raise OutputError(f"argument --out: {out} holds {', '.join(stray)} but no campaign.json: "
