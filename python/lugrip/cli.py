@@ -121,7 +121,7 @@ class _Terminated(BaseException):
     policy's temporary files are removed, commands/_output.py)."""
 
 
-def _on_sigterm(signum, frame):  # noqa: ARG001 (signal handler signature)
+def _on_sigterm(signum, frame):  # the signal handler signature
     raise _Terminated()
 
 

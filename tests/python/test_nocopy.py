@@ -8,10 +8,9 @@ from __future__ import annotations
 import copy
 import pickle
 
+import lugrip
 import numpy as np
 import pytest
-
-import lugrip
 from lugrip import ContactParams, Observer, SliderModel, SlipControl
 
 

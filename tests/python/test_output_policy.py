@@ -16,7 +16,6 @@ import time
 from pathlib import Path
 
 import pytest
-
 from lugrip.cli import main
 from lugrip.commands._output import (
     OutputError,
@@ -172,10 +171,9 @@ def test_a_failed_write_leaves_the_old_file_and_no_temporary(tmp_path):
     out = tmp_path / "o.csv"
     out.write_text("old contents\n")
     before = _sha(out)
-    with pytest.raises(RuntimeError):
-        with staged_path(out, force=True) as tmp:
-            tmp.write_text("half")
-            raise RuntimeError("disk full")
+    with pytest.raises(RuntimeError), staged_path(out, force=True) as tmp:
+        tmp.write_text("half")
+        raise RuntimeError("disk full")
     assert _sha(out) == before and _leftovers(tmp_path) == []
 
 
@@ -202,10 +200,9 @@ def test_disk_full_names_the_output_and_keeps_the_old_file(tmp_path):
 def test_a_file_created_during_the_work_is_not_replaced_without_force(tmp_path):
     out = tmp_path / "o.csv"
     check_file(out, force=False)
-    with pytest.raises(OutputError, match="exists"):
-        with staged_path(out, force=False) as tmp:
-            tmp.write_text("ours")
-            out.write_text("someone else's")  # appears between the check and the rename
+    with pytest.raises(OutputError, match="exists"), staged_path(out, force=False) as tmp:
+        tmp.write_text("ours")
+        out.write_text("someone else's")  # appears between the check and the rename
     assert out.read_text() == "someone else's" and _leftovers(tmp_path) == []
 
 

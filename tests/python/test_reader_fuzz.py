@@ -27,7 +27,6 @@ import numpy as np
 import pytest
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
-
 from lugrip import ContactParams, LogError, LogWarning, read_log, write_log
 from lugrip.sliding import simulate_maneuvers
 
@@ -152,7 +151,7 @@ def test_csv_visible_corruptions_are_refused(base, data):
         column = "t"
     path = base["dir"] / "vis.csv"
     path.write_text("\n".join(lines) + "\n")
-    log, err, _ = _read(path)
+    _log, err, _ = _read(path)
     assert err is not None, f"{kind} at row {r} ({column}) accepted"
     if column is not None and column != "," and "," not in str(column):
         assert err.column in (column, None) or err.row == r, str(err)

@@ -15,11 +15,10 @@ import pytest
 
 pytest.importorskip("mcap")
 pytest.importorskip("rosbags")
-from mcap.writer import CompressionType, Writer  # noqa: E402  (imported before any monkeypatch)
-
-from lugrip import ContactParams, LogError, read_log, write_log  # noqa: E402
-from lugrip.cli import main  # noqa: E402
-from lugrip.sliding import simulate_maneuvers  # noqa: E402
+from lugrip import ContactParams, LogError, read_log, write_log
+from lugrip.cli import main
+from lugrip.sliding import simulate_maneuvers
+from mcap.writer import CompressionType, Writer
 
 WRENCH = "geometry_msgs/msg/WrenchStamped"
 
@@ -90,7 +89,7 @@ def _unchunked(path, log):
                                 data=ts.generate_msgdef(WRENCH, ros_version=2)[0].encode())
         cid = w.register_channel(topic="/wrench", message_encoding="cdr", schema_id=sid)
         for i in range(len(log)):
-            ns = 1_000_000_000 + int(round(log.t[i] * 1e9))
+            ns = 1_000_000_000 + int(np.rint(log.t[i] * 1e9))
             hdr = T["std_msgs/msg/Header"](
                 stamp=T["builtin_interfaces/msg/Time"](sec=ns // 10**9, nanosec=ns % 10**9),
                 frame_id="pad")

@@ -38,7 +38,7 @@ class _Drawn:
         self._campaign = campaign
         self._values = values
 
-    def draw(self, index: int) -> dict[str, float]:  # noqa: ARG002 (the same for any run)
+    def draw(self, index: int) -> dict[str, float]:
         return dict(self._values)
 
     def __getattr__(self, name: str) -> Any:
