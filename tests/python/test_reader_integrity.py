@@ -427,3 +427,23 @@ def test_bag_with_a_non_standard_definition_is_refused(tmp_path, capsys):
         read_log(path)
     err = _exit_2(capsys, ["observe", path, "--preset", "table1", "--out", tmp_path / "e.csv"])
     assert "f32.bag" in err and "msgdef" in err
+
+
+@pytest.mark.parametrize("q", [50.0, 90.0])
+def test_window_percentiles_match_numpy(q):
+    """The per-block statistic (one sort per window) equals np.percentile of each window's
+    used samples; windows with fewer than a quarter used are NaN."""
+    from lugrip.io._log import _window_stat
+
+    rng = np.random.default_rng(1)
+    x = rng.lognormal(size=10_037)
+    use = rng.random(x.size) > 0.3
+    use[400:600] = False  # a window without enough samples
+    starts, stat = _window_stat(x, use, 200, q)
+    for s, v in zip(starts, stat):
+        sel = x[s:s + 200][use[s:s + 200]]
+        if sel.size >= 50:
+            assert v == pytest.approx(np.percentile(sel, q), rel=1e-12)
+        else:
+            assert np.isnan(v)
+    assert starts[-1] == x.size - 200
