@@ -335,3 +335,23 @@ def test_sigterm_during_a_write_removes_the_temporary(tmp_path):
             proc.kill()
     assert rc == 143, proc.stderr.read()
     assert _sha(out) == before and _leftovers(tmp_path) == []
+
+
+def test_report_files_are_replaced_atomically(tmp_path, monkeypatch):
+    """The library's report writer (campaign report, demo report, identify --report):
+    permissions kept, and a failure before the rename leaves the old file and no temporary."""
+    from lugrip._atomic import write_text_atomic
+
+    path = tmp_path / "report.md"
+    path.write_text("old\n")
+    os.chmod(path, 0o640)
+    write_text_atomic(path, "new\n")
+    assert path.read_text() == "new\n" and stat.S_IMODE(os.stat(path).st_mode) == 0o640
+
+    def fail(src, dst):
+        raise OSError(28, "No space left on device")
+
+    monkeypatch.setattr(os, "replace", fail)
+    with pytest.raises(OSError):
+        write_text_atomic(path, "newer\n")
+    assert path.read_text() == "new\n" and _leftovers(tmp_path) == []

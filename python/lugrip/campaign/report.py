@@ -279,8 +279,10 @@ def write_report(directory: str | Path, campaign: Campaign, rows: Sequence[dict]
 
             paths["failure_map"] = plot.save(fig, d / "failure_map.png")
             fig_name = "failure_map.png"
-    (d / "report.json").write_text(json.dumps(data, indent=1, default=str))
-    (d / "report.md").write_text(markdown(data, fig_name))
+    from .._atomic import write_text_atomic
+
+    write_text_atomic(d / "report.json", json.dumps(data, indent=1, default=str))
+    write_text_atomic(d / "report.md", markdown(data, fig_name))
     paths["json"] = d / "report.json"
     paths["markdown"] = d / "report.md"
     return paths

@@ -147,8 +147,9 @@ def run_demo(out_dir: str | Path, steps: list[DemoStep] | None = None,
         "",
         *sections,
     ])
-    path = out_dir / REPORT_NAME
-    path.write_text(report)
+    from .._atomic import write_text_atomic
+
+    path = write_text_atomic(out_dir / REPORT_NAME, report)
     return path, failed
 
 

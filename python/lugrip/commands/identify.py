@@ -270,19 +270,19 @@ def write_report(result, out_dir: Path, *, title: str | None = None) -> list[Pat
     import numpy as np
 
     from .. import plot
+    from .._atomic import write_text_atomic
 
     out_dir = Path(out_dir)
     out_dir.mkdir(parents=True, exist_ok=True)
     written = []
-    path = out_dir / "identification.txt"
-    path.write_text(result.summary() + "\n")
+    path = write_text_atomic(out_dir / "identification.txt", result.summary() + "\n")
     written.append(path)
     path = out_dir / "maneuver_rmse.csv"
     val = set(result.validation_keys)
     lines = ["maneuver,set,rmse_rad_s"]
     for key, v in result.maneuver_rmse.items():
         lines.append(f"{key},{'validation' if key in val else 'train'},{v:.6g}")
-    path.write_text("\n".join(lines) + "\n")
+    write_text_atomic(path, "\n".join(lines) + "\n")
     written.append(path)
     written.append(result.save_yaml(out_dir / "params.yaml"))
 
