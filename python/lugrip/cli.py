@@ -73,6 +73,10 @@ def _one_line(err: BaseException) -> str:
     return line if len(line) <= _MAX_MESSAGE else line[: _MAX_MESSAGE - 5] + " [...]"
 
 
+#: Arguments that name outputs (never reported as the input a message is about).
+_OUTPUT_ARGS = ("out", "output", "run", "json", "video", "csv", "plot", "report")
+
+
 def _input_files(args: argparse.Namespace) -> str:
     """'FILE: ' for the one existing input file among the arguments (outputs excluded), or
     'one of A, B: ' for several; '' when none is known."""
@@ -80,7 +84,7 @@ def _input_files(args: argparse.Namespace) -> str:
 
     files = []
     for name, value in vars(args).items():
-        if name in ("out", "output", "run") or not isinstance(value, (str, os.PathLike)):
+        if name in _OUTPUT_ARGS or not isinstance(value, (str, os.PathLike)):
             continue
         try:
             if Path(value).is_file():
