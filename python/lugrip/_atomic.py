@@ -4,6 +4,7 @@
 from __future__ import annotations
 
 import contextlib
+import errno
 import os
 import tempfile
 from pathlib import Path
@@ -14,9 +15,12 @@ __all__ = ["write_text_atomic"]
 def write_text_atomic(path: str | os.PathLike, text: str) -> Path:
     """Write ``text`` (UTF-8) to a temporary file next to ``path``, flush it to disk and rename
     it over ``path``: readers see the old file or the new one, never a part. The temporary is
-    removed when anything fails. A file that is there keeps its permissions."""
+    removed when anything fails. A file that is there keeps its permissions; a device, FIFO or
+    directory at ``path`` is refused (OSError), never replaced."""
     path = Path(path)
     target = Path(os.path.realpath(path))
+    if target.exists() and not target.is_file():  # a rename would replace a device or FIFO
+        raise OSError(errno.EINVAL, "not a regular file, not replaced", str(path))
     fd, tmp = tempfile.mkstemp(dir=target.parent, prefix=f".{target.name}.", suffix=".part")
     try:
         with os.fdopen(fd, "wb") as fh:

@@ -351,6 +351,11 @@ def test_report_files_are_replaced_atomically(tmp_path, monkeypatch):
     def fail(src, dst):
         raise OSError(28, "No space left on device")
 
+    fifo = tmp_path / "fifo.md"
+    os.mkfifo(fifo)
+    with pytest.raises(OSError, match="not a regular file"):
+        write_text_atomic(fifo, "x")
+    assert stat.S_ISFIFO(os.stat(fifo).st_mode)
     monkeypatch.setattr(os, "replace", fail)
     with pytest.raises(OSError):
         write_text_atomic(path, "newer\n")

@@ -8,6 +8,7 @@ import types
 from pathlib import Path
 from typing import Any
 
+from .._atomic import write_text_atomic
 from .definition import Campaign, CampaignError
 from .runner import campaign_from_doc, simulate_run
 
@@ -89,7 +90,7 @@ def replay(directory: str | Path, index: int, *, controllers=None, out: str | Pa
                 paths[name] = plot.save(fig, out_dir / f"replay_{index}_{name}.png")
     doc["figures"] = {k: str(v) for k, v in paths.items()}
     path = out_dir / f"replay_{index}.json"
-    path.write_text(json.dumps(doc, indent=1, default=str))
+    write_text_atomic(path, json.dumps(doc, indent=1, default=str))
     doc["json"] = str(path)
     return doc
 
