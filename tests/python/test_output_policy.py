@@ -360,3 +360,23 @@ def test_report_files_are_replaced_atomically(tmp_path, monkeypatch):
     with pytest.raises(OSError):
         write_text_atomic(path, "newer\n")
     assert path.read_text() == "new\n" and _leftovers(tmp_path) == []
+
+
+def test_a_failed_figure_keeps_the_old_one(tmp_path):
+    """lugrip.plot.save writes through a temporary: a figure that fails to render leaves the
+    earlier file and no temporary."""
+    from lugrip import plot
+
+    fig, ax = plot.new_figure(1, 1)
+    ax.plot([0, 1], [0, 1])
+    path = plot.save(fig, tmp_path / "f.png")
+    before = _sha(path)
+    ax.plot([0, 1], [1, 0])
+
+    def broken(*args, **kwargs):
+        raise RuntimeError("renderer failed")
+
+    fig.savefig = broken
+    with pytest.raises(RuntimeError):
+        plot.save(fig, path)
+    assert _sha(path) == before and _leftovers(tmp_path) == []
