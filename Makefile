@@ -26,7 +26,7 @@ $(VENV)/.installed: $(VPY) $(SOURCES)
 install: $(VENV)/.installed
 
 demo: install
-	$(VENV)/bin/lugrip demo --out $(OUT)
+	$(VENV)/bin/lugrip demo --out $(OUT) --force
 
 test: test-cpp test-install test-python
 

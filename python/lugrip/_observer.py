@@ -20,6 +20,7 @@ import numpy as np
 
 from . import _core
 from ._contact import Status, _as_params, _flat, _model, _params_path, _shaped
+from ._nocopy import NoCopy
 from ._params import read_observer_settings
 from ._yaml import to_number
 
@@ -176,7 +177,7 @@ def _column(log, name: str):
     return np.ascontiguousarray(np.asarray(value, dtype=np.float64)).reshape(-1)
 
 
-class Observer:
+class Observer(NoCopy):
     """Sliding-velocity observer of one fingertip (paper eqs. 21-23, docs/model.md 7).
 
     Per sample: CoR estimate from f_n, f_t and the low-pass filtered torque (raw torque for
@@ -433,7 +434,7 @@ class SliderTrajectory:
     status: np.ndarray
 
 
-class SliderModel:
+class SliderModel(NoCopy):
     """The planar slider of eqs. 1-2 about a given (virtual) CoR, for simulators and tests.
 
     State z [rad], omega [rad/s]; inertia J [kg m^2] about the CoR axis; per step the normal

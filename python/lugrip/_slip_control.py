@@ -22,6 +22,7 @@ from ._controller import (
     _code,
     _core_settings,
 )
+from ._nocopy import NoCopy
 from ._observer import Observer
 from ._params import ContactParams, read_observer_settings
 
@@ -52,7 +53,7 @@ class SlipControlRun(dict):
         return {name: self[name + suffix] for name in names if name + suffix in self}
 
 
-class SlipControl:
+class SlipControl(NoCopy):
     """Slip detection and grasp-force control for a parallel gripper with one or two
     force/torque fingertips (paper eqs. 19-23 and 34-37; docs/model.md §7, §9).
 

@@ -73,6 +73,10 @@ def _one_line(err: BaseException) -> str:
     return line if len(line) <= _MAX_MESSAGE else line[: _MAX_MESSAGE - 5] + " [...]"
 
 
+#: Arguments that name outputs (never reported as the input a message is about).
+_OUTPUT_ARGS = ("out", "output", "run", "json", "video", "csv", "plot", "report")
+
+
 def _input_files(args: argparse.Namespace) -> str:
     """'FILE: ' for the one existing input file among the arguments (outputs excluded), or
     'one of A, B: ' for several; '' when none is known."""
@@ -80,7 +84,7 @@ def _input_files(args: argparse.Namespace) -> str:
 
     files = []
     for name, value in vars(args).items():
-        if name in ("out", "output", "run") or not isinstance(value, (str, os.PathLike)):
+        if name in _OUTPUT_ARGS or not isinstance(value, (str, os.PathLike)):
             continue
         try:
             if Path(value).is_file():
@@ -116,6 +120,31 @@ def _input_error(err: BaseException, args: argparse.Namespace) -> str | None:
     return None
 
 
+class _Terminated(BaseException):
+    """SIGTERM, raised in the main thread so that every ``finally`` block runs (the output
+    policy's temporary files are removed, commands/_output.py)."""
+
+
+def _on_sigterm(signum, frame):  # the signal handler signature
+    raise _Terminated()
+
+
+def _sigterm_handler():
+    """Installs the SIGTERM handler when SIGTERM has its default action and this is the main
+    thread; returns the previous handler to restore, or None."""
+    import signal
+    import threading
+
+    if threading.current_thread() is not threading.main_thread():
+        return None
+    try:
+        if signal.getsignal(signal.SIGTERM) is not signal.SIG_DFL:
+            return None
+        return signal.signal(signal.SIGTERM, _on_sigterm)
+    except (ValueError, OSError, AttributeError):
+        return None
+
+
 def main(argv: list[str] | None = None) -> int:
     """Entry point of the ``lugrip`` script; returns the exit code (0 ok, 2 user error)."""
     parser = build_parser()
@@ -128,8 +157,22 @@ def main(argv: list[str] | None = None) -> int:
         return exit_.code if isinstance(exit_.code, int) else 0
 
     prog = f"lugrip {args.command}"
+    previous = _sigterm_handler()
+    try:
+        return _run(args, prog)
+    finally:
+        if previous is not None:
+            import signal
+
+            signal.signal(signal.SIGTERM, previous)
+
+
+def _run(args: argparse.Namespace, prog: str) -> int:
     try:
         return int(args.run(args) or 0)
+    except _Terminated:
+        print(f"{prog}: terminated", file=sys.stderr)
+        return 143
     except BrokenPipeError:  # e.g. `lugrip ls | head`: not an error
         try:  # silence the second failure when Python flushes stdout at exit
             os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())

@@ -70,7 +70,6 @@ from pathlib import Path
 from typing import Any
 
 import numpy as np
-import yaml
 
 __all__ = [
     "CONTROLLERS",
@@ -906,11 +905,10 @@ def load_campaign(path: str | Path) -> Campaign:
     p = Path(path)
     if not p.is_file():
         raise CampaignError(f"campaign file {p} does not exist")
-    try:
-        with open(p) as f:
-            data = yaml.safe_load(f)
-    except yaml.YAMLError as err:
-        line = getattr(getattr(err, "problem_mark", None), "line", None)
-        where = f" (line {line + 1})" if line is not None else ""
-        raise CampaignError(f"{p}: not valid YAML{where}") from None
+    from .._yaml import load_yaml
+
+    try:  # the limits every YAML file lugrip reads goes through (size, depth, aliases)
+        data = load_yaml(p)
+    except ValueError as err:  # YamlLimitError: names the file and the line
+        raise CampaignError(str(err)) from None
     return Campaign.from_dict(data, source=p)

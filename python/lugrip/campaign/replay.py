@@ -8,6 +8,7 @@ import types
 from pathlib import Path
 from typing import Any
 
+from .._atomic import write_text_atomic
 from .definition import Campaign, CampaignError
 from .runner import campaign_from_doc, simulate_run
 
@@ -19,8 +20,15 @@ def load_results_campaign(directory: str | Path) -> Campaign:
     meta = Path(directory) / "campaign.json"
     if not meta.is_file():
         raise CampaignError(f"{directory}: not a campaign results directory (no campaign.json)")
-    doc = json.loads(meta.read_text())
-    return campaign_from_doc(doc["campaign"])
+    try:
+        doc = json.loads(meta.read_text(encoding="utf-8"))
+        return campaign_from_doc(doc["campaign"])
+    except (ValueError, KeyError, TypeError) as err:  # broken JSON or not lugrip's document
+        if isinstance(err, CampaignError):
+            raise CampaignError(f"{meta}: {err}") from None
+        raise CampaignError(f"{meta}: not a campaign.json lugrip wrote ({type(err).__name__}"
+                            f"{': ' + str(err).splitlines()[0][:120] if str(err) else ''})"
+                            ) from None
 
 
 def replay(directory: str | Path, index: int, *, controllers=None, out: str | Path | None = None,
@@ -84,7 +92,7 @@ def replay(directory: str | Path, index: int, *, controllers=None, out: str | Pa
                 paths[name] = plot.save(fig, out_dir / f"replay_{index}_{name}.png")
     doc["figures"] = {k: str(v) for k, v in paths.items()}
     path = out_dir / f"replay_{index}.json"
-    path.write_text(json.dumps(doc, indent=1, default=str))
+    write_text_atomic(path, json.dumps(doc, indent=1, default=str))
     doc["json"] = str(path)
     return doc
 

@@ -507,8 +507,10 @@ def write_report(directory: str | Path, campaign: Campaign, rows: Sequence[dict]
         if fig is not None:
             paths["frontier"] = plot.save(fig, d / "frontier.png")
             front_name = "frontier.png"
-    (d / "report.json").write_text(json.dumps(data, indent=1, default=str))
-    (d / "report.md").write_text(markdown(data, fig_name, front_name))
+    from .._atomic import write_text_atomic
+
+    write_text_atomic(d / "report.json", json.dumps(data, indent=1, default=str))
+    write_text_atomic(d / "report.md", markdown(data, fig_name, front_name))
     paths["json"] = d / "report.json"
     paths["markdown"] = d / "report.md"
     return paths

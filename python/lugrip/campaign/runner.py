@@ -419,6 +419,9 @@ _WORKER_CAMPAIGN: Campaign | None = None
 
 def _init_worker(campaign: Campaign) -> None:
     global _WORKER_CAMPAIGN
+    from ._lifetime import die_with_parent
+
+    die_with_parent()  # a killed campaign leaves no worker behind
     _WORKER_CAMPAIGN = campaign
 
 
@@ -540,6 +543,9 @@ def run_campaign(
         raise CampaignError(f"backend {backend!r}: expected one of {', '.join(BACKENDS)}")
     if runs < 1 or workers < 1:
         raise CampaignError("--runs and --workers must be >= 1")
+    from .validate import validate_campaign
+
+    validate_campaign(campaign)  # a definition error is exit 2 at load, never failed runs
     store = ResultStore(out, campaign)
     store.open()
     done = store.done()

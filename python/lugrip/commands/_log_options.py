@@ -96,6 +96,10 @@ def add_log_options(parser: argparse.ArgumentParser, *, wrench_topic: bool = Tru
                         "sets every force); repeatable")
     r.add_argument("--allow-gaps", action="store_true",
                    help="accept long NaN runs (the observer restarts after them)")
+    r.add_argument("--time-source", choices=("header", "log"), default=None,
+                   help="ROS sources: order the messages by their header stamps (default; a "
+                        "clock that jumps back or stamps repeated on over 1 %% of the messages "
+                        "is an error) or by the recorder's log times")
     return r
 
 
@@ -115,6 +119,7 @@ def log_kwargs(args: argparse.Namespace) -> dict:
         "contact_offset": getattr(args, "contact_offset", None),
         "units": units or None,
         "allow_gaps": bool(getattr(args, "allow_gaps", False)),
+        "time_source": getattr(args, "time_source", None) or "header",
     }
 
 

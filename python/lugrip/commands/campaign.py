@@ -62,6 +62,74 @@ def _positive_int(text: str) -> int:
     return v
 
 
+MAX_RUNS = 1_000_000
+"""Most runs one campaign command accepts (checked before any list of runs is built; a
+million runs is days of computing on a cluster)."""
+
+
+def _run_count(text: str) -> int:
+    """--runs: an integer 1..MAX_RUNS (refused before any work: '1e9' and 10**9 alike)."""
+    t = text.strip()
+    if len(t) > 20:
+        raise argparse.ArgumentTypeError(f"invalid value of {len(t)} characters: expected an "
+                                         f"integer 1..{MAX_RUNS}")
+    try:
+        v = int(t)
+    except ValueError:
+        try:
+            f = float(t)
+        except ValueError:
+            raise argparse.ArgumentTypeError(
+                f"invalid value {t!r}: expected an integer") from None
+        if not (f.is_integer() and 1 <= f <= MAX_RUNS):
+            raise argparse.ArgumentTypeError(
+                f"invalid value {t!r}: expected an integer 1..{MAX_RUNS}") from None
+        v = int(f)
+    if not 1 <= v <= MAX_RUNS:
+        raise argparse.ArgumentTypeError(f"invalid value {t!r}: expected an integer "
+                                         f"1..{MAX_RUNS}")
+    return v
+
+
+#: The report files of a campaign folder (rewritten when the folder is resumed).
+REPORT_FILES = ("report.md", "report.json", "failure_map.png", "frontier.png")
+#: Stored runs: only a folder holding this campaign's campaign.json resumes from them.
+RESULT_FILES = ("results.parquet", "parts")
+
+
+def check_campaign_out(out: Path, campaign, force: bool, inputs=()) -> bool:
+    """The output policy for a campaign folder, before any run. A folder that holds this
+    campaign (its campaign.json, same fingerprint) is resumed: its report is rewritten. Any
+    other folder that holds report files is refused without --force, and one holding runs
+    without a campaign.json (or a campaign.json that cannot be read) is refused always.
+    Returns True when the folder is resumed."""
+    import json
+
+    from ._output import OutputError, check_dir
+
+    meta = out / "campaign.json"
+    if meta.is_file():
+        try:
+            doc = json.loads(meta.read_text(encoding="utf-8"))
+            fp = doc.get("fingerprint") if isinstance(doc, dict) else None
+        except (ValueError, OSError) as err:
+            raise OutputError(f"argument --out: {meta}: not a readable campaign.json "
+                              f"({type(err).__name__}); use a new --out") from None
+        if fp == campaign.fingerprint():
+            check_dir(out, "--out", force=True, results=REPORT_FILES, inputs=inputs)
+            return True
+        name = doc.get("name") if isinstance(doc, dict) else None
+        raise OutputError(f"argument --out: {out} holds results of another campaign definition "
+                          f"({meta}: name {name!s:.60}, fingerprint {fp!s:.20}); use a new "
+                          "--out")
+    stray = [n for n in RESULT_FILES if os.path.lexists(out / n)]
+    if stray:
+        raise OutputError(f"argument --out: {out} holds {', '.join(stray)} but no campaign.json: "
+                          "not a campaign folder lugrip can resume; use a new --out")
+    check_dir(out, "--out", force=force, results=REPORT_FILES, inputs=inputs)
+    return False
+
+
 def _index(text: str) -> int:
     try:
         v = int(text)
@@ -87,7 +155,8 @@ def register(subparsers) -> None:
     )
     p.add_argument("target", nargs="+", metavar="CONFIG",
                    help="campaign YAML file, or 'replay DIR', or 'report DIR'")
-    p.add_argument("--runs", type=_positive_int, metavar="N", help="number of runs (0..N-1)")
+    p.add_argument("--runs", type=_run_count, metavar="N",
+                   help=f"number of runs (0..N-1; at most {MAX_RUNS})")
     p.add_argument("--workers", type=_positive_int, default=None, metavar="W",
                    help="parallel workers (default: the CPUs this process may use)")
     p.add_argument("--backend", choices=("process", "ray"), default="process",
@@ -104,6 +173,9 @@ def register(subparsers) -> None:
     p.add_argument("--no-report", action="store_true", help="do not write the report")
     p.add_argument("--no-figures", action="store_true", help="report/replay without figures")
     p.add_argument("--quiet", action="store_true", help="no progress line")
+    p.add_argument("--force", action="store_true",
+                   help="overwrite report files (report.md, report.json, failure_map.png, frontier.png) in an "
+                        "--out folder that is not this campaign's; replay: earlier replay files")
     p.set_defaults(run=run)
 
 
@@ -123,6 +195,7 @@ def _run_campaign(args) -> int:
     campaign = load_campaign(args.target[0])
     if args.evaluation:
         campaign = campaign.for_set("evaluation")
+    check_campaign_out(args.out, campaign, args.force, inputs=[args.target[0]])
     affinity = getattr(os, "sched_getaffinity", None)  # Linux; elsewhere every CPU
     workers = args.workers or max(len(affinity(0)) if affinity else (os.cpu_count() or 1), 1)
     info = run_campaign(
@@ -163,6 +236,15 @@ def _run_campaign(args) -> int:
     return 0
 
 
+def check_replay_out(out: Path, index: int, force: bool) -> None:
+    """The output policy for the files a campaign replay writes (replay_<ID>.json and its
+    figures): refused without --force when they exist."""
+    from ._output import check_dir
+
+    check_dir(Path(out), "--out", force=force,
+              results=(f"replay_{index}.json", f"replay_{index}_*.png"))
+
+
 def run(args) -> int:
     head = args.target[0]
     if head in ("replay", "report") and not Path(head).is_file():
@@ -179,6 +261,12 @@ def run(args) -> int:
             return 0
         if args.run_id is None:
             raise CliError("replay needs --run ID")
+        campaign = load_results_campaign(directory)
+        unknown = [c for c in args.controller or () if c not in campaign.controllers]
+        if unknown:
+            raise CliError(f"--controller {', '.join(unknown)}: not in the campaign "
+                           f"({', '.join(campaign.controllers)})")
+        check_replay_out(directory if args.out is None else args.out, args.run_id, args.force)
         return replay_command(directory, args.run_id, controllers=args.controller, out=args.out,
                               figures=not args.no_figures)
     return _run_campaign(args)

@@ -81,6 +81,8 @@ def register(subparsers) -> None:
                    help="output directory (default: out)")
     p.add_argument("--only", nargs="+", metavar="STEP", default=None,
                    help="run only these steps: " + ", ".join(s.name for s in STEPS))
+    p.add_argument("--force", action="store_true",
+                   help="overwrite the report of an earlier demo in --out")
     p.set_defaults(run=run)
 
 
@@ -145,13 +147,17 @@ def run_demo(out_dir: str | Path, steps: list[DemoStep] | None = None,
         "",
         *sections,
     ])
-    path = out_dir / REPORT_NAME
-    path.write_text(report)
+    from .._atomic import write_text_atomic
+
+    path = write_text_atomic(out_dir / REPORT_NAME, report)
     return path, failed
 
 
 def run(args: argparse.Namespace) -> int:
     steps = _select(args.only)
+    from ._output import check_dir
+
+    check_dir(args.out, "--out", force=args.force, results=(REPORT_NAME,))
     if any(step.name == "mujoco" for step in steps):
         from ..sim import report
 

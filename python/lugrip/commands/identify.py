@@ -11,6 +11,7 @@ from pathlib import Path
 
 from . import CliError, observer_options, positive_float
 from ._log_options import add_log_options, read_log_from_args
+from ._output import atomic_write_text, check_dir, check_file, is_same_file
 
 __all__ = ["ProgressBar", "register", "run", "write_report"]
 
@@ -258,25 +259,30 @@ class ProgressBar:
             self.stream.flush()
 
 
+#: The files write_report writes in its folder (identify --report refuses them without --force).
+REPORT_FILES = ("identification.txt", "maneuver_rmse.csv", "params.yaml", "cost_trace.png",
+                "fig07_limit_surface.png", "validation_S_omega.png", "fig05_identification.png")
+
+
 def write_report(result, out_dir: Path, *, title: str | None = None) -> list[Path]:
     """Parameter table (text), per-maneuver RMSE (CSV), the cost trace and the Figure-5-style
     plot of the validation maneuvers (PNG). Returns the written paths."""
     import numpy as np
 
     from .. import plot
+    from .._atomic import write_text_atomic
 
     out_dir = Path(out_dir)
     out_dir.mkdir(parents=True, exist_ok=True)
     written = []
-    path = out_dir / "identification.txt"
-    path.write_text(result.summary() + "\n")
+    path = write_text_atomic(out_dir / "identification.txt", result.summary() + "\n")
     written.append(path)
     path = out_dir / "maneuver_rmse.csv"
     val = set(result.validation_keys)
     lines = ["maneuver,set,rmse_rad_s"]
     for key, v in result.maneuver_rmse.items():
         lines.append(f"{key},{'validation' if key in val else 'train'},{v:.6g}")
-    path.write_text("\n".join(lines) + "\n")
+    write_text_atomic(path, "\n".join(lines) + "\n")
     written.append(path)
     written.append(result.save_yaml(out_dir / "params.yaml"))
 
@@ -423,8 +429,15 @@ def run(args) -> int:
     for path in args.logs:
         if not path.exists():
             raise CliError(f"{path}: no such file")
-    if args.out.exists() and not args.force:  # checked before any work
-        raise CliError(f"argument --out: {args.out} exists; pass --force to overwrite it")
+    # the output policy (commands/_output.py), checked before any work
+    inputs = [*args.logs, args.params0]
+    check_file(args.out, "--out", force=args.force, inputs=inputs, create_parent=True)
+    if args.report is not None:
+        check_dir(args.report, "--report", force=args.force, results=REPORT_FILES,
+                  inputs=inputs)
+        for name in ("params.yaml",):
+            if is_same_file(args.report / name, args.out):
+                raise CliError(f"argument --report: {args.report / name} is also the --out file")
     if args.rubbing:
         if args.params0 is None:
             raise CliError("--rubbing needs --params0 (the fingertip's delta and gamma)")
@@ -451,13 +464,12 @@ def run(args) -> int:
         else:
             mu, beta = est.mu, est.beta_a
         params = base.replace(mu=mu, beta_a=beta)
-        args.out.parent.mkdir(parents=True, exist_ok=True)
-        params.to_yaml(
-            args.out,
+        text = params.to_yaml(
             comment=f"lugrip identify --rubbing: mu and beta_A from "
             f"{', '.join(str(p) for p in args.logs)}",
             observer=block,  # the fingertip's observer goes with its parameters
         )
+        atomic_write_text(args.out, text, "--out", force=args.force, create_parent=True)
         print(f"wrote {args.out}")
         return 0
 
@@ -514,7 +526,8 @@ def run(args) -> int:
             seen.add(text)
             print(f"warning: {text}", file=sys.stderr)
     print(result.summary())
-    result.save_yaml(args.out)
+    atomic_write_text(args.out, result.yaml_text(), "--out", force=args.force,
+                      create_parent=True)
     print(f"wrote {args.out}")
     if args.report is not None:
         for path in write_report(result, args.report):

@@ -15,6 +15,7 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from . import CliError, k_label, parse_k, positive_float
+from ._output import check_dir, check_file, is_same_file, staged_path
 
 __all__ = [
     "DEFAULT_K",
@@ -76,6 +77,8 @@ def register(subparsers) -> None:
     p.add_argument("--csv", type=Path, default=None, metavar="FILE",
                    help="also write the table as CSV (columns k, xi, c_tilde, ft_star, tau_star)")
     p.add_argument("--no-plot", action="store_true", help="only print the table")
+    p.add_argument("--force", action="store_true",
+                   help="overwrite existing figures in --out and an existing --csv file")
     p.set_defaults(run=run)
 
 
@@ -383,6 +386,15 @@ def run(args: argparse.Namespace) -> int:
         c_values = list(args.c)
     else:
         c_values = [c for c in TABLE_C if c <= args.c_max + 1e-12]
+    # the output policy (commands/_output.py), before any work
+    if not args.no_plot:
+        check_dir(args.out, "--out", force=args.force,
+                  results=(f"{FIG3_NAME}.{args.format}", f"{FIG7_NAME}.{args.format}"))
+    if args.csv is not None:
+        check_file(args.csv, "--csv", force=args.force, create_parent=True)
+        if not args.no_plot and any(is_same_file(args.csv, args.out / f"{n}.{args.format}")
+                                    for n in (FIG3_NAME, FIG7_NAME)):
+            raise CliError(f"argument --csv: {args.csv} is also a figure of --out")
     table = ls_table(ks, c_values)
     if not args.no_plot:
         paths = write_figures(args.out, ks, args.c_max, args.format)
@@ -390,7 +402,8 @@ def run(args: argparse.Namespace) -> int:
             print(f"wrote {p}", file=sys.stderr)
     sys.stdout.write(table.format())
     if args.csv is not None:
-        table.write_csv(args.csv)
+        with staged_path(args.csv, "--csv", force=args.force, create_parent=True) as tmp:
+            table.write_csv(tmp)
         print(f"wrote {args.csv}", file=sys.stderr)
     return 0
 

@@ -6,15 +6,14 @@ from __future__ import annotations
 
 import argparse
 import math
-import os
 import sys
-import tempfile
 import textwrap
 import time
 from pathlib import Path
 
 from . import CliError, observer_options, positive_float
 from ._log_options import add_log_options, read_log_from_args
+from ._output import atomic_write, check_file, is_same_file
 from .simulate_sliding import add_params_arguments, load_params
 
 __all__ = ["OUTPUT_COLUMNS", "demo_section", "register", "run", "write_estimates"]
@@ -145,38 +144,14 @@ def register(subparsers) -> None:
     p.set_defaults(run=run)
 
 
-def _check_target(path: Path, what: str, force: bool) -> None:
-    if path.is_dir():
-        raise CliError(f"argument {what}: {path} is a directory")
-    if path.exists() and not force:
-        raise CliError(f"argument {what}: {path} exists; pass --force to overwrite it")
-    if not path.parent.exists():
-        raise CliError(f"argument {what}: directory {path.parent} does not exist")
+def _check_target(path: Path, what: str, force: bool, inputs=()) -> None:
+    """The output policy (commands/_output.py) for one output file."""
+    check_file(path, what, force=force, inputs=inputs)
 
 
-def _atomic_write(path: Path, force: bool, body) -> None:
+def _atomic_write(path: Path, force: bool, body, what: str = "--out") -> None:
     """Write through a temporary file next to ``path``; rename into place when complete."""
-    fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=f".{path.name}.", suffix=".part")
-    try:
-        with os.fdopen(fd, "wb") as fh:
-            body(fh)
-        os.chmod(tmp, 0o644)
-        if force:
-            os.replace(tmp, path)
-        else:
-            try:
-                os.link(tmp, path)  # refuses to replace a file created meanwhile
-            except FileExistsError:
-                raise CliError(
-                    f"argument --out: {path} exists; pass --force to overwrite it"
-                ) from None
-            except OSError:
-                if path.exists():
-                    raise CliError(f"argument --out: {path} exists") from None
-                os.replace(tmp, path)
-    finally:
-        if os.path.exists(tmp):
-            os.unlink(tmp)
+    atomic_write(path, body, what, force=force)
 
 
 def _columns(log, run) -> dict:
@@ -230,16 +205,22 @@ def write_estimates(path: Path, log, run, *, force: bool = False) -> Path:
 
         def body(fh):
             n = len(cols["t"])
-            out = [",".join(OUTPUT_COLUMNS)]
-            reprs = {k: (v.tolist() if k != "status" else v) for k, v in cols.items()}
-            for i in range(n):
-                out.append(
-                    ",".join(
-                        repr(reprs[k][i]) if isinstance(reprs[k][i], float) else str(reprs[k][i])
-                        for k in OUTPUT_COLUMNS
+            fh.write((",".join(OUTPUT_COLUMNS) + "\n").encode())
+            chunk = 50_000  # rows per write: the text of the whole file is never in memory
+            for a in range(0, n, chunk):
+                b = min(a + chunk, n)
+                reprs = {k: (cols[k][a:b].tolist() if k != "status" else cols[k][a:b])
+                         for k in OUTPUT_COLUMNS}
+                out = []
+                for i in range(b - a):
+                    out.append(
+                        ",".join(
+                            repr(reprs[k][i]) if isinstance(reprs[k][i], float)
+                            else str(reprs[k][i])
+                            for k in OUTPUT_COLUMNS
+                        )
                     )
-                )
-            fh.write(("\n".join(out) + "\n").encode())
+                fh.write(("\n".join(out) + "\n").encode())
     elif suffix in (".parquet", ".pq"):
         try:
             import pyarrow as pa
@@ -295,7 +276,8 @@ def run(args) -> int:
         raise CliError(
             f"argument --out: {out}: unknown suffix {out.suffix!r}; use .csv or .parquet"
         )
-    _check_target(out, "--out", args.force)
+    inputs = [args.log, getattr(args, "params", None)]
+    _check_target(out, "--out", args.force, inputs)
     fig_path = None
     if args.plot is not None:
         from ..plot.observer import FIG5_NAME
@@ -303,10 +285,9 @@ def run(args) -> int:
         if args.plot.exists() and not args.plot.is_dir():
             raise CliError(f"argument --plot: {args.plot} exists and is not a directory")
         fig_path = args.plot / f"{FIG5_NAME}.{args.format}"
-        if fig_path.exists() and not args.force:
-            raise CliError(f"argument --plot: {fig_path} exists; pass --force to overwrite it")
-    if Path(args.log).resolve() == out.resolve():
-        raise CliError("argument --out: the output would replace the input log")
+        check_file(fig_path, "--plot", force=args.force, inputs=inputs, create_parent=True)
+        if is_same_file(fig_path, out):
+            raise CliError(f"argument --plot: {fig_path} is also the --out file")
     params = load_params(args, default=None)
     block = observer_block(args)
     log = read_log_from_args(args.log, args)

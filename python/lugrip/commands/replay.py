@@ -10,7 +10,8 @@ from pathlib import Path
 
 from . import CliError, positive_float
 from ._log_options import add_log_options, log_kwargs
-from .observe import _atomic_write, _check_target
+from ._output import check_file, is_same_file
+from .observe import _atomic_write
 from .simulate_sliding import add_params_arguments, load_params
 
 __all__ = ["OUTPUT_COLUMNS", "register", "run"]
@@ -101,21 +102,17 @@ def _read(args):
                           command_topic=args.command_topic, **kw)
 
 
-_MAX_SETTINGS_BYTES = 1 << 20  # a settings file is a few lines; refuse anything huge
-
-
 def _settings_file(path: Path) -> tuple[dict, dict]:
-    """(controller, observer) settings of a --settings YAML."""
-    import yaml
+    """(controller, observer) settings of a --settings YAML (read with the limits of
+    lugrip._yaml.load_yaml, like every YAML file lugrip reads)."""
+    from .._yaml import load_yaml
 
     if not path.is_file():
         raise CliError(f"argument --settings: {path}: no such file")
-    if path.stat().st_size > _MAX_SETTINGS_BYTES:
-        raise CliError(f"argument --settings: {path}: larger than 1 MiB, not a settings file")
     try:
-        data = yaml.safe_load(path.read_text(encoding="utf-8"))
-    except (yaml.YAMLError, UnicodeDecodeError) as err:
-        raise CliError(f"argument --settings: {path}: not YAML ({type(err).__name__})") from None
+        data = load_yaml(path)
+    except ValueError as err:
+        raise CliError(f"argument --settings: {err}") from None
     if not isinstance(data, dict) or not ({"controller", "observer"} & set(data)):
         raise CliError(f"argument --settings: {path}: expected a mapping with a 'controller:' "
                        "and/or an 'observer:' block")
@@ -242,9 +239,8 @@ def run(args) -> int:
     if out_path.suffix.lower() != ".csv":
         raise CliError(f"argument --out: {out_path}: unknown suffix {out_path.suffix!r}; "
                        "use .csv")
-    _check_target(out_path, "--out", args.force)
-    if Path(args.log).resolve() == out_path.resolve():
-        raise CliError("argument --out: the output would replace the input log")
+    inputs = [args.log, getattr(args, "params", None), getattr(args, "settings", None)]
+    check_file(out_path, "--out", force=args.force, inputs=inputs)
     fig_path = None
     if args.plot is not None:
         from ..plot.replay import REPLAY_NAME
@@ -252,8 +248,9 @@ def run(args) -> int:
         if args.plot.exists() and not args.plot.is_dir():
             raise CliError(f"argument --plot: {args.plot} exists and is not a directory")
         fig_path = args.plot / f"{REPLAY_NAME}.{args.format}"
-        if fig_path.exists() and not args.force:
-            raise CliError(f"argument --plot: {fig_path} exists; pass --force to overwrite it")
+        check_file(fig_path, "--plot", force=args.force, inputs=inputs, create_parent=True)
+        if is_same_file(fig_path, out_path):
+            raise CliError(f"argument --plot: {fig_path} is also the --out file")
     glog = _read(args)
     if len(glog) < 2:
         raise CliError(f"{args.log}: a replay needs at least two samples")

@@ -104,6 +104,9 @@ def register(subparsers) -> None:
     p.add_argument(
         "--no-frames", action="store_true", help="MuJoCo plant: no rendered frames in the figures"
     )
+    p.add_argument("--force", action="store_true",
+                   help="overwrite the result files of an earlier run in --out (experiments.md, "
+                        "metrics.json, mujoco.md, figures) and an existing --json/--video file")
     p.add_argument("--no-baselines", action="store_true", help="only lugrip's controller")
     p.add_argument("--no-plots", action="store_true", help="skip the figures")
     p.add_argument("--list", action="store_true", help="list the available scenarios and exit")
@@ -120,7 +123,9 @@ def run(args: argparse.Namespace) -> int:
         if args.campaign is None or args.campaign_run is None or args.campaign_run < 0:
             raise CliError("--campaign DIR and --run ID (>= 0) go together")
         from ..campaign.replay import replay_command
+        from .campaign import check_replay_out
 
+        check_replay_out(args.out, args.campaign_run, args.force)
         return replay_command(args.campaign, args.campaign_run, out=args.out,
                               figures=not args.no_plots)
     from ..sim import report
@@ -163,6 +168,7 @@ def run(args: argparse.Namespace) -> int:
         raise CliError(f"--seeds {args.seeds}: must be >= 1")
     if args.video is not None and args.video.suffix.lower() != ".mp4":
         raise CliError(f"--video {args.video}: expected a .mp4 file")
+    check_outputs(args, paths)
     if args.plant == "mujoco":
         return _run_mujoco(args, paths)
 
@@ -200,6 +206,32 @@ def run(args: argparse.Namespace) -> int:
     for name, path in written.items():
         print(f"wrote {path}", file=sys.stderr)
     return 0 if all(r.passed for r in results) else 1
+
+
+#: The result files ``simulate`` writes in --out (names and patterns): a folder holding any
+#: of them is refused without --force.
+RESULT_FILES = ("experiments.md", "metrics.json", "mujoco.md", "mujoco_metrics.json",
+                "fig1[1357]_*.png", "*_baselines.png", "mujoco_*.png")
+
+
+def check_outputs(args: argparse.Namespace, scenario_paths: list[str]) -> None:
+    """The output policy (commands/_output.py) for --out DIR, --json and --video, before any
+    scenario runs; the scenario files are inputs."""
+    from ._output import check_dir, check_file
+
+    if args.no_plots and args.plant != "mujoco":  # only the metrics file is written
+        if args.json is None:
+            check_dir(args.out, "--out", force=args.force, results=("metrics.json",),
+                      inputs=scenario_paths)
+    else:
+        check_dir(args.out, "--out", force=args.force, results=RESULT_FILES,
+                  inputs=scenario_paths)
+    if args.json is not None:
+        check_file(args.json, "--json", force=args.force, inputs=scenario_paths,
+                   create_parent=True)
+    if args.video is not None:
+        check_file(args.video, "--video", force=args.force, inputs=scenario_paths,
+                   create_parent=True)
 
 
 def _run_mujoco(args: argparse.Namespace, paths: list[str]) -> int:

@@ -10,6 +10,7 @@ import time
 from pathlib import Path
 
 from . import CliError
+from ._output import check_dir
 
 __all__ = ["MAX_MANEUVERS", "register", "run"]
 
@@ -83,13 +84,10 @@ def run(args) -> int:
     from ..rigs.registry import make_rig
 
     out = Path(args.out)
-    if out.exists() and not out.is_dir():
-        raise CliError(f"argument --out: {out} exists and is not a directory")
     if not out.parent.exists():
         raise CliError(f"argument --out: directory {out.parent} does not exist")
-    if out.is_dir() and not args.force and any(
-            (out / n).exists() for n in ("log.parquet", "log.csv", "labels.npz", "truth.json")):
-        raise CliError(f"argument --out: {out} holds a previous run; pass --force to overwrite it")
+    check_dir(out, "--out", force=args.force,
+              results=("log.parquet", "log.csv", "labels.npz", "truth.json"))
     params = None
     if args.preset is not None:
         if args.plant not in ("lumped", "patch"):

@@ -11,6 +11,7 @@ import textwrap
 from pathlib import Path
 
 from . import CliError, positive_float
+from ._output import check_file
 
 __all__ = ["load_params", "register", "run"]
 
@@ -174,12 +175,7 @@ def run(args) -> int:
         raise CliError(
             f"argument --out: {out}: unknown suffix {out.suffix!r}; use .csv, .parquet or .mcap"
         )
-    if out.is_dir():
-        raise CliError(f"argument --out: {out} is a directory")
-    if out.exists() and not args.force:
-        raise CliError(f"argument --out: {out} exists; pass --force to overwrite it")
-    if not out.parent.exists():
-        raise CliError(f"argument --out: directory {out.parent} does not exist")
+    check_file(out, "--out", force=args.force, inputs=[getattr(args, "params", None)])
     if args.stick_fraction > 1.0:
         raise CliError(f"argument --stick-fraction: {args.stick_fraction:g} must be <= 1")
     if args.f_n_range[1] < args.f_n_range[0]:

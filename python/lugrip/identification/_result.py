@@ -5,6 +5,7 @@ from __future__ import annotations
 import dataclasses
 import math
 import os
+import tempfile
 from pathlib import Path
 from typing import Any
 
@@ -262,20 +263,29 @@ class IdentificationResult:
         summary. :meth:`lugrip.ContactParams.from_yaml` reads the parameters back (the
         ``contact`` block), :func:`lugrip.read_observer_settings` the observer block;
         ``lugrip observe --params`` and ``lugrip identify --params0`` use both."""
-        import yaml
-
         path = Path(path)
         path.parent.mkdir(parents=True, exist_ok=True)
-        text = (
+        text = self.yaml_text()
+        fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=f".{path.name}.", suffix=".tmp")
+        try:
+            with os.fdopen(fd, "w") as fh:
+                fh.write(text)
+            os.replace(tmp, path)
+        finally:  # no temporary left behind when the write fails (disk full, ...)
+            if os.path.exists(tmp):
+                os.unlink(tmp)
+        return path
+
+    def yaml_text(self) -> str:
+        """The text :meth:`save_yaml` writes."""
+        import yaml
+
+        return (
             "# lugrip identification (paper Section 4, docs/model.md §8): contact parameters\n"
             "# value [unit], standard error, bounds; the observer they were identified with\n"
             "# (use it online: lugrip observe --params reads the observer block); fit summary\n"
             + yaml.safe_dump(_plain(self.to_dict()), sort_keys=False)
         )
-        tmp = path.with_name(path.name + ".tmp")
-        tmp.write_text(text)
-        os.replace(tmp, path)
-        return path
 
 
 def _stage_dict(st) -> dict:

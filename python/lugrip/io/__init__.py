@@ -188,7 +188,8 @@ def read_log(path: str | os.PathLike, *, format: str | None = None,
              maneuver_topic: str | None = None, maneuvers=None,
              flip_normal: bool = False, contact_offset: float | None = None,
              units: Mapping[str, str] | None = None, check_units: bool = True,
-             max_nan_run: int = 3, allow_gaps: bool = False) -> SlidingLog:
+             max_nan_run: int = 3, allow_gaps: bool = False,
+             time_source: str = "header") -> SlidingLog:
     """Read a sliding log.
 
     Args:
@@ -224,9 +225,15 @@ def read_log(path: str | os.PathLike, *, format: str | None = None,
         max_nan_run: longest run of non-finite force/torque samples accepted (with a
             :class:`LogWarning`; the samples are flagged invalid and split segments).
         allow_gaps: accept longer runs too.
+        time_source: ROS sources: ``"header"`` (default) orders the messages by their header
+            stamps (the sensor's clock; log times for types without a header), ``"log"`` by
+            the recorder's log times (for a sensor whose clock jumped).
 
-    Duplicated ROS time stamps are warned about (:class:`LogWarning`) and dropped, the first
-    message of each time kept; messages out of time order are sorted.
+    ROS header stamps that go backwards are an error (LogError naming the topic and the count
+    of backward steps; ``time_source="log"`` reads such a recording by log time). Messages
+    repeating the time of the one before are dropped with a warning (the first of each time
+    kept) when they are at most 1 % of the topic's messages (at least one is tolerated), an
+    error beyond (``lugrip.io._ros.MAX_DUPLICATE_FRACTION``). Log times out of order are sorted.
 
     Returns:
         SlidingLog with ``source`` = path and ``meta`` (format, units, topics, ...).
@@ -240,12 +247,14 @@ def read_log(path: str | os.PathLike, *, format: str | None = None,
     return _read(path, format=format, wrench_topic=wrench_topic, omega_topic=omega_topic,
                  maneuver_topic=maneuver_topic, maneuvers=maneuvers, flip_normal=flip_normal,
                  contact_offset=contact_offset, units=units, check_units=check_units,
-                 max_nan_run=max_nan_run, allow_gaps=allow_gaps, stacklevel=4)[0]
+                 max_nan_run=max_nan_run, allow_gaps=allow_gaps, stacklevel=4,
+                 time_source=time_source)[0]
 
 
 def _read(path, *, format, wrench_topic, omega_topic, maneuver_topic, maneuvers, flip_normal,
           contact_offset, units, check_units, max_nan_run, allow_gaps, stacklevel,
-          finger: int | None = None, scalar_topics: Mapping[str, str] | None = None):
+          finger: int | None = None, scalar_topics: Mapping[str, str] | None = None,
+          time_source: str = "header"):
     """read_log's work; also returns the columns (with a two-finger table's ``command`` when
     ``finger`` is given, or the ``scalar_topics`` {column: topic} of a ROS source)."""
     path = Path(path)
@@ -256,7 +265,8 @@ def _read(path, *, format, wrench_topic, omega_topic, maneuver_topic, maneuvers,
     if fmt in _MODULE_FOR:
         need(_MODULE_FOR[fmt], _EXTRA_FOR[fmt])
     ros_only = {"wrench_topic": wrench_topic, "omega_topic": omega_topic,
-                "maneuver_topic": maneuver_topic, "contact_offset": contact_offset}
+                "maneuver_topic": maneuver_topic, "contact_offset": contact_offset,
+                "time_source": None if time_source == "header" else time_source}
     if fmt in ("csv", "parquet"):
         given_ros = [k for k, v in ros_only.items() if v is not None]
         if given_ros:
@@ -286,7 +296,7 @@ def _read(path, *, format, wrench_topic, omega_topic, maneuver_topic, maneuvers,
             src, wrench_topic=wrench_topic, omega_topic=omega_topic,
             maneuver_topic=maneuver_topic, flip_normal=flip_normal,
             contact_offset=contact_offset, scalar_topics=scalar_topics,
-            stacklevel=stacklevel)
+            stacklevel=stacklevel, time_source=time_source)
         meta["format"] = fmt
 
     given = dict(header_units)
@@ -379,6 +389,9 @@ def _atomic_write(path: Path, overwrite: bool, body: Callable) -> None:
 
     if path.is_dir():
         raise IsADirectoryError(errno.EISDIR, "is a directory", str(path))
+    if path.exists() and not path.is_file():  # a device or FIFO: a rename would replace it
+        raise OSError(errno.EINVAL, "not a regular file, not replaced (also with "
+                      "overwrite=True)", str(path))
     if path.exists() and not overwrite:
         raise exists_error()
     fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=f".{path.name}.", suffix=".part")

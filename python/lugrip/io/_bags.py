@@ -10,7 +10,48 @@ from typing import Any
 
 from ._extras import exc_text, need
 from ._log import LogError
-from ._ros import RosSource, short_type
+from ._ros import _TYPES, RosSource, short_type
+
+
+def _reachable(defs: dict, name: str) -> list[str]:
+    """``name`` and every message type its fields use, through ``defs`` (a typestore's
+    fielddefs: name -> (constants, [(field, (node type, spec))]))."""
+    seen: list[str] = []
+    todo = [name]
+    while todo:
+        t = todo.pop()
+        if t in seen or t not in defs:
+            continue
+        seen.append(t)
+
+        def walk(spec):
+            if isinstance(spec, str):
+                todo.append(spec)
+            elif isinstance(spec, tuple):
+                for part in spec:
+                    walk(part)
+
+        for _field, desc in defs[t][1]:
+            walk(desc)
+    return seen
+
+
+def _check_definitions(file: str, connections, defined: dict, standard: dict) -> None:
+    """A topic of a type the log reads must carry the standard definition of it, as in MCAP
+    files (the bag is decoded with its own definitions, so a bag that declares the standard
+    name for another layout is not a recording of that message; lugrip picks its fields by the
+    standard layout). LogError naming the topic and the type."""
+    for conn in connections:
+        if short_type(conn.msgtype) not in _TYPES:
+            continue
+        for t in _reachable(defined, conn.msgtype):
+            ref = standard.get(t)
+            if ref is not None and ref[1] != defined[t][1]:
+                names = ", ".join(f[0] for f in defined[t][1])[:120]
+                raise LogError(file, f"the bag declares {short_type(conn.msgtype)} but defines "
+                               f"{short_type(t)} with fields ({names}) that are not the "
+                               f"standard message's ({', '.join(f[0] for f in ref[1])}): "
+                               "field msgdef", where=f"topic '{conn.topic}'")
 
 
 class BagSource(RosSource):
@@ -32,6 +73,12 @@ class BagSource(RosSource):
         except Exception as exc:  # noqa: BLE001 (any reader failure: a bad file)
             raise LogError(file, f"not a readable ROS {self._ros} bag "
                            f"({exc_text(exc)})") from None
+        try:
+            _check_definitions(file, self._reader.connections, self._reader.typestore.fielddefs,
+                               store.fielddefs)
+        except LogError:
+            self._reader.close()
+            raise
         for conn in self._reader.connections:
             typ = short_type(conn.msgtype)
             count = getattr(conn, "msgcount", None)

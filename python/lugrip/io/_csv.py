@@ -208,7 +208,10 @@ def _read_csv_fast(raw: bytes, file: str, finger: int | None = None):
     except UnicodeDecodeError:
         return None
     delim = _delimiter(first)
-    header = [c.strip() for c in next(csv.reader([first], delimiter=delim))]
+    try:
+        header = [c.strip() for c in next(csv.reader([first], delimiter=delim))]
+    except (csv.Error, StopIteration):  # e.g. a bare CR in the header: the slow reader names it
+        return None
     index, units, ignored = _parse_header(header, file, finger)
     if not index:
         return None

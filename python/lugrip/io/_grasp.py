@@ -69,7 +69,8 @@ def read_grasp_log(path: str | os.PathLike, *, finger_topics: Sequence[str] | No
                    maneuvers=None, flip_normal: bool = False,
                    contact_offset: float | None = None, units: Mapping[str, str] | None = None,
                    check_units: bool = True, max_nan_run: int = 3,
-                   allow_gaps: bool = False, format: str | None = None) -> GraspLog:
+                   allow_gaps: bool = False, format: str | None = None,
+                   time_source: str = "header") -> GraspLog:
     """Read a two-finger log.
 
     A table (CSV, Parquet) has ``t``, per finger k = 0, 1 the sliding-log columns with the
@@ -105,7 +106,8 @@ def read_grasp_log(path: str | os.PathLike, *, finger_topics: Sequence[str] | No
     common = {"format": format, "omega_topic": None, "maneuver_topic": maneuver_topic,
               "maneuvers": maneuvers, "flip_normal": flip_normal,
               "contact_offset": contact_offset, "units": units, "check_units": check_units,
-              "max_nan_run": max_nan_run, "allow_gaps": allow_gaps, "stacklevel": 4}
+              "max_nan_run": max_nan_run, "allow_gaps": allow_gaps, "stacklevel": 4,
+              "time_source": time_source}
     fingers: list[SlidingLog] = []
     command = None
     n_fingers = 2 if table else len(finger_topics)

@@ -28,6 +28,10 @@ _FORCES = ("f_n", "f_t", "f_x", "f_y")
 _MAX_FORCE_MEDIAN = 200.0  # [N] median |force| above this is not a fingertip in newtons
 _MAX_TAU_PER_FORCE = 0.1  # [m] |tau|/f_n is at most mu*xi*rho, a few cm at most
 _GAP_FACTOR = 5.0  # default segments() gap: this many median sample periods
+# [-] f_t/f_n per block: mu plus the viscous term (beta_A) at high slip speed; synthetic
+# Table 1 maneuvers reach 14, a block of f_t in mN against f_n in N several hundred
+_MAX_FRICTION_RATIO = 100.0
+_UNIT_BLOCK = 200  # [rows] window of the per-block unit checks (docs/sliding_log.md)
 
 
 _HINT_RE = re.compile(r"\[\[(units|flag|opt|alt):([^\]]*)\]\]")
@@ -462,6 +466,7 @@ def _validate(cols: dict[str, np.ndarray], loc: _Locator, *, max_nan_run: int,
 
     if check_units:
         _check_units(cols, loc, explicit)
+        _check_unit_blocks(cols, loc, explicit)
 
     present = [c for c in _SIGNALS if c in cols]
     nonfinite = {c: ~np.isfinite(cols[c]) for c in present}
@@ -549,6 +554,83 @@ def _check_units(cols: dict[str, np.ndarray], loc: _Locator, explicit: set[str])
                                 f"a fingertip contact gives at most a few cm); it looks like "
                                 f"N mm: divide by 1000 or pass [[units:tau=N mm]]"
                                 + override.format(si="N m", c="tau"), i, "tau")
+
+
+def _window_stat(x: np.ndarray, use: np.ndarray, width: int, q: float) -> tuple[np.ndarray,
+                                                                                np.ndarray]:
+    """(starts, stat): the q-th percentile of x over the samples ``use`` of each window of
+    ``width`` rows (windows at 0, width, 2 width, ... and one ending at the last row); NaN
+    where fewer than a quarter of a window's samples are used."""
+    n = len(x)
+    k = n // width
+    starts = np.arange(k) * width
+    if n % width:
+        starts = np.append(starts, n - width)
+    stat = np.full(len(starts), np.nan)
+    vals = np.where(use, x, np.nan)
+    chunk = max(1, 2_000_000 // width)  # windows per pass: bounded temporary memory
+    for a in range(0, len(starts), chunk):
+        idx = starts[a:a + chunk, None] + np.arange(width)
+        block = np.sort(vals[idx], axis=1)  # NaN last
+        count = np.sum(np.isfinite(block), axis=1)
+        enough = count >= width // 4
+        if enough.any():
+            # np.nanpercentile's linear interpolation, on the sorted finite values of each row
+            b, k = block[enough], count[enough]
+            pos = (q / 100.0) * (k - 1)
+            lo = np.floor(pos).astype(np.int64)
+            hi = np.minimum(lo + 1, k - 1)
+            rows = np.arange(len(b))
+            frac = pos - lo
+            stat[a:a + chunk][enough] = (b[rows, lo] * (1.0 - frac) + b[rows, hi] * frac)
+    return starts, stat
+
+
+def _check_unit_blocks(cols: dict[str, np.ndarray], loc: _Locator,
+                       explicit: set[str]) -> None:
+    """LogError when a block of rows is in other units than the rest (the whole-file checks
+    of :func:`_check_units` pass a 5 % block in N mm): per window of ``_UNIT_BLOCK`` rows in
+    contact, the 90th percentile of |tau|/f_n against the contact-size bound, of f_t/f_n
+    against the friction bound, and the median f_n against the force bound. The message names
+    the field and the rows of the first and last flagged windows."""
+    f_n = cols["f_n"]
+    n = len(f_n)
+    width = _UNIT_BLOCK
+    if n < 2 * width:
+        return  # one or two windows: the whole-file checks are the block checks
+    finite = np.isfinite(f_n)
+    if not finite.any():
+        return
+    med_fn = float(np.median(f_n[finite]))
+    contact = finite & (f_n > max(0.1 * med_fn, 1e-3))
+    with np.errstate(divide="ignore", invalid="ignore"):
+        checks = []
+        if "f_n" not in explicit:
+            checks.append(("f_n", np.abs(f_n), finite, 50.0, _MAX_FORCE_MEDIAN, "N",
+                           "median f_n", "N", "mN or gram-force"))
+        if "tau" in cols and "tau" not in explicit:
+            checks.append(("tau", np.abs(cols["tau"]) / f_n, contact, 90.0, _MAX_TAU_PER_FORCE,
+                           "N m", "|tau|/f_n", "m", "N mm"))
+        ft_col = "f_t" if "f_t" in cols else ("f_y" if "f_y" in cols else None)
+        if ft_col is not None and ft_col not in explicit and "f_n" not in explicit:
+            f_t = cols["f_t"] if "f_t" in cols else np.hypot(cols["f_x"], cols["f_y"])
+            checks.append((ft_col, f_t / f_n, contact, 90.0, _MAX_FRICTION_RATIO, "N",
+                           "f_t/f_n", "", "mN (f_n in N)"))
+        for col, x, use, q, bound, si, what, unit, likely in checks:
+            starts, stat = _window_stat(x, use & np.isfinite(x), width, q)
+            bad = np.flatnonzero(stat > bound)
+            if not bad.size:
+                continue
+            ok = stat[np.isfinite(stat) & ~(stat > bound)]
+            a, b = int(starts[bad[0]]), int(starts[bad[-1]]) + width - 1
+            rest = (f"; {float(np.max(ok)):.3g}{' ' + unit if unit else ''} at most in the "
+                    "other blocks") if ok.size else ""
+            raise loc.error(
+                f"mixed units: {col} in {loc.rows_text(a, b)} ({bad.size} block(s) of {width} "
+                f"rows, {100.0 * bad.size * width / n:.2g} % of the file) is not in {si}: "
+                f"{what} reaches {float(np.nanmax(stat[bad])):.3g}{' ' + unit if unit else ''} "
+                f"there, over the {bound:g}{' ' + unit if unit else ''} a fingertip gives{rest}; "
+                f"it looks like {likely}: convert those rows", a, col)
 
 
 def _json_meta(meta: Mapping) -> dict:

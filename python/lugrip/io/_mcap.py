@@ -60,6 +60,12 @@ class _Decoders:
         typename = full_type(schema.name)
         text = schema.data.decode("utf-8", "replace")
         if encoding == "cdr":
+            if short_type(schema.name) in _TYPES:
+                # the types a sliding log reads: their schema was checked against the standard
+                # definition (_check_schema), and rosbags' decoder refuses a message whose
+                # size does not match the type (mcap-ros2's ignores trailing bytes)
+                ts = self._store(False, typename, "")
+                return lambda data: ts.deserialize_cdr(data, typename)
             if self._ros2 is not None and schema.encoding == "ros2msg":
                 decoder = self._ros2.decoder_for(encoding, schema)
                 if decoder is not None:
@@ -71,6 +77,70 @@ class _Decoders:
             return lambda data: ts.deserialize_ros1(data, typename)
         raise LogError(self.file, f"channel of type {short_type(schema.name)} is encoded as "
                        f"{encoding!r}; only ROS 1 and ROS 2 (CDR) messages can be read")
+
+
+_SCHEMA_ENCODING = {"cdr": "ros2msg", "ros1": "ros1msg"}  # message encoding -> schema encoding
+
+
+def _check_schema(file: str, topic: str, encoding: str, schema) -> None:
+    """A channel of a type a sliding log reads must declare it as the standard message: the
+    schema encoding must go with the message encoding, and a schema text (when the file has
+    one) must define the same fields as the standard type (ROS 2 Humble or ROS 1 Noetic).
+    Raises LogError naming the topic and the field."""
+    name = short_type(schema.name)
+    where = f"topic '{topic}'"
+    want = _SCHEMA_ENCODING.get(encoding)
+    if want is None:
+        return  # refused when read (for_channel): only ROS 1 and ROS 2 messages are decoded
+    if schema.encoding != want:
+        raise LogError(file, f"schema encoding {schema.encoding!r} of {name} does not go with "
+                       f"message encoding {encoding!r} (expected {want!r}): field "
+                       "schema.encoding", where=where)
+    text = schema.data.decode("utf-8", "replace").strip()
+    if not text:
+        return  # no definition stored: the standard one is used
+    typesys = need("rosbags.typesys", "decoding ROS messages")
+    typename = full_type(schema.name)
+    try:
+        defined = typesys.get_types_from_msg(text, typename)
+    except Exception as exc:  # noqa: BLE001 (the parser raises several types)
+        raise LogError(file, f"the schema of {name} cannot be parsed ({exc_text(exc)}): field "
+                       "schema.data", where=where) from None
+    standard = typestore(encoding == "ros1").fielddefs
+    for tname, fields in defined.items():
+        ref = standard.get(tname)
+        if ref is not None and [f[0] for f in ref[1]] != [f[0] for f in fields[1]]:
+            raise LogError(file, f"the schema declares {name} but defines {short_type(tname)} "
+                           f"with fields {', '.join(f[0] for f in fields[1])[:120]} instead of "
+                           f"{', '.join(f[0] for f in ref[1])}: field schema.data", where=where)
+        if ref is not None and ref != fields:
+            raise LogError(file, f"the schema declares {name} but its {short_type(tname)} "
+                           "fields have other types than the standard message: field "
+                           "schema.data", where=where)
+
+
+def _at_end(fh, exc: BaseException) -> bool:
+    """Whether a reader failure is the end of a recording cut short (the file ends inside a
+    record: mcap raises EndOfFile) rather than damage inside the file."""
+    import struct
+
+    from mcap.exceptions import EndOfFile
+
+    return isinstance(exc, (EndOfFile, struct.error))
+
+
+def _crc_error(file: str, exc) -> LogError:
+    """LogError for mcap's CRCValidationError: the record and its CRC field named."""
+    rec = getattr(exc, "record", None)
+    kind = type(rec).__name__ if rec is not None else "record"
+    field = {"Chunk": "uncompressed_crc", "DataEnd": "data_section_crc"}.get(kind, "crc")
+    where = "chunk" if kind == "Chunk" else "data section" if kind == "DataEnd" else kind
+    extra = ""
+    if kind == "Chunk":
+        extra = (f" (messages {rec.message_start_time}..{rec.message_end_time} ns)")
+    return LogError(file, f"checksum mismatch in the {where}{extra}: field {kind}.{field} "
+                    f"stores {getattr(exc, 'expected', 0):#010x}, the data give "
+                    f"{getattr(exc, 'actual', 0):#010x}; the file is corrupted")
 
 
 class McapSource(RosSource):
@@ -91,7 +161,9 @@ class McapSource(RosSource):
         self._channel: dict[str, tuple[str, Any]] = {}
         with open(path, "rb") as fh:
             try:
-                for rec in stream_reader.StreamReader(fh).records:
+                # chunk CRCs (uncompressed_crc) and the data section CRC (DataEnd) are checked
+                # where the file stores them (a CRC of 0 means none was written)
+                for rec in stream_reader.StreamReader(fh, validate_crcs=True).records:
                     if isinstance(rec, records.Message):
                         topic, typ, _enc, _schema = channels[rec.channel_id]
                         counts[topic] += 1
@@ -103,14 +175,23 @@ class McapSource(RosSource):
                     elif isinstance(rec, records.Channel):
                         schema = schemas.get(rec.schema_id)
                         typ = short_type(schema.name) if schema is not None else "(no schema)"
+                        if typ in _TYPES:
+                            _check_schema(file, rec.topic, rec.message_encoding, schema)
                         channels[rec.id] = (rec.topic, typ, rec.message_encoding, schema)
                         counts.setdefault(rec.topic, 0)
                         self._raw.setdefault(rec.topic, [])
                         self._channel[rec.topic] = (rec.message_encoding, schema)
                     elif isinstance(rec, records.Metadata) and rec.name == _MCAP_META:
                         self.metadata = dict(rec.metadata)
+            except LogError:
+                raise
+            except stream_reader.CRCValidationError as exc:
+                raise _crc_error(file, exc) from None
             except Exception as exc:  # noqa: BLE001 (any reader failure: a bad file)
-                if not channels:
+                if not channels or not _at_end(fh, exc):
+                    if channels:  # damage inside the file, not a recording cut short
+                        raise LogError(file, f"damaged MCAP at byte {fh.tell()} of "
+                                       f"{path.stat().st_size} ({exc_text(exc)})") from None
                     raise LogError(file, f"not a readable MCAP file ({exc_text(exc)})") from None
                 warnings.warn(f"{file}: truncated or damaged MCAP ({exc_text(exc)}); read the "
                               f"{sum(counts.values())} messages before the damage",

@@ -85,10 +85,12 @@ class Topic:
         self.stamp_ns.append(_stamp_ns(msg) if stamped else 0)
         self.values.append(_values(self.type, msg))
 
-    def times(self) -> tuple[np.ndarray, str]:
-        """Header stamps when the type has them and they are set, else the log times."""
+    def times(self, source: str = "header") -> tuple[np.ndarray, str]:
+        """Header stamps when the type has them, they are set and ``source`` is "header";
+        else the log times."""
         stamps = np.asarray(self.stamp_ns, dtype=np.int64)
-        if _TYPES[self.type][0] and stamps.size and np.any(stamps != 0):
+        if (source == "header" and _TYPES[self.type][0] and stamps.size
+                and np.any(stamps != 0)):
             return stamps, "header"
         return np.asarray(self.log_ns, dtype=np.int64), "log"
 
@@ -166,14 +168,40 @@ class RosSource:
         return wrench_topic
 
 
+#: Largest fraction of a topic's messages that may repeat the time of the message before them
+#: (dropped with a warning, the first of each time kept); more is an error. At least one
+#: duplicate is always tolerated.
+MAX_DUPLICATE_FRACTION = 0.01
+
+TIME_SOURCES = ("header", "log")
+"""How a ROS source orders its messages: by the header stamps (the sensor's clock, default)
+or by the recorder's log times."""
+
+_BY_LOG = "read by log time instead with [[alt:time_source='log'|--time-source log]]"
+
+
 def ordered(file: str, topic: Topic, ns: np.ndarray, column: str,
-            stacklevel: int) -> np.ndarray:
+            stacklevel: int, source: str = "header") -> np.ndarray:
     """Indices that put the messages of ``topic`` in increasing time ``ns`` with exact
-    duplicates dropped (first kept); both are warned about, naming the first message."""
+    duplicates dropped (first kept).
+
+    Header stamps (``source`` "header") that go backwards in recording order are an error (a
+    sensor clock that jumps back would interleave samples seconds apart), and so are
+    duplicated times on more than :data:`MAX_DUPLICATE_FRACTION` of the messages (identical
+    stamps would collapse the recording); both messages name the topic and the count. Fewer
+    duplicates are dropped with a warning; log times out of order are sorted with a warning."""
     n = len(ns)
     order = np.argsort(ns, kind="stable")
-    if n > 1 and np.any(np.diff(ns) < 0):
-        k = int(np.flatnonzero(np.diff(ns) < 0)[0]) + 1
+    back = np.flatnonzero(np.diff(ns) < 0) if n > 1 else np.zeros(0, dtype=np.int64)
+    if back.size:
+        k = int(back[0]) + 1
+        if source == "header":
+            jump = (int(ns[k]) - int(ns[k - 1])) / 1e9
+            raise LogError(file, f"the header stamps go backwards at {back.size} of {n} "
+                           f"messages, first at message {k + 1} (by {-jump:.6g} s; column "
+                           f"'{column}'): the sensor clock jumped or the messages are out of "
+                           f"order; {_BY_LOG}", where=f"topic '{topic.name}'", row=k + 1,
+                           column=column)
         warnings.warn(f"{file}: topic '{topic.name}': times go backwards from message {k + 1} "
                       f"on (column '{column}'); messages sorted by time", LogWarning,
                       stacklevel=stacklevel)
@@ -182,7 +210,15 @@ def ordered(file: str, topic: Topic, ns: np.ndarray, column: str,
     dup[1:] = s[1:] == s[:-1]
     if dup.any():
         first = int(order[np.flatnonzero(dup)[0]])
-        warnings.warn(f"{file}: topic '{topic.name}': {int(dup.sum())} message(s) with a "
+        count = int(dup.sum())
+        if count > max(1, int(MAX_DUPLICATE_FRACTION * n)):
+            alt = f"; {_BY_LOG}" if source == "header" else ""
+            raise LogError(file, f"{count} of {n} messages ({100.0 * count / n:.3g} %) repeat "
+                           f"the time of the message before them, more than "
+                           f"{100 * MAX_DUPLICATE_FRACTION:g} %; first message {first + 1} "
+                           f"(column '{column}', t = {int(ns[first])} ns){alt}",
+                           where=f"topic '{topic.name}'", row=first + 1, column=column)
+        warnings.warn(f"{file}: topic '{topic.name}': {count} message(s) with a "
                       f"duplicated time, first message {first + 1} (column '{column}', "
                       f"t = {int(ns[first])} ns); dropped, the first of each time kept",
                       LogWarning, stacklevel=stacklevel)
@@ -241,11 +277,23 @@ def to_contact(f: np.ndarray, m: np.ndarray, offset: float) -> tuple[np.ndarray,
     return tau, np.c_[x, y]
 
 
+def _metadata_t0(src: RosSource) -> int:
+    """The ``t0_ns`` field of lugrip's MCAP metadata record (an integer of nanoseconds)."""
+    text = str(src.metadata["t0_ns"]).strip()
+    if len(text) > 24 or not text.lstrip("-").isdigit() or abs(int(text)) >= 2**63:
+        raise LogError(src.file, f"metadata record {_MCAP_META!r}: field t0_ns is not an "
+                       "integer of nanoseconds")
+    return int(text)
+
+
 def read_ros(src: RosSource, *, wrench_topic: str | None, omega_topic: str | None,
              maneuver_topic: str | None, flip_normal: bool, contact_offset: float | None,
-             stacklevel: int, scalar_topics=None):
+             stacklevel: int, scalar_topics=None, time_source: str = "header"):
     """Columns of a sliding log from a ROS source (see :func:`lugrip.io.read_log`)."""
     file = src.file
+    if time_source not in TIME_SOURCES:
+        raise LogError(file, f"time_source {time_source!r}: expected one of "
+                       f"{', '.join(TIME_SOURCES)}")
     wrench_topic = src.pick_wrench_topic(wrench_topic)
     if omega_topic is None:
         omega_topic = src.metadata.get("omega_topic") or None
@@ -265,11 +313,11 @@ def read_ros(src: RosSource, *, wrench_topic: str | None, omega_topic: str | Non
     wrench = topics[wrench_topic]
     if not wrench.values:
         raise LogError(file, f"topic '{wrench_topic}' has no messages")
-    stamps, time_source = wrench.times()
-    keep = ordered(file, wrench, stamps, "t", stacklevel + 1)
+    stamps, used = wrench.times(time_source)
+    keep = ordered(file, wrench, stamps, "t", stacklevel + 1, used)
     stamps = stamps[keep]
     log_ns = np.asarray(wrench.log_ns, dtype=np.int64)[keep]
-    t0 = int(src.metadata["t0_ns"]) if "t0_ns" in src.metadata else int(stamps[0])
+    t0 = _metadata_t0(src) if "t0_ns" in src.metadata else int(stamps[0])
     t = (stamps - t0) / 1e9
     v = np.asarray(wrench.values, dtype=np.float64)[keep]
     sign = -1.0 if flip_normal else 1.0  # rotation by pi about x: y and z components flip
@@ -283,13 +331,13 @@ def read_ros(src: RosSource, *, wrench_topic: str | None, omega_topic: str | Non
     if src.metadata.get("force_vector") == "false":
         cols["f_t"] = np.hypot(cols.pop("f_x"), cols.pop("f_y"))
     prefix = "wrench." if _TYPES[wrench.type][0] else ""
-    fields = {"t": "header.stamp" if time_source == "header" else "log time",
+    fields = {"t": "header.stamp" if used == "header" else "log time",
               "f_x": prefix + "force.x", "f_y": prefix + "force.y",
               "f_t": f"|{prefix}force.xy|", "f_n": prefix + "force.z",
               "tau": prefix + ("torque.z" if contact_offset is None
                                else "torque moved to the contact point")}
     meta: dict[str, Any] = {"format": None, "wrench_topic": wrench_topic,
-                            "wrench_type": wrench.type, "time_source": time_source,
+                            "wrench_type": wrench.type, "time_source": used,
                             "t0_ns": t0, "flip_normal": bool(flip_normal)}
     if contact_offset is not None:
         meta["contact_offset"] = float(contact_offset)
@@ -298,8 +346,8 @@ def read_ros(src: RosSource, *, wrench_topic: str | None, omega_topic: str | Non
         om = topics[omega_topic]
         if not om.values:
             raise LogError(file, f"topic '{omega_topic}' has no messages")
-        o_ns, o_source = om.times()
-        pick = ordered(file, om, o_ns, "omega", stacklevel + 1)
+        o_ns, o_source = om.times(time_source)
+        pick = ordered(file, om, o_ns, "omega", stacklevel + 1, o_source)
         o_t = (o_ns[pick] - t0) / 1e9
         y = sign * np.asarray(om.values, dtype=np.float64)[pick, 0]
         step = np.diff(o_t)
@@ -310,21 +358,21 @@ def read_ros(src: RosSource, *, wrench_topic: str | None, omega_topic: str | Non
 
     if maneuver_topic is not None:
         mt = topics[maneuver_topic]
-        m_ns, m_source = mt.times()
-        pick = ordered(file, mt, m_ns, "maneuver", stacklevel + 1)
+        m_ns, m_source = mt.times(time_source)
+        pick = ordered(file, mt, m_ns, "maneuver", stacklevel + 1, m_source)
         m_val = np.asarray([val[0] for val in mt.values], dtype=np.float64)[pick]
         # compare like with like: a stamped id topic against the wrench stamps, else log times
-        at = stamps if (m_source == "header" and time_source == "header") else log_ns
+        at = stamps if (m_source == "header" and used == "header") else log_ns
         cols["maneuver"] = hold_last(m_ns[pick], m_val, at,
                                      m_val[0] if m_val.size else 0.0)
         meta["maneuver_topic"] = maneuver_topic
 
     for column, topic in scalar_topics.items():  # e.g. a recorded command: the latest value
         st = topics[topic]
-        s_ns, s_source = st.times()
-        pick = ordered(file, st, s_ns, column, stacklevel + 1)
+        s_ns, s_source = st.times(time_source)
+        pick = ordered(file, st, s_ns, column, stacklevel + 1, s_source)
         s_val = np.asarray([val[0] for val in st.values], dtype=np.float64)[pick]
-        at = stamps if (s_source == "header" and time_source == "header") else log_ns
+        at = stamps if (s_source == "header" and used == "header") else log_ns
         cols[column] = hold_last(s_ns[pick], s_val, at, np.nan)
         meta[f"{column}_topic"] = topic
 

@@ -162,13 +162,15 @@ def new_figure(
 
 def save(fig: Figure, path: str | Path, *, dpi: int = DPI) -> Path:
     """Write the figure; the format follows the suffix (.png, .pdf, .svg). Creates the parent
-    directory. Returns the path."""
+    directory. The file is replaced atomically (a temporary renamed over it). Returns the
+    path."""
+    from .._atomic import write_atomic
+
     path = Path(path)
     if not path.suffix:
         raise ValueError(f"{path}: no file suffix; use .png, .pdf or .svg")
     path.parent.mkdir(parents=True, exist_ok=True)
-    fig.savefig(path, dpi=dpi, facecolor="white")
-    return path
+    return write_atomic(path, lambda tmp: fig.savefig(tmp, dpi=dpi, facecolor="white"))
 
 
 def axis_label(name: str, symbol: str | None = None, unit: str | None = None) -> str:

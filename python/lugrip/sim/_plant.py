@@ -16,6 +16,7 @@ from typing import Any
 import numpy as np
 
 from .. import _core
+from .._nocopy import NoCopy
 from .._params import ContactParams
 
 __all__ = [
@@ -417,7 +418,7 @@ class PlantLog(_Columns):
     """
 
 
-class GraspPlant:
+class GraspPlant(NoCopy):
     """The C++ grasp simulator (deterministic with the config's seed).
 
     Args:
@@ -514,7 +515,7 @@ class GraspPlant:
         return PlantLog(self._p.run(np.ascontiguousarray(cmd, dtype=np.float64)))
 
 
-class PatchContact:
+class PatchContact(NoCopy):
     """One fingertip pad as a discretised pressure patch with per-cell bristles (docs/model.md 10.1
     (b)), driven by prescribed kinematics; for checking the limit surface it produces.
 

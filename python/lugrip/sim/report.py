@@ -16,6 +16,7 @@ from collections.abc import Sequence
 from pathlib import Path
 from typing import Any
 
+from .._atomic import write_text_atomic
 from .scenarios import (
     CRITERIA,
     ScenarioResult,
@@ -290,8 +291,8 @@ def write_json(results: Sequence[ScenarioResult], path: str | Path) -> Path:
     """metrics.json: per scenario its metrics and a pass flag per criterion."""
     path = Path(path)
     path.parent.mkdir(parents=True, exist_ok=True)
-    path.write_text(
-        json.dumps(_jsonable(metrics_document(results)), indent=2, allow_nan=False) + "\n"
+    write_text_atomic(
+        path, json.dumps(_jsonable(metrics_document(results)), indent=2, allow_nan=False) + "\n"
     )
     return path
 
@@ -313,8 +314,8 @@ def write_outputs(
     md = markdown_section(results, figures, out)
     paths = dict(figures)
     paths[report_name] = out / report_name
-    (out / report_name).write_text(
-        "# Closed-loop experiments (paper Figures 11, 13, 15, 17)\n\n" + md
+    write_text_atomic(
+        out / report_name, "# Closed-loop experiments (paper Figures 11, 13, 15, 17)\n\n" + md
     )
     paths["metrics.json"] = write_json(
         results, json_path if json_path is not None else out / "metrics.json"
@@ -633,7 +634,7 @@ def write_mujoco_outputs(data: dict[str, Any], out_dir: str | Path, json_path=No
     out = Path(out_dir)
     out.mkdir(parents=True, exist_ok=True)
     md = mujoco_markdown(data, out)
-    (out / "mujoco.md").write_text("# Closed loop on MuJoCo, beside the patch plant\n\n" + md)
+    write_text_atomic(out / "mujoco.md", "# Closed loop on MuJoCo, beside the patch plant\n\n" + md)
     doc = metrics_document(list(data["results"].values()))
     doc["plant"] = "mujoco"
     doc["seeds"] = data["seeds"]
@@ -643,7 +644,7 @@ def write_mujoco_outputs(data: dict[str, Any], out_dir: str | Path, json_path=No
     }
     path = Path(json_path) if json_path is not None else out / "mujoco_metrics.json"
     path.parent.mkdir(parents=True, exist_ok=True)
-    path.write_text(json.dumps(_jsonable(doc), indent=2, allow_nan=False) + "\n")
+    write_text_atomic(path, json.dumps(_jsonable(doc), indent=2, allow_nan=False) + "\n")
     return {"mujoco.md": out / "mujoco.md", "metrics": path, **{f"mujoco_{k}.png": v for k, v in data["figures"].items()}}
 
 
