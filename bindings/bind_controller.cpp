@@ -86,26 +86,27 @@ void bind_controller(nb::module_& m) {
       .def_prop_ro("dynamic_filter", [](const Ctrl& c) { return Lag(c.dynamic_filter(0)); })
       .def("step", [](Ctrl& c, double w0, double s0, double c0, double f0, int st0, bool p0,
                       double w1, double s1, double c1, double f1, int st1, bool p1, double r0,
-                      double r1, double t0, double t1) {
+                      double r1, double t0, double t1, double n0, double n1) {
         c.guard.check("GraspController");
         GraspControllerInput in;
-        in.fingers[0] = FingerInput{w0, s0, c0, f0, static_cast<Status>(st0), p0, r0, t0};
-        in.fingers[1] = FingerInput{w1, s1, c1, f1, static_cast<Status>(st1), p1, r1, t1};
+        in.fingers[0] = FingerInput{w0, s0, c0, f0, static_cast<Status>(st0), p0, r0, t0, n0};
+        in.fingers[1] = FingerInput{w1, s1, c1, f1, static_cast<Status>(st1), p1, r1, t1, n1};
         GraspControllerOutput o;
         c.step(in, o);
         return o;
-      }, "Per-finger values of finger 0 then finger 1: omega_hat, S, c_tilde, f_t, status, present; then omega_resolution and tau of both.")
+      }, "Per-finger values of finger 0 then finger 1: omega_hat, S, c_tilde, f_t, status, present; then omega_resolution, tau and f_n of both.")
       .def("run", [](Ctrl& c, const Fingers2& w, const Fingers2& S, const Fingers2& ct,
                      const Fingers2& ft, const Status2& st, const Bool2& present, const Int1& requests,
-                     const Fingers2& res, const Fingers2& tau) {
+                     const Fingers2& res, const Fingers2& tau, const Fingers2& fn) {
         c.guard.check("GraspController");
         const size_t n = w.shape(0);
         if (S.shape(0) != n || ct.shape(0) != n || ft.shape(0) != n || st.shape(0) != n ||
-            present.shape(0) != n || requests.shape(0) != n || res.shape(0) != n || tau.shape(0) != n)
+            present.shape(0) != n || requests.shape(0) != n || res.shape(0) != n || tau.shape(0) != n ||
+            fn.shape(0) != n)
           throw std::invalid_argument("arrays must have the same length");
         Columns<GraspControllerOutput> cols(n);
         const double *pw = w.data(), *ps = S.data(), *pc = ct.data(), *pf = ft.data(), *pr = res.data(),
-                     *pt = tau.data();
+                     *pt = tau.data(), *pn = fn.data();
         const int32_t *pst = st.data(), *prq = requests.data();
         const bool* pp = present.data();
         {
@@ -117,7 +118,7 @@ void bind_controller(nb::module_& m) {
             else if (prq[i] == 2) c.request_slipping_avoidance();
             for (int k = 0; k < 2; ++k) {
               const size_t j = 2 * i + k;
-              in.fingers[k] = FingerInput{pw[j], ps[j], pc[j], pf[j], static_cast<Status>(pst[j]), pp[j], pr[j], pt[j]};
+              in.fingers[k] = FingerInput{pw[j], ps[j], pc[j], pf[j], static_cast<Status>(pst[j]), pp[j], pr[j], pt[j], pn[j]};
             }
             c.step(in, o);
             cols.set(i, o);
@@ -126,7 +127,7 @@ void bind_controller(nb::module_& m) {
         nb::dict d;
         cols.into(d);
         return d;
-      }, "omega_hat"_a, "S"_a, "c_tilde"_a, "f_t"_a, "status"_a, "present"_a, "requests"_a, "omega_resolution"_a, "tau"_a,
+      }, "omega_hat"_a, "S"_a, "c_tilde"_a, "f_t"_a, "status"_a, "present"_a, "requests"_a, "omega_resolution"_a, "tau"_a, "f_n"_a,
          "Runs step() over (N, 2) arrays in C++ (requests: 0 none, 1 pivoting, 2 slipping "
          "avoidance, applied before the sample); returns a dict of (N,) arrays (GraspControllerOutput.fields).");
 

@@ -359,7 +359,9 @@ Status GraspController::step(const GraspControllerInput& in, GraspControllerOutp
       out.dynamic_sample[i] = cd_[i].output();  // state held, sample not filtered
       continue;
     }
-    slip = std::max(slip, f.slippage * (mu0_ / mu_));  // S against the believed mu
+    // S against the believed mu in slipping avoidance; the pivoting law and its end test keep
+    // the observers' S (their reference S-bar_p > 1 is the observers' scale).
+    slip = std::max(slip, mode_ == ControllerMode::SlippingAvoidance ? f.slippage * (mu0_ / mu_) : f.slippage);
     c_sum += std::fabs(f.c_tilde);
     f_t_max = std::max(f_t_max, std::fabs(f.f_t));
     ++n_valid;

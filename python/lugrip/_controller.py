@@ -15,6 +15,7 @@ import numpy as np
 
 from . import _core
 from ._contact import Status, _as_params, _flat, _model, _shaped
+from ._nocopy import NoCopy
 from ._params import ContactParams
 
 __all__ = [
@@ -167,7 +168,7 @@ def _per_finger(value, n: int | None, name: str, dtype) -> np.ndarray:
     return np.ascontiguousarray(np.broadcast_to(a, (n, 2)))
 
 
-class GraspController:
+class GraspController(NoCopy):
     """Two-mode grasp-force controller f_n = f_ns + f_nd (paper eqs. 34-37, docs/model.md 9).
 
     * Dynamic part f_nd = |C_d omega_hat|, C_d(s) = k_cd (s + z_cd)/(s + p_cd) discretised by
@@ -284,7 +285,7 @@ class GraspController:
 
     # --- stepping --------------------------------------------------------------------------
     def step(self, omega_hat, S, c_tilde=0.0, f_t=0.0, status=Status.OK,
-             present=None, omega_resolution=0.0, tau=0.0) -> ControllerOutput:
+             present=None, omega_resolution=0.0, tau=0.0, f_n=0.0) -> ControllerOutput:
         """One sensor sample. Scalars describe finger 0 alone (finger 1 absent unless `present`
         says otherwise, then it gets the same values); length-2 sequences describe both fingers.
 
@@ -296,9 +297,10 @@ class GraspController:
                 its output), used by the dead band of the dynamic part (``omega_deadband``).
             tau: measured torsional moment [N m] (signed), with f_t the load of the
                 feed-forward and of the slope (``feedforward``, ``slope_gain``).
+            f_n: measured normal force [N] (the grip probe, ``mu_probe``; 0: unknown, no probe).
         """
         vals = [np.atleast_1d(np.asarray(v, dtype=np.float64))
-                for v in (omega_hat, S, c_tilde, f_t, omega_resolution, tau)]
+                for v in (omega_hat, S, c_tilde, f_t, omega_resolution, tau, f_n)]
         st = np.atleast_1d(np.asarray(status, dtype=np.int64))
         n_fingers = max(len(v) for v in vals + [st])
         if n_fingers > 2 or any(len(v) not in (1, n_fingers) for v in vals + [st]):
@@ -310,13 +312,14 @@ class GraspController:
         else:
             p = np.broadcast_to(np.asarray(present, dtype=bool), (2,))
             pres = (bool(p[0]), bool(p[1]))
-        w, s, c, f, r, tq = (tuple(float(x) for x in v) for v in vals)
+        w, s, c, f, r, tq, fn = (tuple(float(x) for x in v) for v in vals)
         o = self._ctrl.step(w[0], s[0], c[0], f[0], int(st[0]), pres[0],
-                            w[1], s[1], c[1], f[1], int(st[1]), pres[1], r[0], r[1], tq[0], tq[1])
+                            w[1], s[1], c[1], f[1], int(st[1]), pres[1], r[0], r[1], tq[0], tq[1],
+                            fn[0], fn[1])
         return ControllerOutput._from_core(o)
 
     def run(self, omega_hat, S, c_tilde=0.0, f_t=0.0, status=None, present=None,
-            requests=None, omega_resolution=0.0, tau=0.0) -> ControllerRun:
+            requests=None, omega_resolution=0.0, tau=0.0, f_n=0.0) -> ControllerRun:
         """Step over N sensor samples in one C++ loop (state carried over between calls).
 
         Args:
@@ -331,11 +334,12 @@ class GraspController:
             omega_resolution: the observers' speed resolution [rad/s], like omega_hat (used by
                 the dead band ``omega_deadband``; default 0: no dead band).
             tau: measured torsional moment [N m], like f_t (feed-forward and slope load).
+            f_n: measured normal force [N], like f_t (the grip probe; 0: unknown, no probe).
 
         Returns:
             ControllerRun with (N,) arrays.
         """
-        arrays = [np.asarray(v) for v in (omega_hat, S, c_tilde, f_t, omega_resolution, tau)]
+        arrays = [np.asarray(v) for v in (omega_hat, S, c_tilde, f_t, omega_resolution, tau, f_n)]
         extra = [np.asarray(v) for v in (status,) if v is not None]
         shaped = [a for a in arrays + extra if a.ndim >= 1]
         if not shaped:
@@ -347,10 +351,10 @@ class GraspController:
             raise ValueError("all per-sample inputs must have the same number of samples")
         n = lengths.pop()
         two = any(a.ndim == 2 and a.shape[1] == 2 for a in shaped)
-        w, s, c, f, res, tq = (
+        w, s, c, f, res, tq, fn = (
             _per_finger(a, n, name, np.float64)
             for a, name in zip(
-                arrays, ("omega_hat", "S", "c_tilde", "f_t", "omega_resolution", "tau")
+                arrays, ("omega_hat", "S", "c_tilde", "f_t", "omega_resolution", "tau", "f_n")
             )
         )
         st = _per_finger(Status.OK if status is None else status, n, "status", np.int32)
@@ -368,7 +372,7 @@ class GraspController:
                 req[int(index)] = codes[what]
         elif requests is not None:
             req[:] = np.asarray(requests, dtype=np.int32)
-        r = self._ctrl.run(w, s, c, f, st, pres, req, res, tq)
+        r = self._ctrl.run(w, s, c, f, st, pres, req, res, tq, fn)
         for name, kind, _doc in OUTPUT_FIELDS:
             if kind == "pair":
                 r[name] = np.stack([r.pop(name + "_0"), r.pop(name + "_1")], axis=1)

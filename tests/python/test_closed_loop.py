@@ -226,8 +226,9 @@ def test_estimator_parameters_feed_the_observers_and_default_to_the_plants():
         closed_loop_config(p, None, OBS, estimator={"sigma_z": -1.0})
     with pytest.raises(ValueError):
         closed_loop_config(p, None, OBS, estimator=3.0)
-    # without the fast reaction to load changes, which also catches the late-seen lift-off
-    slow = {"feedforward_horizon": 0.0, "reaction_lag": 0.0}
+    # without the fast reaction to load changes, which also catches the late-seen lift-off, and
+    # without the ceiling (which, without the fast reaction, lets this lift-off turn 5 deg)
+    slow = {"feedforward_horizon": 0.0, "reaction_lag": 0.0, "ceiling_factor": 0.0}
     own = run_closed_loop(p, slow, OBS, None, 4.0)
     table1 = run_closed_loop(p, slow, OBS, None, 4.0, estimator={"sigma_z": 2.0})
     rot_own = np.degrees(np.max(np.abs(own["rotation"])))

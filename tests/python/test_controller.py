@@ -68,7 +68,9 @@ def test_cd_step_response_through_the_controller():
 
 def test_peak_of_the_last_command_period_reaches_the_command():
     """A one-sample slip spike between commands is not lost: f_nd = max |C_d omega_hat|."""
-    ctrl = GraspController(CAN, s_ref=0.8, max_rate_up=math.inf, max_rate_down=math.inf)
+    # the C_d layer alone (with the ceiling on, C_d adds at most one reflex step)
+    ctrl = GraspController(CAN, s_ref=0.8, max_rate_up=math.inf, max_rate_down=math.inf,
+                           ceiling_factor=0.0)
     ctrl.reset(2.0)
     w = np.zeros(11)
     w[4] = -0.1
@@ -134,7 +136,7 @@ def test_ceiling_and_floor_and_validation_messages():
 
 def test_zero_order_hold_at_the_command_rate():
     rng = np.random.default_rng(1)
-    ctrl = GraspController(CAN)
+    ctrl = GraspController(CAN, ceiling_factor=0.0)  # random S: every command moves
     ctrl.reset(3.0)
     n = 1000
     run = ctrl.run(0.02 * rng.standard_normal(n), rng.uniform(0, 1, n), 0.5, 0.5)
@@ -145,7 +147,7 @@ def test_zero_order_hold_at_the_command_rate():
 
 
 def test_two_fingers_combine_max_s_and_max_dynamic_part():
-    ctrl = GraspController(CAN, max_rate_up=math.inf, max_rate_down=math.inf)
+    ctrl = GraspController(CAN, max_rate_up=math.inf, max_rate_down=math.inf, ceiling_factor=0.0)
     ctrl.reset(5.0)
     n = 11
     w = np.tile([0.0, -0.05], (n, 1))
@@ -154,7 +156,7 @@ def test_two_fingers_combine_max_s_and_max_dynamic_part():
     assert run.slippage[0] == 0.9
     assert run.mean_c_tilde[0] == pytest.approx(0.8)
     assert run.dynamic_force[10] == pytest.approx(np.max(np.abs(run.dynamic_sample[1:11, 1])))
-    one = GraspController(CAN, max_rate_up=math.inf, max_rate_down=math.inf)
+    one = GraspController(CAN, max_rate_up=math.inf, max_rate_down=math.inf, ceiling_factor=0.0)
     one.reset(5.0)
     r1 = one.run(w[:, 1], S[:, 1], 1.4, 1.0)  # the dominant finger alone gives the same command
     np.testing.assert_array_equal(r1.force, run.force)
@@ -305,7 +307,7 @@ def test_closed_loop_settles_at_the_static_force(obj, ft, tau):
 def test_dead_band_ignores_speeds_below_the_observer_resolution():
     """omega_deadband (in multiples of the observer's omega_resolution) removes the noise-level
     speeds from C_d: no dynamic force below the band, the force of the shrunk speed above it."""
-    kw = {"omega_deadband": 2.0}
+    kw = {"omega_deadband": 2.0, "ceiling_factor": 0.0}  # the C_d layer alone
     below = lugrip.GraspController("aluminium_can", **kw).run(
         np.full(40, 0.015), 0.8, omega_resolution=0.01
     )

@@ -1,4 +1,5 @@
-"""Objects that own C++ state (SlipControl, Observer, SliderModel, GraspPlant, PatchContact)
+"""Objects that own C++ state (SlipControl, GraspController, Observer, SliderModel, GraspPlant,
+PatchContact)
 refuse copy.copy, copy.deepcopy and pickle with a TypeError: a shallow copy of the Python
 wrapper shared the C++ object, so stepping the copy changed the original's next outputs (two
 grippers' samples interleaved). Two objects built from the same arguments are independent."""
@@ -27,7 +28,8 @@ def _objects():
     from lugrip.sim._plant import PatchContact
 
     p = ContactParams.table1()
-    return [SlipControl("table1"), Observer(p), SliderModel(p, 1e-4), PatchContact(p)]
+    return [SlipControl("table1"), lugrip.GraspController(p), Observer(p), SliderModel(p, 1e-4),
+            PatchContact(p)]
 
 
 @pytest.mark.parametrize("how", [copy.copy, copy.deepcopy, pickle.dumps],

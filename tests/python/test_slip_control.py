@@ -137,7 +137,7 @@ def test_same_numbers_as_the_hand_wired_path_with_statuses():
         r = ref.step(omega_hat=[x.omega_hat for x in o], S=[x.S for x in o],
                      c_tilde=[x.c_tilde for x in o], f_t=[x for x in np.hypot(w[k, :, 1], w[k, :, 2])],
                      status=[int(x.status) for x in o], omega_resolution=[x.omega_resolution for x in o],
-                     tau=list(w[k, :, 3]))
+                     tau=list(w[k, :, 3]), f_n=list(w[k, :, 0]))
         out = ctrl.step(w[k])
         # f_t: the C++ core uses its own planar norm, within an ulp of numpy's hypot
         assert out.force == pytest.approx(r.force, rel=1e-12, abs=1e-12), k
