@@ -99,6 +99,11 @@ struct IntField {
   const char* name;
   int* (*ref)(S&);
 };
+template <class S>
+struct BoolField {
+  const char* name;
+  bool* (*ref)(S&);
+};
 
 // Total order of doubles as integers (negative values mapped below positive ones).
 inline int64_t order_key(double v) {
@@ -205,6 +210,7 @@ struct SettingsSpace {
   S base;
   std::vector<RealField<S>> reals;
   std::vector<IntField<S>> ints;
+  std::vector<BoolField<S>> bools;  // every value is valid: drawn true or false
   std::vector<Edges> real_edges, int_edges;
 
   template <class Valid>
@@ -239,6 +245,8 @@ struct SettingsSpace {
         const double v = pick(src, int_edges[i], *ints[i].ref(s), allow_invalid);
         *ints[i].ref(s) = std::isfinite(v) && std::fabs(v) < 2.1e9 ? static_cast<int>(v) : -1;
       }
+    for (const auto& f : bools)
+      if (src.chance(p_field)) *f.ref(s) = src.chance(0.5);
     return s;
   }
 };
@@ -247,6 +255,8 @@ struct SettingsSpace {
   RealField<S> { #field, [](S& s) -> double* { return &s.field; } }
 #define LUGRIP_FUZZ_INT(S, field) \
   IntField<S> { #field, [](S& s) -> int* { return &s.field; } }
+#define LUGRIP_FUZZ_BOOL(S, field) \
+  BoolField<S> { #field, [](S& s) -> bool* { return &s.field; } }
 
 // --- statistics ---------------------------------------------------------------------------------
 struct Stats {
@@ -314,8 +324,15 @@ class Campaign {
                   LUGRIP_FUZZ_REAL(G, pivot_end_slippage),
                   LUGRIP_FUZZ_REAL(G, feedforward_horizon), LUGRIP_FUZZ_REAL(G, feedforward_trend),
                   LUGRIP_FUZZ_REAL(G, reaction_lag),      LUGRIP_FUZZ_REAL(G, reserve_force),
-                  LUGRIP_FUZZ_REAL(G, reserve_torque)};
-    ctl_.ints = {LUGRIP_FUZZ_INT(G, command_ratio), LUGRIP_FUZZ_INT(G, pivot_end_samples)};
+                  LUGRIP_FUZZ_REAL(G, reserve_torque),    LUGRIP_FUZZ_REAL(G, loop_gain_p),
+                  LUGRIP_FUZZ_REAL(G, loop_gain_i),       LUGRIP_FUZZ_REAL(G, feedforward_slippage),
+                  LUGRIP_FUZZ_REAL(G, reflex_slippage),   LUGRIP_FUZZ_REAL(G, reflex_factor)};
+    ctl_.ints = {LUGRIP_FUZZ_INT(G, command_ratio), LUGRIP_FUZZ_INT(G, pivot_end_samples),
+                 LUGRIP_FUZZ_INT(G, reflex_samples)};
+    ctl_.bools = {LUGRIP_FUZZ_BOOL(G, dynamic_enabled), LUGRIP_FUZZ_BOOL(G, anti_windup),
+                  LUGRIP_FUZZ_BOOL(G, slope_gain),      LUGRIP_FUZZ_BOOL(G, average_slippage),
+                  LUGRIP_FUZZ_BOOL(G, feedforward),     LUGRIP_FUZZ_BOOL(G, slip_reflex),
+                  LUGRIP_FUZZ_BOOL(G, pivot_end_at_floor)};
     ctl_.init([](const G& s) { return validate(s, nullptr); });
   }
 

@@ -442,3 +442,16 @@ def test_light_cup_on_mujoco_holds_without_a_limit_cycle():
         out[label] = _steady_ptp(run, 3.5, 5.0)
     assert out["lugrip"] < 0.10
     assert out["paper"] > 0.5
+
+
+def test_the_seeded_fuzz_campaign_draws_every_controller_field():
+    """The C++ adversarial campaign (tests/fuzz/campaign.hpp) lists the controller's fields by
+    hand; this compares that list with the binding's field table, so a new setting cannot be
+    left out of it (booleans included)."""
+    import re
+    from pathlib import Path
+
+    text = (Path(__file__).resolve().parents[1] / "fuzz" / "campaign.hpp").read_text()
+    listed = set(re.findall(r"LUGRIP_FUZZ_(?:REAL|INT|BOOL)\(G, (\w+)\)", text))
+    fields = {name for name, _kind, _doc in lugrip._core.GraspControllerSettings.fields}
+    assert listed == fields, (sorted(fields - listed), sorted(listed - fields))

@@ -1,0 +1,65 @@
+// lugrip — SlipControl::step for two fingers in C++: the real-time call a robot loop makes at
+// the sensor rate (both observers, the controller with the grip probe and the ceiling).
+//
+// Input: a precomputed stream of two-finger wrenches of a quasi-static grasp (a lift-like ramp
+// of the load, a steady hold, a push, sensor noise), replayed in order so that the controller
+// runs its real branches (feed-forward, reflex, probes). Each repetition resets the object and
+// steps the whole stream; the per-call figure is the median over repetitions of the stream's
+// mean time per step (time_batched: batches of 16 calls). Allocations inside the timed loops are
+// counted (counting operator new). The same source builds against any lugrip version with this
+// API, so a baseline can be built from another checkout and run beside it:
+//   bench_slip_control [--quick]
+#include <cmath>
+#include <cstdio>
+#include <cstring>
+#include <random>
+#include <vector>
+
+#include "bench_timing.hpp"
+#include "lugrip/slip_control.hpp"
+
+using namespace lugrip;
+
+int main(int argc, char** argv) {
+  const bool quick = argc > 1 && std::strcmp(argv[1], "--quick") == 0;
+  const int n = quick ? 20000 : 100000;
+  const int reps = quick ? 5 : 15;
+  std::mt19937 rng(7);
+  std::normal_distribution<double> noise(0.0, 1.0);
+  std::vector<SlipControlInput> stream(static_cast<size_t>(n));
+  for (int k = 0; k < n; ++k) {
+    const double t = k * 0.002;
+    const double load = 0.6 * std::min(1.0, t / 0.5) + (std::fmod(t, 20.0) > 10.0 && std::fmod(t, 20.0) < 10.3 ? 0.4 : 0.0);
+    for (int i = 0; i < 2; ++i) {
+      FingerWrench& w = stream[static_cast<size_t>(k)].fingers[static_cast<size_t>(i)];
+      w.f_n = 3.0 + 0.01 * noise(rng);
+      w.f_x = 0.005 * noise(rng);
+      w.f_y = load + 0.005 * noise(rng);
+      w.tau = 1.5e-3 * std::min(1.0, t / 0.5) + 2e-5 * noise(rng);
+    }
+  }
+  SlipControl sc(object_params("small_resin_block"));
+  SlipControlOutput out;
+  std::vector<double> per_step;
+  per_step.reserve(static_cast<size_t>(reps));
+  long allocs = 0;
+  double sink = 0.0;
+  for (int r = 0; r < reps; ++r) {
+    sc.reset(3.0);
+    const long before = lugrip_support::g_allocations.load();
+    const auto t0 = lugrip_bench::Clock::now();
+    for (int k = 0; k < n; ++k) {
+      sc.step(stream[static_cast<size_t>(k)], out);
+      sink += out.force;
+    }
+    const auto t1 = lugrip_bench::Clock::now();
+    allocs += lugrip_support::g_allocations.load() - before;
+    per_step.push_back(lugrip_bench::ns_between(t0, t1) / n);
+  }
+  std::sort(per_step.begin(), per_step.end());
+  std::printf("SlipControl::step, two fingers: median %.1f ns per step, best %.1f ns, worst %.1f ns "
+              "(%d repetitions of %d steps); allocations in the timed loops: %ld; build %s (%s)%s\n",
+              per_step[per_step.size() / 2], per_step.front(), per_step.back(), reps, n, allocs,
+              LUGRIP_BENCH_BUILD_TYPE, LUGRIP_BENCH_CXX_FLAGS, sink > 0 ? "" : " ");
+  return 0;
+}
