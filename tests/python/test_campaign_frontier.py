@@ -524,3 +524,16 @@ def test_mujoco_plant_takes_the_campaign_mass_range(mass, mu, offset_x, force):
     assert row["error"] is None and row["m_scene_status"] == "ok"
     assert row["min_static_force"] < force < row["crush_force"]
     assert row["success"], {k: v for k, v in row.items() if k.startswith(("pass_", "m_hold"))}
+
+
+@pytest.mark.parametrize("name", ["everyday_patch", "hard_patch_overbelief", "everyday_mujoco"])
+def test_the_shipped_campaign_files_pass_the_check_at_load(name):
+    """The load-time check builds every drawn parameter at both ends of its support: for the
+    counted pushes, push_count at 3 draws three pushes (it once failed on the missing second
+    push), and a per-push parameter at a bound sets every push of the run."""
+    from lugrip.campaign.definition import load_campaign
+    from lugrip.campaign.validate import validate_campaign
+
+    if name.endswith("mujoco"):
+        pytest.importorskip("mujoco")
+    validate_campaign(load_campaign(ROOT / "campaigns" / f"{name}.yaml"))

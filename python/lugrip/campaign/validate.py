@@ -22,7 +22,7 @@ from __future__ import annotations
 import math
 from typing import Any
 
-from .definition import Campaign, CampaignError
+from .definition import PUSH_PARAMETERS, Campaign, CampaignError
 
 __all__ = ["CHECK_DURATION", "validate_campaign"]
 
@@ -119,8 +119,16 @@ def validate_campaign(campaign: Campaign) -> None:
         for which, v in (("low", lo), ("high", hi)):
             if not math.isfinite(v) or v == values[name]:
                 continue
+            trial = values | {name: float(v)}
+            if campaign.counted_pushes:
+                if name == "push_count":  # that many pushes, drawn as a run would draw them
+                    trial.update(campaign._draw_pushes(campaign.draw_seed, 0, int(v)))
+                elif name in PUSH_PARAMETERS:  # every push of run 0 at the bound
+                    for k in range(campaign.max_pushes):
+                        if trial.get(f"{name}_{k}") is not None:
+                            trial[f"{name}_{k}"] = float(v)
             try:
-                _build(campaign, values | {name: float(v)}, first)
+                _build(campaign, trial, first)
             except CampaignError as err:
                 raise CampaignError(f"{where}: {err} (the {which} bound of parameters.{name})"
                                     ) from None
