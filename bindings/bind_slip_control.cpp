@@ -53,29 +53,32 @@ void bind_slip_control(nb::module_& m) {
            "settings"_a = SlipControlSettings())
       .def(nb::init<const ContactModel&, const SlipControlSettings&>(), "model"_a,
            "settings"_a = SlipControlSettings())
-      .def("step", [](SC& sc, const Wrenches& w, double dt) {
+      .def("step", [](SC& sc, const Wrenches& w, double dt, int command) {
         sc.guard.check("SlipControl");
         SlipControlInput in;
         load(sc, w.data(), w.size(), in);
         in.dt = dt;
+        in.command = static_cast<CommandTiming>(command);
         SlipControlOutput o;
         sc.step(in, o);
         return o;
-      }, "wrenches"_a, "dt"_a = 0.0,
+      }, "wrenches"_a, "dt"_a = 0.0, "command"_a = 0,
          "One cycle: wrenches = fingers x (f_n, f_x, f_y, tau) float64 values (C order); dt [s] since "
-         "the previous cycle (0: nominal).")
-      .def("run", [](SC& sc, const Batch& w, const Times& dt, const Requests& req) {
+         "the previous cycle (0: nominal); command: 0 the clock, 1 a command now, 2 none (CommandTiming).")
+      .def("run", [](SC& sc, const Batch& w, const Times& dt, const Requests& req, const Requests& cmd) {
         sc.guard.check("SlipControl");
         const size_t n = w.shape(0), k = w.shape(1);
         if (w.shape(2) != 4 || (k != static_cast<size_t>(sc.fingers()) && k != kMaxFingers))
           throw std::invalid_argument("wrenches: expected shape (N, " + std::to_string(sc.fingers()) + ", 4)");
         if (dt.shape(0) != n && dt.shape(0) != 0) throw std::invalid_argument("dt: expected N values or none");
         if (req.shape(0) != n && req.shape(0) != 0) throw std::invalid_argument("requests: expected N values or none");
+        if (cmd.shape(0) != n && cmd.shape(0) != 0) throw std::invalid_argument("commands: expected N values or none");
         Columns<GraspControllerOutput> ctrl(n);
         Columns<ObserverOutput> f0(n, "_0"), f1(n, "_1");
         const double* pw = w.data();
         const double* pd = dt.shape(0) ? dt.data() : nullptr;
         const int32_t* pr = req.shape(0) ? req.data() : nullptr;
+        const int32_t* pc = cmd.shape(0) ? cmd.data() : nullptr;
         const bool two = sc.fingers() == 2;
         {
           nb::gil_scoped_release release;
@@ -89,6 +92,7 @@ void bind_slip_control(nb::module_& m) {
               in.fingers[j] = FingerWrench{x[0], x[1], x[2], x[3]};
             }
             in.dt = pd ? pd[i] : 0.0;
+            in.command = pc ? static_cast<CommandTiming>(pc[i]) : CommandTiming::Clock;
             sc.step(in, o);
             ctrl.set(i, o.controller);
             f0.set(i, o.fingers[0]);
@@ -100,9 +104,10 @@ void bind_slip_control(nb::module_& m) {
         f0.into(d);
         if (two) f1.into(d);
         return d;
-      }, "wrenches"_a, "dt"_a, "requests"_a,
+      }, "wrenches"_a, "dt"_a, "requests"_a, "commands"_a,
          "Runs step() over (N, fingers, 4) wrenches in one C++ loop (dt: (N,) or empty; requests: (N,) "
-         "0 none, 1 pivoting, 2 slipping avoidance, or empty). Returns a dict of (N,) arrays: the "
+         "0 none, 1 pivoting, 2 slipping avoidance, or empty; commands: (N,) CommandTiming codes or "
+         "empty for the clock). Returns a dict of (N,) arrays: the "
          "GraspControllerOutput fields and each finger's ObserverOutput fields suffixed _0 / _1.")
       .def("reset", [](SC& sc, double force) {
         sc.guard.check("SlipControl");

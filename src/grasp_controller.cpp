@@ -433,10 +433,14 @@ Status GraspController::step(const GraspControllerInput& in, GraspControllerOutp
   }
   out.pivot_time = mode_ == ControllerMode::Pivoting ? static_cast<double>(pivot_samples_) * dt_ : 0.0;
 
-  if (phase_ == 0) {
+  // Hold suppresses the command; any other code than Now and Hold is the clock's.
+  const bool now = in.command == CommandTiming::Now, hold = in.command == CommandTiming::Hold;
+  const bool due = now || (!hold && phase_ == 0);
+  if (due) {
     // The PI's S: this sample (paper) or the mean over the command period (anti-aliasing).
     issue_command(valid, s_.average_slippage && n_s_ > 0 ? sum_s_ / n_s_ : slip);
     out.command_issued = true;
+    if (now) phase_ = 0;  // the clock restarts at this command
   }
   phase_ = phase_ + 1 >= s_.command_ratio ? 0 : phase_ + 1;
 

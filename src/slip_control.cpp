@@ -97,6 +97,7 @@ Status SlipControl::step(const SlipControlInput& in, SlipControlOutput& out) noe
         ++n_faulty;
       }
   if (n_faulty == 1) cin_.fingers[faulty].present = false;  // this cycle only
+  cin_.command = in.command;
   ctrl_.step(cin_, out.controller);
   if (n_faulty == 1) cin_.fingers[faulty].present = true;
   out.force = out.controller.force;

@@ -221,8 +221,23 @@ struct FingerInput {
 };
 
 //! Input of one step(): the two fingertips at one sensor sample.
+//! When the call computes a command. Stable integer values.
+enum class CommandTiming : int {
+  //! The controller's clock: the first call after construction or reset() and every
+  //! command_ratio-th call after it. A command is then computed from the samples up to the
+  //! one of that call, i.e. from the first sample of each period onwards.
+  Clock = 0,
+  //! A command now, from the samples since the last command including this one; the clock
+  //! restarts here. A gripper that takes a command after each batch of samples passes Now
+  //! with the batch's newest sample (and Hold with the others): the command is not a period
+  //! old when it is sent.
+  Now = 1,
+  Hold = 2,  //!< no command in this call (the samples count toward the next one)
+};
+
 struct GraspControllerInput {
   std::array<FingerInput, kMaxFingers> fingers{};
+  CommandTiming command = CommandTiming::Clock;  //!< when this call computes a command
 };
 
 //! Output of one step() (caller-owned, reused). The command fields are those of the last

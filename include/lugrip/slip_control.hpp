@@ -46,6 +46,9 @@ struct FingerWrench {
 struct SlipControlInput {
   std::array<FingerWrench, kMaxFingers> fingers{};  //!< per-finger wrench
   double dt = 0.0;  //!< [s] time since the previous cycle; 0: the nominal observer dt
+  //! When this cycle computes a command (GraspController's CommandTiming): Clock (every
+  //! command_ratio-th cycle from reset), Now (a command from the samples up to this one) or Hold.
+  CommandTiming command = CommandTiming::Clock;
 };
 
 //! Output of one cycle (caller-owned, reused).

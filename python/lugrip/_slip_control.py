@@ -53,6 +53,10 @@ class SlipControlRun(dict):
         return {name: self[name + suffix] for name in names if name + suffix in self}
 
 
+#: Codes of SlipControl.step's ``command`` (lugrip::CommandTiming).
+_COMMAND_CODES = {"clock": 0, "now": 1, "hold": 2}
+
+
 class SlipControl(NoCopy):
     """Slip detection and grasp-force control for a parallel gripper with one or two
     force/torque fingertips (paper eqs. 19-23 and 34-37; docs/model.md §7, §9).
@@ -159,13 +163,19 @@ class SlipControl(NoCopy):
         return self._sc.settings
 
     # --- the cycle -------------------------------------------------------------------------
-    def step(self, wrenches, dt: float = 0.0):
+    def step(self, wrenches, dt: float = 0.0, command: str = "clock"):
         """One cycle at the sensor rate.
 
         Args:
             wrenches: (fingers, 4) values (f_n, f_x, f_y, tau) per finger, a float64 array for
                 the fast path (any array-like is converted). One finger also takes (4,).
             dt: [s] time since the previous cycle; 0 means the nominal period.
+            command: when this cycle computes a command: ``"clock"`` (the first cycle after
+                reset and every ``command_ratio``-th after it), ``"now"`` (from the samples up
+                to this one; the clock restarts here) or ``"hold"`` (none). A gripper that takes
+                one command per batch of samples passes ``"now"`` with the batch's newest
+                sample and ``"hold"`` with the others, so the command it sends is not a period
+                old.
 
         Returns:
             ``lugrip._core.SlipControlOutput``: ``force`` (the command [N]), ``status``
@@ -173,12 +183,15 @@ class SlipControl(NoCopy):
             (GraspControllerOutput: static/dynamic parts, mode, pivot_finished, held, ...) and
             ``fingers`` (each finger's ObserverOutput). Never raises on bad samples.
         """
+        code = _COMMAND_CODES.get(command)
+        if code is None:
+            raise ValueError(f"command {command!r}: expected one of {list(_COMMAND_CODES)}")
         try:
-            return self._sc.step(wrenches, dt)
+            return self._sc.step(wrenches, dt, code)
         except TypeError:
-            return self._sc.step(np.ascontiguousarray(wrenches, dtype=np.float64), float(dt))
+            return self._sc.step(np.ascontiguousarray(wrenches, dtype=np.float64), float(dt), code)
 
-    def run(self, wrenches, dt=None, requests=None) -> SlipControlRun:
+    def run(self, wrenches, dt=None, requests=None, commands=None) -> SlipControlRun:
         """Step over N cycles in one C++ loop (state carried over between calls).
 
         Args:
@@ -187,6 +200,9 @@ class SlipControl(NoCopy):
             requests: None, (N,) ints applied before each sample (0 none,
                 REQUEST_PIVOTING, REQUEST_SLIPPING_AVOIDANCE) or a dict {sample index:
                 "pivoting" | "slipping_avoidance"}.
+            commands: None (the controller's clock) or (N,) bools, True where a command is due
+                (computed from the samples since the last one, this one included) and False
+                where none is (see :meth:`step`).
 
         Returns:
             :class:`SlipControlRun`.
@@ -207,7 +223,14 @@ class SlipControl(NoCopy):
                 req[int(index)] = codes[what]
         elif requests is not None:
             req[:] = np.asarray(requests, dtype=np.int32)
-        return SlipControlRun(self._sc.run(w, d, req))
+        if commands is None:
+            cmd = np.zeros(0, dtype=np.int32)
+        else:
+            due = np.asarray(commands)
+            if due.shape != (n,) or due.dtype != bool:
+                raise ValueError(f"commands: expected ({n},) bools, got {due.dtype} {due.shape}")
+            cmd = np.where(due, _COMMAND_CODES["now"], _COMMAND_CODES["hold"]).astype(np.int32)
+        return SlipControlRun(self._sc.run(w, d, req, cmd))
 
     # --- run-time calls --------------------------------------------------------------------
     def reset(self, force: float | None = None) -> None:
@@ -227,9 +250,10 @@ class SlipControl(NoCopy):
         self._sc.set_dynamic_enabled(bool(enabled))
 
     def set_mu(self, mu: float) -> None:
-        """New friction coefficient for the observers and the controller (the per-object refit).
-        Rebuilds the contact tables (a few ms): call it between cycles. The observers restart at
-        the next sample; the controller keeps its mode and command."""
+        """New friction coefficient for the observers and the controller (the per-object refit;
+        the controller's learned belief restarts from it). Real-time safe in C++ (mu scales the
+        contact maps; no table is rebuilt). The observers restart at the next sample; the
+        controller keeps its mode and command."""
         mu = float(mu)
         params = self._params.replace(mu=mu)  # validates (ValueError naming mu)
         self._sc.set_mu(mu)

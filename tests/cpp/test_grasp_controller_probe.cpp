@@ -170,3 +170,46 @@ TEST(ControllerProbe, SetMuIsRealTimeAndRestartsTheBelief) {
     EXPECT_NEAR(b.solve(1.0, tau).force, ref.solve(1.0, tau).force, 1e-9 * ref.solve(1.0, tau).force) << tau;
   }
 }
+
+TEST(ControllerCommandTiming, TheCallerSaysWhenACommandIsDue) {
+  // A gripper fed in batches of 10 samples takes one command per batch: Hold on the first nine,
+  // Now on the newest. The command is computed exactly there, from the batch's own samples (the
+  // PI's S is their mean), not from the batch's first sample as the clock would.
+  GraspControllerSettings s;
+  s.ceiling_factor = 0.0;
+  s.feedforward = false;
+  GraspController clock(told(0.6), s), caller(told(0.6), s);
+  clock.reset(2.0);
+  caller.reset(2.0);
+  GraspControllerOutput oc, on;
+  int issued = 0;
+  for (int batch = 0; batch < 20; ++batch) {
+    double sum = 0.0;
+    for (int k = 0; k < 10; ++k) {
+      GraspControllerInput in;
+      for (auto& f : in.fingers) {
+        f.slippage = 0.5 + 0.04 * k + 0.01 * batch;  // S rising within each batch
+        f.c_tilde = 1.5;
+      }
+      sum += in.fingers[0].slippage;
+      clock.step(in, oc);
+      in.command = k == 9 ? CommandTiming::Now : CommandTiming::Hold;
+      caller.step(in, on);
+      EXPECT_EQ(on.command_issued, k == 9) << batch << " " << k;
+      issued += on.command_issued;
+      EXPECT_EQ(oc.command_issued, k == 0) << batch << " " << k;
+    }
+    if (batch > 0) EXPECT_NEAR(on.slippage, sum / 10.0, 1e-12) << batch;
+  }
+  EXPECT_EQ(issued, 20);
+  // Unknown codes count as the clock's (a hostile value never silences the controller).
+  GraspController odd(told(0.6), s);
+  GraspControllerInput in;
+  in.command = static_cast<CommandTiming>(7);
+  int n = 0;
+  for (int k = 0; k < 30; ++k) {
+    odd.step(in, on);
+    n += on.command_issued;
+  }
+  EXPECT_EQ(n, 3);
+}

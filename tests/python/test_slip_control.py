@@ -314,3 +314,38 @@ def test_robot_loop_example_holds_through_the_contact_loss():
     path = Path(__file__).resolve().parents[2] / "examples" / "04_robot_loop.py"
     module = runpy.run_path(str(path), run_name="example_04")
     assert module["main"]() >= 0.0
+
+
+def test_the_caller_says_when_a_command_is_due():
+    """A 50 Hz gripper fed 10-sample batches: 'now' with each batch's newest sample, 'hold'
+    with the others. Commands come exactly there, step() and run() agree, and the clock (the
+    first sample of each period) computes its commands from a period that lags by nine samples
+    (S is the period's mean: a rising load reads higher when the newest samples are in it)."""
+    rng = np.random.default_rng(4)
+    n = 400
+    w = np.empty((n, 2, 4))
+    w[:, :, 0] = 3.0 + 0.005 * rng.standard_normal((n, 2))
+    w[:, :, 1] = np.linspace(0.1, 1.2, n)[:, None]            # a load rising through the run
+    w[:, :, 2] = 0.005 * rng.standard_normal((n, 2))
+    w[:, :, 3] = 1e-4 * rng.standard_normal((n, 2))
+    due = np.arange(n) % 10 == 9
+    a = lugrip.SlipControl(CAN)
+    stepped = [a.step(w[k], command="now" if due[k] else "hold") for k in range(n)]
+    issued = np.array([o.controller.command_issued for o in stepped])
+    np.testing.assert_array_equal(issued, due)
+    b = lugrip.SlipControl(CAN)
+    run = b.run(w, commands=due)
+    np.testing.assert_array_equal(run["command_issued"].astype(bool), due)
+    np.testing.assert_array_equal(run["force"], [o.force for o in stepped])
+    c = lugrip.SlipControl(CAN)
+    clock = c.run(w)
+    np.testing.assert_array_equal(clock["command_issued"].astype(bool), np.arange(n) % 10 == 0)
+    # what the gripper gets after batch k (samples 10k..10k+9): the command from samples up to
+    # 10k+9 (now) against the clock's latest, computed at sample 10k (samples 10k-9..10k)
+    s_now = run["slippage"][due][5:]
+    s_clock = clock["slippage"][np.arange(n) % 10 == 0][5:]
+    assert np.all(s_now > s_clock)
+    with pytest.raises(ValueError, match="command"):
+        a.step(w[0], command="later")
+    with pytest.raises(ValueError, match="commands"):
+        b.run(w, commands=np.ones(n, dtype=int))
