@@ -1,6 +1,8 @@
 // Example 04 (C++): a 500 Hz robot loop with SlipControl, linking lugrip::core only.
 //
-// Each cycle: read both fingertip wrenches, SlipControl::step(), send the command. The robot
+// Each cycle: read both fingertip wrenches, SlipControl::step(); every tenth cycle send the
+// command (the gripper takes one per 20 ms): that cycle asks for it (CommandTiming::Now), so it
+// is computed from the ten samples just read, the others pass Hold. The robot
 // here is a stand-in (FakeGripper): a gripper whose force follows the command with a 30 ms lag,
 // holding a can whose weight and a torsional load grow after 1 s; at 2.0 s finger 1 loses
 // contact for 0.2 s (the command is held), at 3.0 s the operator asks for pivoting. Replace
@@ -69,13 +71,16 @@ int main(int argc, char** argv) {
   std::printf("%6s %9s %6s %6s %-18s %s\n", "t [s]", "force [N]", "S_0", "S_1", "mode", "status");
   for (int k = 0; k < cycles; ++k) {
     if (k == 1500) control.request_pivoting();  // operator: pivot the can
-    const lugrip::SlipControlInput in = gripper.read();
+    lugrip::SlipControlInput in = gripper.read();
+    // The gripper takes a command after every tenth sample: compute it from the newest one.
+    const bool send = k % 10 == 9;
+    in.command = send ? lugrip::CommandTiming::Now : lugrip::CommandTiming::Hold;
     const auto t0 = clock::now();
     const lugrip::Status status = control.step(in, out);
     const double us = std::chrono::duration<double, std::micro>(clock::now() - t0).count();
     worst_us = std::max(worst_us, us);
     total_us += us;
-    gripper.send(out.force);
+    if (send) gripper.send(out.force);
     if (status != lugrip::Status::Ok) ++not_ok;
     if (gripper.t >= 1.99 && gripper.t < 2.0) before_loss = out.force;
     if (gripper.t >= 2.0 && gripper.t < 2.2) min_during_loss = std::min(min_during_loss, out.force);

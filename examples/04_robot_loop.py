@@ -1,7 +1,9 @@
 """Example 04 (Python): a 500 Hz robot loop with lugrip.SlipControl.
 
 Each cycle: read both fingertip wrenches as a (2, 4) array (f_n, f_x, f_y, tau per finger),
-``SlipControl.step()``, send ``out.force``. The robot is a stand-in (FakeGripper, the same as in
+``SlipControl.step()``; every tenth cycle send ``out.force`` (the gripper takes one command per
+20 ms): that cycle passes ``command="now"``, so the command is computed from the ten samples just
+read, and the others ``command="hold"``. The robot is a stand-in (FakeGripper, the same as in
 the C++ twin): the grasp force follows the command with a 30 ms lag, the can's weight and a
 torsional load grow after 1 s, finger 1 loses contact for 0.2 s at 2.0 s (the command is held)
 and the operator asks for pivoting at 3.0 s. Replace FakeGripper with your driver.
@@ -61,9 +63,11 @@ def main(params: str = "aluminium_can", realtime: bool = False) -> float:
             control.request_pivoting()
         w = gripper.read()
         t0 = time.perf_counter()
-        out = control.step(w)
+        send = k % 10 == 9  # the gripper takes a command after every tenth sample
+        out = control.step(w, command="now" if send else "hold")
         times.append(time.perf_counter() - t0)
-        gripper.send(out.force)
+        if send:
+            gripper.send(out.force)
         if 1.99 <= gripper.t < 2.0:
             before_loss = out.force
         if 2.0 <= gripper.t < 2.2:
