@@ -317,13 +317,16 @@ class Distribution:
                     f"{where}: {name} takes whole numbers: use distribution choice or constant "
                     "with integer values"
                 )
+
+        def field(bound: str) -> str:  # the key of this distribution that sets the bound
+            if self.kind in ("uniform", "loguniform", "normal"):
+                return bound
+            return "values" if self.kind == "choice" else "value"
+
         if p.upper is not None and hi > p.upper:
-            field = "high" if self.kind in ("uniform", "loguniform", "normal") else (
-                "values" if self.kind == "choice" else "value"
-            )
             what = f"can be {hi:g}" if math.isfinite(hi) else "is unbounded above (set high)"
             raise CampaignError(
-                f"{where}.{field}: {name} must be <= {p.upper:g} [{p.unit}], but the "
+                f"{where}.{field('high')}: {name} must be <= {p.upper:g} [{p.unit}], but the "
                 f"distribution {what}"
             )
         if p.lower is None:
@@ -331,12 +334,9 @@ class Distribution:
         bad = lo <= p.lower if p.strict else lo < p.lower
         if bad:
             rel = ">" if p.strict else ">="
-            field = "low" if self.kind in ("uniform", "loguniform", "normal") else (
-                "values" if self.kind == "choice" else "value"
-            )
             what = f"can be {lo:g}" if math.isfinite(lo) else "is unbounded below (set low)"
             raise CampaignError(
-                f"{where}.{field}: {name} must be {rel} {p.lower:g} [{p.unit}], but the "
+                f"{where}.{field('low')}: {name} must be {rel} {p.lower:g} [{p.unit}], but the "
                 f"distribution {what}"
             )
 
