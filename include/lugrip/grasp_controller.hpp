@@ -119,8 +119,9 @@ struct GraspControllerSettings {
   double reaction_lag = 0.03;
 
   // --- friction learned online (not in the paper; docs/controller.md "Friction learned") -------
-  //! (*) [-] default 0.08; 0 = off (paper: mu as told). Relative size of the grip probe, which
-  //! learns mu online. While S is at least 0.5 and not falling, and no reaction is under way,
+  //! (*) [-] default 0 = off (mu as told, the paper's); 0.08 learns mu online. Relative size of
+  //! the grip probe. Off by default: its answers mistake a load rising during the probe for a
+  //! slide and lower the belief of sticking contacts (docs/controller.md §9). While S is at least 0.5 and not falling, and no reaction is under way,
   //! the static part is raised by this fraction for three command periods (the integrator does
   //! not see it). The measured load's answer tells stick from slip with no speed signal: a
   //! sticking contact's load does not follow the grip (elasticity d ln load / d ln f_n ~ 0), a
@@ -132,7 +133,7 @@ struct GraspControllerSettings {
   //! never below half the told mu; the belief never rises above the told mu. Probes repeat 3
   //! commands apart while S rises above the last stick answer's, and back off (doubling, up to
   //! 1 s) otherwise. Needs each finger's f_n (FingerInput::f_n). In [0, 0.5].
-  double mu_probe = 0.08;
+  double mu_probe = 0.0;
 
   // --- ceiling from the measured load (not in the paper; docs/controller.md §10) -------------
   //! (*) [-] default 1.7; 0 = off (paper). In slipping avoidance the command never exceeds this

@@ -27,9 +27,10 @@ def _lift(name, over, seed=None, duration=4.0):
 def test_big_block_stick_slip_at_lift_off_is_caught_by_the_reflex_and_the_probe():
     """Seed 401 of experiment 1: the block's pads slide in stick-slip at lift-off, S alternates
     around the reflex threshold from sample to sample. The reflex (its samples counted anywhere
-    in the period) and the grip probe catch it within 0.3 mm (measured 0.17 mm); with neither,
+    in the period) and the grip probe (mu_probe 0.08; off by default) catch it within 0.3 mm
+    (measured 0.17 mm); with neither,
     the block slides 2.1 mm before the PI catches the load."""
-    run, on, slip, _ = _lift("exp1_big_resin_block", {}, seed=401, duration=3.0)
+    run, on, slip, _ = _lift("exp1_big_resin_block", {"mu_probe": 0.08}, seed=401, duration=3.0)
     _, _, slip_old, _ = _lift("exp1_big_resin_block", {"slip_reflex": False, "mu_probe": 0.0},
                               seed=401, duration=3.0)
     assert run.scene["status"] == "ok"
