@@ -789,8 +789,7 @@ double GraspController::reaction_floor(double& slope_exponent, GraspControllerOu
     // force lags would overshoot the load several times).
     double base = std::min(last_.static_force, command_);
     double fn_meas = 0.0;
-    for (int i = 0; i < kMaxFingers; ++i)
-      if (n_load_[i] > 0 && fn_ok_[i]) fn_meas = std::max(fn_meas, sum_f_n_[i] / n_load_[i]);
+    for (int i = 0; i < kMaxFingers; ++i) fn_meas = std::max(fn_meas, period_load(i).fn);
     if (fn_meas > 0.0) base = std::min(base, fn_meas);
     const double reflex = s_.reflex_factor * base;
     lift = std::max(lift, reflex);
