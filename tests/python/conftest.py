@@ -86,3 +86,19 @@ def phys():
     import types
 
     return types.SimpleNamespace(tau_max=tau_max, viscous_ratio=viscous_ratio)
+
+
+@pytest.fixture
+def exit_2(capsys):
+    """A command-line call that must be refused: ``exit_2(argv)`` runs ``lugrip.cli.main`` and
+    asserts exit code 2 with a one-line message and no traceback on stderr; returns the line."""
+    from lugrip.cli import main
+
+    def run(argv) -> str:
+        rc = main([str(a) for a in argv])
+        err = capsys.readouterr().err.strip()
+        assert rc == 2, err
+        assert len(err.splitlines()) == 1 and "Traceback" not in err, err
+        return err
+
+    return run

@@ -43,13 +43,6 @@ def _log(path: Path, n: int = 400) -> Path:
     return path
 
 
-def _exit_2(capsys, argv) -> str:
-    rc = main([str(a) for a in argv])
-    err = capsys.readouterr().err.strip()
-    assert rc == 2, err
-    assert len(err.splitlines()) == 1 and "Traceback" not in err, err
-    return err
-
 
 def _leftovers(directory: Path) -> list[str]:
     return sorted(p.name for p in directory.iterdir()
@@ -59,7 +52,7 @@ def _leftovers(directory: Path) -> list[str]:
 
 # --- an output that is an input -----------------------------------------------------------
 
-def test_identify_refuses_its_own_input_even_with_force(tmp_path, capsys):
+def test_identify_refuses_its_own_input_even_with_force(exit_2, tmp_path):
     """`identify x.csv --out x.csv --force` (the log became an 8 KB YAML): exit 2, the log
     unchanged; also through a symbolic link, a '..' path and a hard link."""
     log = _log(tmp_path / "x.csv")
@@ -69,7 +62,7 @@ def test_identify_refuses_its_own_input_even_with_force(tmp_path, capsys):
     (tmp_path / "sub").mkdir()
     for out in (log, tmp_path / "link.csv", tmp_path / "sub" / ".." / "x.csv",
                 tmp_path / "hard.csv"):
-        err = _exit_2(capsys, ["identify", log, "--out", out, "--force", "--quiet",
+        err = exit_2(["identify", log, "--out", out, "--force", "--quiet",
                                "--max-iterations", "1"])
         assert "replace the input" in err and "--out" in err
     assert _sha(log) == before
@@ -77,23 +70,23 @@ def test_identify_refuses_its_own_input_even_with_force(tmp_path, capsys):
 
 
 @pytest.mark.parametrize("command", ["observe", "replay"])
-def test_observe_and_replay_refuse_their_input(tmp_path, capsys, command):
+def test_observe_and_replay_refuse_their_input(exit_2, tmp_path, command):
     log = _log(tmp_path / "x.csv")
     before = _sha(log)
     extra = ["--preset", "table1"]
-    err = _exit_2(capsys, [command, log, *extra, "--out", log, "--force"])
+    err = exit_2([command, log, *extra, "--out", log, "--force"])
     assert "replace the input" in err
     assert _sha(log) == before
 
 
-def test_identify_rubbing_refuses_params0_as_output(tmp_path, capsys):
+def test_identify_rubbing_refuses_params0_as_output(exit_2, tmp_path, capsys):
     """The --params0 file is an input too: `--out` naming it is refused."""
     p0 = tmp_path / "p0.yaml"
     assert main(["params", "--preset", "table1"]) == 0
     p0.write_text(capsys.readouterr().out)
     log = _log(tmp_path / "x.csv")
     before = _sha(p0)
-    err = _exit_2(capsys, ["identify", log, "--rubbing", "--params0", p0, "--out", p0,
+    err = exit_2(["identify", log, "--rubbing", "--params0", p0, "--out", p0,
                            "--force"])
     assert "p0.yaml" in err and "replace the input" in err
     assert _sha(p0) == before
@@ -101,7 +94,7 @@ def test_identify_rubbing_refuses_params0_as_output(tmp_path, capsys):
 
 # --- special files --------------------------------------------------------------------------
 
-def test_special_files_are_refused_even_with_force(tmp_path, capsys):
+def test_special_files_are_refused_even_with_force(exit_2, tmp_path):
     """A FIFO, a symbolic link to a FIFO, a character device (/dev/null) and a directory are
     not regular files: exit 2 with --force, and they stay what they were."""
     log = _log(tmp_path / "x.csv")
@@ -120,7 +113,7 @@ def test_special_files_are_refused_even_with_force(tmp_path, capsys):
         (["ls", "--k", "4", "--no-plot", "--csv", "/dev/null", "--force"], "character device"),
     ]
     for argv, kind in cases:
-        err = _exit_2(capsys, argv)
+        err = exit_2(argv)
         assert kind in err and "regular file" in err or kind == "a directory" and kind in err, err
     assert stat.S_ISFIFO(os.stat(fifo).st_mode) and os.path.islink(link)
     assert folder.is_dir() and not any(folder.iterdir())
@@ -141,13 +134,13 @@ def test_check_file_refuses_a_dangling_link_and_a_file_as_parent(tmp_path):
 
 # --- --force: atomic replacement of a regular file ---------------------------------------
 
-def test_existing_output_needs_force_and_is_replaced_atomically(tmp_path, capsys):
+def test_existing_output_needs_force_and_is_replaced_atomically(exit_2, tmp_path, capsys):
     log = _log(tmp_path / "x.csv")
     out = tmp_path / "e.csv"
     out.write_text("the user's file\n")
     os.chmod(out, 0o600)
     before = _sha(out)
-    err = _exit_2(capsys, ["observe", log, "--preset", "table1", "--out", out])
+    err = exit_2(["observe", log, "--preset", "table1", "--out", out])
     assert "exists; pass --force" in err and _sha(out) == before
     inode = os.stat(out).st_ino
     assert main(["observe", str(log), "--preset", "table1", "--out", str(out), "--force"]) == 0
@@ -206,23 +199,23 @@ def test_a_file_created_during_the_work_is_not_replaced_without_force(tmp_path):
     assert out.read_text() == "someone else's" and _leftovers(tmp_path) == []
 
 
-def test_writability_is_checked_before_the_work(tmp_path, capsys):
+def test_writability_is_checked_before_the_work(exit_2, tmp_path):
     """An output below a regular file (cannot exist): exit 2 at once, before the fit."""
     log = _log(tmp_path / "x.csv")
     (tmp_path / "file").write_text("x")
     t0 = time.perf_counter()
-    err = _exit_2(capsys, ["identify", log, "--out", tmp_path / "file" / "p.yaml"])
+    err = exit_2(["identify", log, "--out", tmp_path / "file" / "p.yaml"])
     assert "--out" in err and time.perf_counter() - t0 < 5.0
 
 
 @pytest.mark.skipif(os.geteuid() == 0, reason="root writes in read-only folders")
-def test_an_unwritable_folder_is_refused_before_the_work(tmp_path, capsys):
+def test_an_unwritable_folder_is_refused_before_the_work(exit_2, tmp_path):
     log = _log(tmp_path / "x.csv")
     ro = tmp_path / "ro"
     ro.mkdir()
     ro.chmod(0o555)
     try:
-        err = _exit_2(capsys, ["identify", log, "--out", ro / "p.yaml", "--quiet"])
+        err = exit_2(["identify", log, "--out", ro / "p.yaml", "--quiet"])
         assert "cannot write" in err
     finally:
         ro.chmod(0o755)
@@ -230,7 +223,7 @@ def test_an_unwritable_folder_is_refused_before_the_work(tmp_path, capsys):
 
 # --- folder outputs ---------------------------------------------------------------------------
 
-def test_simulate_refuses_a_folder_with_earlier_results(tmp_path, capsys):
+def test_simulate_refuses_a_folder_with_earlier_results(exit_2, tmp_path):
     """report.md / metrics.json / experiments.md of an earlier run (or the user's) in --out:
     exit 2 without --force, before any scenario runs; the files unchanged."""
     out = tmp_path / "out"
@@ -239,13 +232,13 @@ def test_simulate_refuses_a_folder_with_earlier_results(tmp_path, capsys):
     (out / "experiments.md").write_text("# my notes\n")
     sums = {p.name: _sha(p) for p in out.iterdir()}
     t0 = time.perf_counter()
-    err = _exit_2(capsys, ["simulate", "exp1_big_resin_block", "--out", out])
+    err = exit_2(["simulate", "exp1_big_resin_block", "--out", out])
     assert "experiments.md" in err and "metrics.json" in err and "--force" in err
     assert time.perf_counter() - t0 < 5.0
     assert {p.name: _sha(p) for p in out.iterdir()} == sums
     # a result name that is a directory is refused even with --force
     (out / "mujoco.md").mkdir()
-    err = _exit_2(capsys, ["simulate", "exp1_big_resin_block", "--out", out, "--force"])
+    err = exit_2(["simulate", "exp1_big_resin_block", "--out", out, "--force"])
     assert "mujoco.md" in err and "a directory" in err
 
 
@@ -265,7 +258,7 @@ def test_check_dir_accepts_foreign_files_and_new_folders(tmp_path):
         check_dir(tmp_path / "afile", force=True)
 
 
-def test_campaign_refuses_report_files_of_another_folder(tmp_path, capsys):
+def test_campaign_refuses_report_files_of_another_folder(exit_2, tmp_path):
     """A folder that is not this campaign's and holds report.md: exit 2 without --force (the
     runs are not started); runs without a campaign.json: refused even with --force."""
     src = CAMPAIGN
@@ -273,31 +266,31 @@ def test_campaign_refuses_report_files_of_another_folder(tmp_path, capsys):
     out.mkdir()
     (out / "report.md").write_text("# my report\n")
     before = _sha(out / "report.md")
-    err = _exit_2(capsys, ["campaign", src, "--runs", "1", "--out", out, "--quiet"])
+    err = exit_2(["campaign", src, "--runs", "1", "--out", out, "--quiet"])
     assert "report.md" in err and "--force" in err
     assert _sha(out / "report.md") == before and sorted(os.listdir(out)) == ["report.md"]
     (out / "results.parquet").write_bytes(b"PAR1")
-    err = _exit_2(capsys, ["campaign", src, "--runs", "1", "--out", out, "--quiet", "--force"])
+    err = exit_2(["campaign", src, "--runs", "1", "--out", out, "--quiet", "--force"])
     assert "results.parquet" in err and "campaign.json" in err
 
 
 @pytest.mark.parametrize("runs", ["1e9", "1000000000", "99999999999999999999999"])
-def test_campaign_run_count_is_refused_before_any_list(tmp_path, capsys, runs):
+def test_campaign_run_count_is_refused_before_any_list(exit_2, tmp_path, runs):
     src = CAMPAIGN
     t0 = time.perf_counter()
-    err = _exit_2(capsys, ["campaign", src, "--runs", runs, "--out", tmp_path / "o"])
+    err = exit_2(["campaign", src, "--runs", runs, "--out", tmp_path / "o"])
     assert "--runs" in err and time.perf_counter() - t0 < 5.0
     assert not (tmp_path / "o").exists()
 
 
-def test_demo_and_ls_refuse_earlier_results(tmp_path, capsys):
+def test_demo_and_ls_refuse_earlier_results(exit_2, tmp_path, capsys):
     (tmp_path / "report.md").write_text("mine\n")
     before = _sha(tmp_path / "report.md")
-    err = _exit_2(capsys, ["demo", "--out", tmp_path, "--only", "ls"])
+    err = exit_2(["demo", "--out", tmp_path, "--only", "ls"])
     assert "report.md" in err and _sha(tmp_path / "report.md") == before
     assert main(["ls", "--k", "4", "--out", str(tmp_path)]) == 0
     capsys.readouterr()
-    err = _exit_2(capsys, ["ls", "--k", "4", "--out", tmp_path])
+    err = exit_2(["ls", "--k", "4", "--out", tmp_path])
     assert "fig03_limit_surface_curves.png" in err
     assert main(["ls", "--k", "4", "--out", str(tmp_path), "--force"]) == 0
 

@@ -48,15 +48,8 @@ def _flip_value(raw: bytearray, value: float, factor: float = 1000.0) -> int:
     return i
 
 
-def _exit_2(capsys, argv) -> str:
-    rc = main([str(a) for a in argv])
-    err = capsys.readouterr().err.strip()
-    assert rc == 2, err
-    assert len(err.splitlines()) == 1 and "Traceback" not in err, err
-    return err
 
-
-def test_chunk_crc_mismatch_is_refused(tmp_path, monkeypatch, capsys, log):
+def test_chunk_crc_mismatch_is_refused(exit_2, tmp_path, monkeypatch, log):
     """Two values changed in an uncompressed chunk (f_n 1970 N for 1.97 N was read as valid):
     exit 2 naming the file and Chunk.uncompressed_crc; the intact file still reads."""
     good = _uncompressed(tmp_path / "good.mcap", log, monkeypatch)
@@ -69,7 +62,7 @@ def test_chunk_crc_mismatch_is_refused(tmp_path, monkeypatch, capsys, log):
     before = _sha(bad)
     with pytest.raises(LogError, match="Chunk.uncompressed_crc"):
         read_log(bad)
-    err = _exit_2(capsys, ["observe", bad, "--preset", "table1", "--out", tmp_path / "e.csv"])
+    err = exit_2(["observe", bad, "--preset", "table1", "--out", tmp_path / "e.csv"])
     assert "bad.mcap" in err and "uncompressed_crc" in err and "corrupted" in err
     assert _sha(bad) == before and not (tmp_path / "e.csv").exists()
 
@@ -153,12 +146,12 @@ def _one_channel(path, *, schema_name=WRENCH, schema_encoding="ros2msg", schema_
     ],
     ids=["float-bytes", "schema-float64", "schema-wrong-nested", "schema-ros1", "schema-junk"],
 )
-def test_channel_that_is_not_the_declared_type_is_refused(tmp_path, capsys, kwargs, field):
+def test_channel_that_is_not_the_declared_type_is_refused(exit_2, tmp_path, kwargs, field):
     path = _one_channel(tmp_path / "w.mcap", **kwargs)
     with pytest.raises(LogError) as info:
         read_log(path)
     assert field in str(info.value) and str(path) in str(info.value)
-    err = _exit_2(capsys, ["observe", path, "--preset", "table1", "--out", tmp_path / "e.csv"])
+    err = exit_2(["observe", path, "--preset", "table1", "--out", tmp_path / "e.csv"])
     assert field in err
 
 
@@ -211,9 +204,10 @@ def test_a_recording_cut_short_still_reads_with_a_warning(tmp_path, log):
 
 # --- ROS time stamps ----------------------------------------------------------------------------
 
-def _stamped(path, log, stamps_ns, log_ns=None):
+def _stamped(path, log, stamps_ns, log_ns=None, metadata=None):
     """The log as WrenchStamped messages with the given header stamps; log times increasing
-    at the log's rate (what a recorder sees when the sensor's clock misbehaves)."""
+    at the log's rate (what a recorder sees when the sensor's clock misbehaves); `metadata`:
+    lugrip's ``lugrip.sliding_log`` record, written before the messages."""
     from rosbags.typesys import Stores, get_typestore
 
     ts = get_typestore(Stores.ROS2_HUMBLE)
@@ -227,6 +221,8 @@ def _stamped(path, log, stamps_ns, log_ns=None):
         sid = w.register_schema(name=WRENCH, encoding="ros2msg",
                                 data=ts.generate_msgdef(WRENCH, ros_version=2)[0].encode())
         cid = w.register_channel(topic="/ft", message_encoding="cdr", schema_id=sid)
+        if metadata is not None:
+            w.add_metadata("lugrip.sliding_log", metadata)
         for i in range(len(log)):
             s = int(stamps_ns[i])
             hdr = T["std_msgs/msg/Header"](stamp=T["builtin_interfaces/msg/Time"](
@@ -240,7 +236,7 @@ def _stamped(path, log, stamps_ns, log_ns=None):
     return path
 
 
-def test_header_clock_jumping_back_is_an_error_with_a_log_time_option(tmp_path, capsys, log):
+def test_header_clock_jumping_back_is_an_error_with_a_log_time_option(exit_2, tmp_path, log):
     """The sensor clock jumps back 10 s at sample 500 (it interleaved samples 10 s apart with
     a warning): exit 2 naming the topic and the count; --time-source log reads it in order."""
     stamps = 5_000_000_000 + np.round(log.t * 1e9).astype(np.int64)
@@ -250,7 +246,7 @@ def test_header_clock_jumping_back_is_an_error_with_a_log_time_option(tmp_path, 
                                        r"first at message 501 \(by 9.998 s") as info:
         read_log(path)
     assert "time_source='log'" in str(info.value)
-    err = _exit_2(capsys, ["observe", path, "--preset", "table1", "--out", tmp_path / "e.csv"])
+    err = exit_2(["observe", path, "--preset", "table1", "--out", tmp_path / "e.csv"])
     assert "'/ft'" in err and "--time-source log" in err
     got = read_log(path, time_source="log")
     assert len(got) == len(log) and np.all(np.diff(got.t) > 0)
@@ -260,7 +256,7 @@ def test_header_clock_jumping_back_is_an_error_with_a_log_time_option(tmp_path, 
                  "--time-source", "log"]) == 0
 
 
-def test_identical_stamps_are_an_error_not_one_sample(tmp_path, capsys, log):
+def test_identical_stamps_are_an_error_not_one_sample(exit_2, tmp_path, log):
     """Every header stamp identical (the recording became one sample, exit 0): exit 2 naming
     the topic and the count; by log time the recording reads whole."""
     stamps = np.full(len(log), 7_000_000_000, dtype=np.int64)
@@ -268,7 +264,7 @@ def test_identical_stamps_are_an_error_not_one_sample(tmp_path, capsys, log):
     n = len(log)
     with pytest.raises(LogError, match=rf"topic '/ft'.*{n - 1} of {n} messages"):
         read_log(path)
-    _exit_2(capsys, ["observe", path, "--preset", "table1", "--out", tmp_path / "e.csv"])
+    exit_2(["observe", path, "--preset", "table1", "--out", tmp_path / "e.csv"])
     assert len(read_log(path, time_source="log")) == n
 
 
@@ -327,7 +323,7 @@ def _mixed_csv(path, log, column: str, factor: float, start: float, frac: float)
      ("f_n", 1000.0, 0.05, "mN"), ("f_y", 1000.0, 0.05, "mN")],
     ids=["tau-Nmm-5pct", "tau-Nmm-1pct", "f_n-mN-5pct", "f_y-mN-5pct"],
 )
-def test_a_block_in_other_units_is_refused(tmp_path, capsys, long_log, column, factor, frac,
+def test_a_block_in_other_units_is_refused(exit_2, tmp_path, long_log, column, factor, frac,
                                            what):
     """τ in N mm in a 5 % block of rows passed observe (ω̂ RMSE 37.9 rad/s): exit 2, one line
     naming the field and rows that overlap the block; the clean file still reads."""
@@ -342,7 +338,7 @@ def test_a_block_in_other_units_is_refused(tmp_path, capsys, long_log, column, f
     lo, hi = (int(x) for x in str(e).split(" in rows ")[1].split(" ")[0].split("-"))
     assert lo <= last and hi >= first  # the rows named overlap the block
     assert hi - lo < 3 * (last - first + 1) + 400  # and are the block, not the whole file
-    err = _exit_2(capsys, ["observe", path, "--preset", "table1", "--out", tmp_path / "e.csv"])
+    err = exit_2(["observe", path, "--preset", "table1", "--out", tmp_path / "e.csv"])
     assert "mixed units" in err and column in err
     assert _sha(path) == before
     # the user declares the column's unit: the check is theirs to skip
@@ -360,34 +356,15 @@ def test_clean_files_of_other_rigs_pass_the_block_checks(tmp_path):
 
 
 @pytest.mark.parametrize("t0", ["abc", "1e9", "99999999999999999999999999999"])
-def test_bad_metadata_t0_names_the_file_and_field(tmp_path, capsys, log, t0):
+def test_bad_metadata_t0_names_the_file_and_field(exit_2, tmp_path, log, t0):
     """lugrip's MCAP metadata record with a t0_ns that is not an integer (a ValueError that
     named no file): exit 2 naming the file and the field."""
-    from rosbags.typesys import Stores, get_typestore
-
-    ts = get_typestore(Stores.ROS2_HUMBLE)
-    path = tmp_path / "meta.mcap"
-    T = ts.types
-    V = T["geometry_msgs/msg/Vector3"]
-    with open(path, "wb") as fh:
-        w = Writer(fh, compression=CompressionType.NONE)
-        w.start(profile="ros2", library="test")
-        sid = w.register_schema(name=WRENCH, encoding="ros2msg",
-                                data=ts.generate_msgdef(WRENCH, ros_version=2)[0].encode())
-        cid = w.register_channel(topic="/ft", message_encoding="cdr", schema_id=sid)
-        w.add_metadata("lugrip.sliding_log", {"wrench_topic": "/ft", "t0_ns": t0})
-        for i in range(20):
-            ns = 10**9 + 2_000_000 * i
-            hdr = T["std_msgs/msg/Header"](stamp=T["builtin_interfaces/msg/Time"](
-                sec=ns // 10**9, nanosec=ns % 10**9), frame_id="pad")
-            msg = T[WRENCH](header=hdr, wrench=T["geometry_msgs/msg/Wrench"](
-                force=V(0.0, 0.1, 2.0), torque=V(0.0, 0.0, 1e-4)))
-            w.add_message(channel_id=cid, log_time=ns, publish_time=ns,
-                          data=bytes(ts.serialize_cdr(msg, WRENCH)), sequence=i)
-        w.finish()
+    stamps = 10**9 + np.round(log.t * 1e9).astype(np.int64)
+    path = _stamped(tmp_path / "meta.mcap", log, stamps,
+                    metadata={"wrench_topic": "/ft", "t0_ns": t0})
     with pytest.raises(LogError, match="t0_ns"):
         read_log(path)
-    err = _exit_2(capsys, ["observe", path, "--preset", "table1", "--out", tmp_path / "e.csv"])
+    err = exit_2(["observe", path, "--preset", "table1", "--out", tmp_path / "e.csv"])
     assert "meta.mcap" in err and "t0_ns" in err
 
 
@@ -412,7 +389,7 @@ _F32 = ("std_msgs/Header header\ngeometry_msgs/Wrench wrench\n" + "=" * 80 +
         + "=" * 80 + "\nMSG: geometry_msgs/Vector3\nfloat32 x\nfloat32 y\nfloat32 z\n")
 
 
-def test_bag_with_a_non_standard_definition_is_refused(tmp_path, capsys):
+def test_bag_with_a_non_standard_definition_is_refused(exit_2, tmp_path):
     """A ROS 1 bag whose WrenchStamped definition has float32 vectors (the standard field
     names, another layout): not the standard message, refused as in MCAP files, naming the
     topic and the msgdef (it was read by its own definition)."""
@@ -425,7 +402,7 @@ def test_bag_with_a_non_standard_definition_is_refused(tmp_path, capsys):
     path = _bag_with_definition(tmp_path / "f32.bag", _F32, payload)
     with pytest.raises(LogError, match=r"topic '/ft'.*geometry_msgs/Vector3.*field msgdef"):
         read_log(path)
-    err = _exit_2(capsys, ["observe", path, "--preset", "table1", "--out", tmp_path / "e.csv"])
+    err = exit_2(["observe", path, "--preset", "table1", "--out", tmp_path / "e.csv"])
     assert "f32.bag" in err and "msgdef" in err
 
 
