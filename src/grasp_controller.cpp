@@ -24,6 +24,20 @@ constexpr double kProbeSigmas = 2.0;      // ... beyond this many standard error
 constexpr double kProbeStepDown = 0.7;    // the belief falls by at most 30 % per probe
 constexpr double kMuFloor = 0.5;          // ... and never below half the told mu
 constexpr double kProbeRise = 0.05;       // a new probe once S exceeds the highest stick answer by this
+// Constants of the law that were settings until a randomized campaign showed that changing them
+// did not pay (docs/controller.md §1).
+constexpr double kFeedforwardSlippage = 0.9;  // S the feed-forward and the reserve are solved for
+constexpr double kFeedforwardHorizon = 0.03;  // [s] the trend's extrapolation ahead of the command
+constexpr double kFeedforwardTrend = 0.5;     // the trend is used when it asks this much more
+constexpr double kSlidingSlippage = 0.93;     // S at or above: the period's contact counts as sliding
+constexpr double kOmegaDeadband = 1.0;        // C_d's dead band in the observer's speed resolutions
+constexpr double kDynamicCap = 0.25;          // with the ceiling, C_d adds at most this x f_ns
+constexpr double kPivotFloorFactor = 1.1;     // pivoting floor factor x max_i |f_t,i| / mu
+constexpr int kPivotEndSamples = 3;           // consecutive samples of the pivot's end test
+constexpr double kPivotEndFilter = 0.2;       // [s] low-pass on mean |c~| of that test
+constexpr double kPivotEndSlippage = 0.99;    // the test counts while max_i S_i is below this
+constexpr double kPivotFloorTime = 1.0;       // [s] pivoting ends after this long at the floor
+constexpr double kPivotTimeout = 10.0;        // [s] pivoting ends after this long
 
 // Shortest of %.15g / %.17g that reads back exactly.
 std::string fmt(double v) { return detail::format_number(v); }
@@ -64,10 +78,9 @@ bool validate(const GraspControllerSettings& s, std::string* message) {
   constexpr int kRatioMax = 1000000;                     // command_ratio
   constexpr double kGainMax = 1.0e9;                     // k_cd [N s/rad], k_p, k_f [N], k_i [N/s]
   constexpr double kPoleMin = 1.0e-9, kCornerMax = 1.0e12;  // [rad/s] p_cd, z_cd
-  constexpr double kForceMin = 1.0e-6, kForceMax = 1.0e6;   // [N] f_min, f_max, gain_schedule_force
+  constexpr double kForceMin = 1.0e-6, kForceMax = 1.0e6;   // [N] f_min, f_max, gain_force
   constexpr double kPivotMax = 1.0e3;                    // s_pivot (slippage inputs are <= 1e3)
-  constexpr double kHoldMax = 1.0e6;                     // [s] pivot_end_filter
-  constexpr double kSlippageMin = 1.0e-3;                // s_ref, feedforward_slippage, reflex_slippage
+  constexpr double kSlippageMin = 1.0e-3;                // s_ref
   std::string msg;
   auto bad = [&](const char* name, double v, const std::string& rule) {
     msg += std::string(name) + " = " + fmt(v) + ": " + rule + "\n";
@@ -85,58 +98,33 @@ bool validate(const GraspControllerSettings& s, std::string* message) {
   };
   within("sensor_rate", s.sensor_rate, kRateMin, false, kRateMax, " [Hz]");
   if (!(s.command_ratio >= 1 && s.command_ratio <= kRatioMax)) bad("command_ratio", s.command_ratio, "must be >= 1 and <= 1000000");
-  within("k_cd", s.k_cd, 0.0, true, kGainMax, " [N s/rad]");
-  within("p_cd", s.p_cd, kPoleMin, false, kCornerMax, " [rad/s]");
-  if (!(std::isfinite(s.z_cd) && s.z_cd > s.p_cd && s.z_cd <= kCornerMax))
-    bad("z_cd", s.z_cd, "must be finite, > p_cd (lag network) and <= 1e+12 [rad/s]");
-  if (!(s.s_ref >= kSlippageMin && s.s_ref < 1.0)) bad("s_ref", s.s_ref, "must satisfy 1e-03 <= s_ref < 1");
-  within("k_p", s.k_p, 0.0, true, kGainMax, " [N]");
-  within("k_i", s.k_i, 0.0, true, kGainMax, " [N/s]");
   within("f_min", s.f_min, kForceMin, false, kForceMax, " [N]");
   if (!(std::isfinite(s.f_max) && s.f_max > s.f_min && s.f_max <= kForceMax))
     bad("f_max", s.f_max, "must be finite, > f_min and <= 1e+06 [N]");
   positive_or_inf("max_rate_up", s.max_rate_up);
   positive_or_inf("max_rate_down", s.max_rate_down);
-  if (!(std::isfinite(s.omega_deadband) && s.omega_deadband >= 0.0))
-    bad("omega_deadband", s.omega_deadband, "must be finite and >= 0");
-  if (!(std::isfinite(s.invalid_raise_step) && s.invalid_raise_step >= 0.0))
-    bad("invalid_raise_step", s.invalid_raise_step, "must be finite and >= 0");
-  if (!(std::isfinite(s.s_pivot) && s.s_pivot > 1.0 && s.s_pivot <= kPivotMax))
-    bad("s_pivot", s.s_pivot, "must be finite, > 1 and <= 1000");
-  positive("tau_pivot", s.tau_pivot);
-  within("k_f", s.k_f, 0.0, true, kGainMax, " [N]");
-  if (!(std::isfinite(s.pivot_floor_factor) && s.pivot_floor_factor >= 1.0))
-    bad("pivot_floor_factor", s.pivot_floor_factor, "must be finite and >= 1");
-  positive("pivot_end_c_tilde", s.pivot_end_c_tilde);
-  if (!(s.pivot_end_samples >= 1)) bad("pivot_end_samples", s.pivot_end_samples, "must be >= 1");
-  positive_or_inf("pivot_timeout", s.pivot_timeout);
-  positive_or_inf("pivot_floor_time", s.pivot_floor_time);
-  positive_or_inf("pivot_end_slippage", s.pivot_end_slippage);
-  if (!(std::isfinite(s.pivot_end_filter) && s.pivot_end_filter >= 0.0 && s.pivot_end_filter <= kHoldMax))
-    bad("pivot_end_filter", s.pivot_end_filter, "must be finite, >= 0 and <= 1e6");
-  within("loop_gain_p", s.loop_gain_p, 0.0, true, kGainMax, " [-]");
-  within("loop_gain_i", s.loop_gain_i, 0.0, true, kGainMax, " [1/s]");
-  if (!(std::isfinite(s.mu_probe) && s.mu_probe >= 0.0 && s.mu_probe <= 0.5))
-    bad("mu_probe", s.mu_probe, "must be finite, >= 0 and <= 0.5");
-  if (!(s.ceiling_factor == 0.0 || (std::isfinite(s.ceiling_factor) && s.ceiling_factor >= 1.0 && s.ceiling_factor <= 1.0e3)))
-    bad("ceiling_factor", s.ceiling_factor, "must be 0 (off) or finite, >= 1 and <= 1000");
-  if (!(s.feedforward_slippage >= kSlippageMin && s.feedforward_slippage <= 1.0))
-    bad("feedforward_slippage", s.feedforward_slippage, "must satisfy 1e-03 <= feedforward_slippage <= 1");
-  if (!(s.reflex_slippage >= kSlippageMin && s.reflex_slippage <= 1.0))
-    bad("reflex_slippage", s.reflex_slippage, "must satisfy 1e-03 <= reflex_slippage <= 1");
-  if (!(s.reflex_samples >= 1)) bad("reflex_samples", s.reflex_samples, "must be >= 1");
-  if (!(std::isfinite(s.reflex_factor) && s.reflex_factor > 1.0 && s.reflex_factor <= kPivotMax))
-    bad("reflex_factor", s.reflex_factor, "must be finite, > 1 and <= 1000");
-  if (!(std::isfinite(s.feedforward_horizon) && s.feedforward_horizon >= 0.0 && s.feedforward_horizon <= 1.0e3))
-    bad("feedforward_horizon", s.feedforward_horizon, "must be finite, >= 0 and <= 1000 [s]");
-  if (!(std::isfinite(s.feedforward_trend) && s.feedforward_trend >= 0.0 && s.feedforward_trend <= 1.0e3))
-    bad("feedforward_trend", s.feedforward_trend, "must be finite, >= 0 and <= 1000");
-  if (!(std::isfinite(s.reaction_lag) && s.reaction_lag >= 0.0 && s.reaction_lag <= 1.0e3))
-    bad("reaction_lag", s.reaction_lag, "must be finite, >= 0 and <= 1000 [s]");
+  if (!(s.s_ref >= kSlippageMin && s.s_ref < 1.0)) bad("s_ref", s.s_ref, "must satisfy 1e-03 <= s_ref < 1");
+  within("k_p", s.k_p, 0.0, true, kGainMax, " [N]");
+  within("k_i", s.k_i, 0.0, true, kGainMax, " [N/s]");
+  if (!(s.gain_force == 0.0 || (std::isfinite(s.gain_force) && s.gain_force >= kForceMin && s.gain_force <= kForceMax)))
+    bad("gain_force", s.gain_force, "must be 0 (constant gains) or finite, >= 1e-06 and <= 1e+06 [N]");
+  within("k_cd", s.k_cd, 0.0, true, kGainMax, " [N s/rad]");
+  within("p_cd", s.p_cd, kPoleMin, false, kCornerMax, " [rad/s]");
+  if (!(std::isfinite(s.z_cd) && s.z_cd > s.p_cd && s.z_cd <= kCornerMax))
+    bad("z_cd", s.z_cd, "must be finite, > p_cd (lag network) and <= 1e+12 [rad/s]");
   if (!(std::isfinite(s.reserve_force) && s.reserve_force >= 0.0 && s.reserve_force <= kForceMax))
     bad("reserve_force", s.reserve_force, "must be finite, >= 0 and <= 1e+06 [N]");
   if (!(std::isfinite(s.reserve_torque) && s.reserve_torque >= 0.0 && s.reserve_torque <= kForceMax))
     bad("reserve_torque", s.reserve_torque, "must be finite, >= 0 and <= 1e+06 [N m]");
+  if (!(s.ceiling_factor == 0.0 || (std::isfinite(s.ceiling_factor) && s.ceiling_factor >= 1.0 && s.ceiling_factor <= 1.0e3)))
+    bad("ceiling_factor", s.ceiling_factor, "must be 0 (off) or finite, >= 1 and <= 1000");
+  if (!(std::isfinite(s.mu_probe) && s.mu_probe >= 0.0 && s.mu_probe <= 0.5))
+    bad("mu_probe", s.mu_probe, "must be finite, >= 0 and <= 0.5");
+  if (!(std::isfinite(s.s_pivot) && s.s_pivot > 1.0 && s.s_pivot <= kPivotMax))
+    bad("s_pivot", s.s_pivot, "must be finite, > 1 and <= 1000");
+  positive("tau_pivot", s.tau_pivot);
+  within("k_f", s.k_f, 0.0, true, kGainMax, " [N]");
+  positive("pivot_end_c_tilde", s.pivot_end_c_tilde);
   if (message) *message = msg;
   return msg.empty();
 }
@@ -145,30 +133,26 @@ std::string to_string(const GraspControllerSettings& s) {
   auto num = [](double v) { return std::isinf(v) ? std::string("float('inf')") : fmt(v); };
   auto flag = [](bool b) { return std::string(b ? "True" : "False"); };
   return "GraspControllerSettings(sensor_rate=" + num(s.sensor_rate) +
-         ", command_ratio=" + std::to_string(s.command_ratio) + ", k_cd=" + num(s.k_cd) +
-         ", p_cd=" + num(s.p_cd) + ", z_cd=" + num(s.z_cd) + ", dynamic_enabled=" + flag(s.dynamic_enabled) +
-         ", s_ref=" + num(s.s_ref) + ", k_p=" + num(s.k_p) + ", k_i=" + num(s.k_i) +
-         ", anti_windup=" + flag(s.anti_windup) +
-         ", omega_deadband=" + num(s.omega_deadband) +
-         ", f_min=" + num(s.f_min) + ", f_max=" + num(s.f_max) +
-         ", max_rate_up=" + num(s.max_rate_up) + ", max_rate_down=" + num(s.max_rate_down) +
-         ", invalid_raise_step=" + num(s.invalid_raise_step) + ", s_pivot=" + num(s.s_pivot) +
-         ", tau_pivot=" + num(s.tau_pivot) + ", k_f=" + num(s.k_f) +
-         ", pivot_floor_factor=" + num(s.pivot_floor_factor) +
-         ", pivot_end_c_tilde=" + num(s.pivot_end_c_tilde) +
-         ", pivot_end_samples=" + std::to_string(s.pivot_end_samples) +
-         ", pivot_timeout=" + num(s.pivot_timeout) + ", pivot_end_filter=" + num(s.pivot_end_filter) +
-         ", pivot_end_at_floor=" + flag(s.pivot_end_at_floor) +
-         ", pivot_floor_time=" + num(s.pivot_floor_time) +
-         ", pivot_end_slippage=" + num(s.pivot_end_slippage) + ", slope_gain=" + flag(s.slope_gain) +
-         ", loop_gain_p=" + num(s.loop_gain_p) + ", loop_gain_i=" + num(s.loop_gain_i) +
-         ", feedforward=" + flag(s.feedforward) + ", feedforward_slippage=" + num(s.feedforward_slippage) +
-         ", slip_reflex=" + flag(s.slip_reflex) + ", reflex_slippage=" + num(s.reflex_slippage) +
-         ", reflex_samples=" + std::to_string(s.reflex_samples) + ", reflex_factor=" + num(s.reflex_factor) +
-         ", average_slippage=" + flag(s.average_slippage) +
-         ", feedforward_horizon=" + num(s.feedforward_horizon) + ", feedforward_trend=" + num(s.feedforward_trend) +
-         ", reaction_lag=" + num(s.reaction_lag) + ", mu_probe=" + num(s.mu_probe) + ", ceiling_factor=" + num(s.ceiling_factor) +
-         ", reserve_force=" + num(s.reserve_force) + ", reserve_torque=" + num(s.reserve_torque) + ")";
+         ", command_ratio=" + std::to_string(s.command_ratio) + ", f_min=" + num(s.f_min) +
+         ", f_max=" + num(s.f_max) + ", max_rate_up=" + num(s.max_rate_up) +
+         ", max_rate_down=" + num(s.max_rate_down) + ", s_ref=" + num(s.s_ref) + ", k_p=" + num(s.k_p) +
+         ", k_i=" + num(s.k_i) + ", gain_force=" + num(s.gain_force) +
+         ", dynamic_enabled=" + flag(s.dynamic_enabled) + ", k_cd=" + num(s.k_cd) + ", p_cd=" + num(s.p_cd) +
+         ", z_cd=" + num(s.z_cd) + ", feedforward=" + flag(s.feedforward) +
+         ", reserve_force=" + num(s.reserve_force) + ", reserve_torque=" + num(s.reserve_torque) +
+         ", ceiling_factor=" + num(s.ceiling_factor) + ", mu_probe=" + num(s.mu_probe) +
+         ", s_pivot=" + num(s.s_pivot) + ", tau_pivot=" + num(s.tau_pivot) + ", k_f=" + num(s.k_f) +
+         ", pivot_end_c_tilde=" + num(s.pivot_end_c_tilde) + ")";
+}
+
+GraspControllerSettings paper_settings() noexcept {
+  GraspControllerSettings s;
+  s.k_i = 10.0;
+  s.gain_force = 0.0;
+  s.feedforward = false;
+  s.ceiling_factor = 0.0;
+  s.mu_probe = 0.0;
+  return s;
 }
 
 const char* to_string(ControllerMode m) noexcept {
@@ -212,7 +196,7 @@ GraspController::GraspController(const ContactModel& model, const GraspControlle
   dt_ = 1.0 / s_.sensor_rate;
   t_cmd_ = s_.command_ratio * dt_;
   pivot_decay_ = std::exp(-t_cmd_ / s_.tau_pivot);
-  pivot_c_alpha_ = s_.pivot_end_filter > 0.0 ? 1.0 - std::exp(-dt_ / s_.pivot_end_filter) : 1.0;
+  pivot_c_alpha_ = 1.0 - std::exp(-dt_ / kPivotEndFilter);
   for (auto& f : cd_) f = LagFilter(s_.k_cd, s_.z_cd, s_.p_cd, dt_);
   reset(s_.f_min);
 }
@@ -233,9 +217,7 @@ void GraspController::reset(double current_force) noexcept {
   last_f_t_ = 0.0;
   last_kp_ = last_e_ = 0.0;
   clear_period();
-  f_est_ = command_;
   trend_lift_ = trend_force_ = 0.0;
-  reflex_armed_ = false;
   reset_probe();
   mu_ = mu0_;
   solver_.set_mu(mu_);
@@ -283,7 +265,6 @@ void GraspController::set_settings(const GraspControllerSettings& settings) {
   s_ = next;
   set_dynamic_enabled(dynamic);
   pivot_decay_ = std::exp(-t_cmd_ / s_.tau_pivot);
-  pivot_c_alpha_ = s_.pivot_end_filter > 0.0 ? 1.0 - std::exp(-dt_ / s_.pivot_end_filter) : 1.0;
   command_ = clamp(command_, s_.f_min, s_.f_max);
   last_.force = command_;
 }
@@ -380,12 +361,11 @@ Status GraspController::step(const GraspControllerInput& in, GraspControllerOutp
       ++n_load_[i];
     }
     if (dynamic) {
-      double w = f.omega_hat;
-      if (s_.omega_deadband > 0.0) {
-        const double band = s_.omega_deadband * f.omega_resolution;
-        w = std::copysign(std::max(0.0, std::fabs(w) - band), w);
-      }
-      const double y = cd_[i].step(w);
+      // C_d sees sign(w) max(0, |w| - band), band = the observer's speed resolution: below it
+      // omega_hat is sensor noise seen through 1 / sigma_1, which |C_d .| would rectify into a
+      // noise-driven force.
+      const double band = kOmegaDeadband * f.omega_resolution;
+      const double y = cd_[i].step(std::copysign(std::max(0.0, std::fabs(f.omega_hat) - band), f.omega_hat));
       peak_ = std::max(peak_, std::fabs(y));
       out.dynamic_sample[i] = y;
     } else {
@@ -401,8 +381,6 @@ Status GraspController::step(const GraspControllerInput& in, GraspControllerOutp
     peak_s_ = std::max(peak_s_, slip);
     sum_s_ += slip;
     ++n_s_;
-    if (slip >= s_.reflex_slippage) ++count_s_;
-    if (count_s_ >= s_.reflex_samples) reflex_armed_ = true;
   }
   out.status = valid ? Status::Ok : worst;
   out.mean_c_tilde = n_valid > 0 ? c_sum / n_valid : 0.0;
@@ -418,17 +396,17 @@ Status GraspController::step(const GraspControllerInput& in, GraspControllerOutp
                                         : pivot_c_filtered_ + pivot_c_alpha_ * (out.mean_c_tilde - pivot_c_filtered_);
       pivot_c_init_ = false;
     }
-    const bool settled = (!s_.pivot_end_at_floor || pivot_at_floor_) && slip < s_.pivot_end_slippage;
+    const bool settled = pivot_at_floor_ && slip < kPivotEndSlippage;
     if (valid && settled && pivot_c_filtered_ > s_.pivot_end_c_tilde)
       pivot_count_ = pivot_count_ < kCountMax ? pivot_count_ + 1 : pivot_count_;
     else
       pivot_count_ = 0;
     pivot_floor_samples_ = pivot_at_floor_ && pivot_floor_samples_ < kCountMax ? pivot_floor_samples_ + 1 : 0;
-    if (pivot_count_ >= s_.pivot_end_samples)
+    if (pivot_count_ >= kPivotEndSamples)
       end_pivot(PivotEnd::CorThreshold, out);
-    else if (static_cast<double>(pivot_floor_samples_) * dt_ >= s_.pivot_floor_time)
+    else if (static_cast<double>(pivot_floor_samples_) * dt_ >= kPivotFloorTime)
       end_pivot(PivotEnd::AtFloor, out);
-    else if (static_cast<double>(pivot_samples_) * dt_ >= s_.pivot_timeout)
+    else if (static_cast<double>(pivot_samples_) * dt_ >= kPivotTimeout)
       end_pivot(PivotEnd::Timeout, out);
   }
   out.pivot_time = mode_ == ControllerMode::Pivoting ? static_cast<double>(pivot_samples_) * dt_ : 0.0;
@@ -438,7 +416,7 @@ Status GraspController::step(const GraspControllerInput& in, GraspControllerOutp
   const bool due = now || (!hold && phase_ == 0);
   if (due) {
     // The PI's S: this sample (paper) or the mean over the command period (anti-aliasing).
-    issue_command(valid, s_.average_slippage && n_s_ > 0 ? sum_s_ / n_s_ : slip);
+    issue_command(valid, n_s_ > 0 ? sum_s_ / n_s_ : slip);
     out.command_issued = true;
     if (now) phase_ = 0;  // the clock restarts at this command
   }
@@ -455,7 +433,6 @@ Status GraspController::step(const GraspControllerInput& in, GraspControllerOutp
   out.gain_i = last_.gain_i;
   out.feedforward_force = last_.feedforward_force;
   out.peak_slippage = last_.peak_slippage;
-  out.reflex = last_.reflex;
   out.mu_belief = last_.mu_belief;
   out.ceiling = last_.ceiling;
   out.probing = last_.probing;
@@ -471,30 +448,27 @@ Status GraspController::step(const GraspControllerInput& in, GraspControllerOutp
 void GraspController::issue_command(bool valid, double slip) noexcept {
   GraspControllerOutput& c = last_;
   const double pivot_floor =
-      std::min(std::max(s_.f_min, s_.pivot_floor_factor * last_f_t_ / mu_), s_.f_max);
+      std::min(std::max(s_.f_min, kPivotFloorFactor * last_f_t_ / mu_), s_.f_max);
   const double floor = mode_ == ControllerMode::Pivoting ? pivot_floor : s_.f_min;
   c.floor = floor;
   c.saturated = false;
   c.rate_limited = false;
 
-  c.reflex = false;
   c.feedforward_force = 0.0;
   c.peak_slippage = peak_s_;
 
-  const double lag = s_.reaction_lag > 0.0 ? std::exp(-t_cmd_ / s_.reaction_lag) : 0.0;
   if (!valid) {  // safe command: hold (or raise), never below the floor; restart bumplessly
-    double f = std::max(command_ + s_.invalid_raise_step, floor);
+    double f = std::max(command_, floor);
     probe_left_ = 0;  // a probe under way is abandoned
     prev_load_ = {};
     if (mode_ == ControllerMode::SlippingAvoidance) {
       // Raise-only reactions from the valid fingers' samples of the period.
       double n_slope = 1.0;
-      double lift = std::min(reaction_floor(n_slope, c), s_.f_max);
-      if (lift > f_est_ && lag > 0.0) lift += (lift - f_est_) * lag / (1.0 - lag);
+      const double lift = std::min(static_floor(n_slope), s_.f_max);
+      c.feedforward_force = lift;
       f = std::max(f, std::min(lift, command_ + s_.max_rate_up * t_cmd_));
     }
     command_ = clamp(f, s_.f_min, s_.f_max);
-    f_est_ = command_ + (f_est_ - command_) * lag;
     init_static_ = true;
     peak_ = 0.0;
     clear_period();
@@ -509,22 +483,22 @@ void GraspController::issue_command(bool valid, double slip) noexcept {
   double f_ns, f_nd = 0.0, e;
   double hi = s_.f_max;  // ceiling of the command (ceiling_factor)
   c.ceiling = hi;
-  bool reacting = false;  // the feed-forward or the reflex lifted the static part
   if (mode_ == ControllerMode::SlippingAvoidance) {
-    // Floor of the static part: feed-forward of the measured load and the slip reflex.
+    // Floor of the static part: feed-forward of the measured load (and the task's reserve).
     // The grip probe's answer first: a slip it finds lowers the belief, which the floors use.
     probe_evaluate(slip);
     double n_slope = 1.0;
-    const double lift = reaction_floor(n_slope, c);
-    const bool probe_started = probe_start(slip, c.reflex || lift > std::min(last_.static_force, command_));
+    const double lift = static_floor(n_slope);
+    c.feedforward_force = lift;
+    const bool probe_started = probe_start(slip, lift > std::min(last_.static_force, command_));
     clear_period();
     // PI on e = S - s_ref: e > 0 (closer to slip than wanted) raises the force (docs/model.md 9.4).
     e = slip - s_.s_ref;
     double k_p, k_i;
-    if (s_.slope_gain) {  // loop gain k |dS/df_n| independent of the force (docs/controller.md)
-      const double s_f = n_slope * s_.s_ref / command_;
-      k_p = s_.loop_gain_p / s_f;
-      k_i = s_.loop_gain_i / s_f;
+    if (s_.gain_force > 0.0) {  // loop gain k |dS/df_n| independent of the force (docs/controller.md)
+      const double scale = command_ / (n_slope * s_.gain_force);
+      k_p = s_.k_p * scale;
+      k_i = s_.k_i * scale;
     } else {
       k_p = s_.k_p;
       k_i = s_.k_i;
@@ -533,10 +507,10 @@ void GraspController::issue_command(bool valid, double slip) noexcept {
       integrator_ = command_ - k_p * e;
       init_static_ = false;
     } else {
-      if (s_.slope_gain) integrator_ += (last_kp_ - k_p) * last_e_;  // gain change without a jump of f_ns
+      if (s_.gain_force > 0.0) integrator_ += (last_kp_ - k_p) * last_e_;  // gain change without a jump of f_ns
       // The trend's lift that the period's load did not confirm; only a sticking contact's
       // load can refute it (while sliding, f_t is capped at mu f_n).
-      if (trend_lift_ > 0.0 && c.peak_slippage < s_.reflex_slippage)
+      if (trend_lift_ > 0.0 && c.peak_slippage < kSlidingSlippage)
         integrator_ -= std::min(trend_lift_, std::max(0.0, trend_force_ - floor_measured_));
     }
     trend_lift_ = 0.0;
@@ -547,7 +521,7 @@ void GraspController::issue_command(bool valid, double slip) noexcept {
     // The need is also read from S itself (S ~ 1/f_n: the grip at S = 1 is ~ f S), so a load
     // given without its torque, or an S the load does not explain, never lowers the ceiling.
     hi = s_.f_max;
-    const double need = std::max(ceiling_load_, f_est_ * slip);
+    const double need = std::max(ceiling_load_, command_ * slip);
     if (s_.ceiling_factor > 0.0 && need > 0.0)
       hi = clamp(std::max(s_.ceiling_factor * need, command_), s_.f_min, s_.f_max);
     c.ceiling = hi;
@@ -555,22 +529,19 @@ void GraspController::issue_command(bool valid, double slip) noexcept {
     f_ns = clamp(u, lo, hi);
     if (f_ns != u) {
       if (u < lo && lo > s_.f_min) {
-        reacting = true;
         integrator_ = f_ns - k_p * e;  // the floor lifted the PI: restart it there
         // the part the trend added beyond the measured load's floor, checked at the next command
         trend_lift_ = f_ns - clamp(std::max(u, floor_measured_), s_.f_min, f_ns);
         trend_force_ = f_ns;
       } else {
         c.saturated = true;
-        if (s_.anti_windup) integrator_ = f_ns - k_p * e;  // back-calculation, static part only
+        integrator_ = f_ns - k_p * e;  // back-calculation anti-windup, static part only
       }
     }
     // The grip probe raises the static part above the PI's for two periods; the integrator
     // does not see them (a probe is not the load's demand).
     if (probe_started) probe_base_ = f_ns;
     const bool probing = probe_left_ > 0;
-    // A reaction during the probe (the load moved: feed-forward lift, reflex) spoils its answer.
-    if (probing && !probe_started && c.reflex) probe_disturbed_ = true;  // the reflex moved it
     c.probing = probing;
     if (probing) {  // the probe is a measurement: it may exceed the ceiling by its own size
       hi = std::min(std::max(hi, probe_base_ * (1.0 + s_.mu_probe)), s_.f_max);
@@ -583,11 +554,10 @@ void GraspController::issue_command(bool valid, double slip) noexcept {
     c.gain_i = k_i;
     if (s_.dynamic_enabled) {
       const double head_room = hi - f_ns;
-      // With the ceiling on, the dynamic part adds at most what one reflex step would
-      // (reflex_factor - 1 of the static part): it answers a slip's speed, not the load, and a
-      // lift-off's transfer slip would otherwise spike the grip to several times what the load
-      // needs.
-      const double cap = s_.ceiling_factor > 0.0 ? std::min(head_room, (s_.reflex_factor - 1.0) * f_ns) : head_room;
+      // With the ceiling on, the dynamic part adds at most kDynamicCap of the static part: it
+      // answers a slip's speed, not the load, and a lift-off's transfer slip would otherwise
+      // spike the grip to several times what the load needs.
+      const double cap = s_.ceiling_factor > 0.0 ? std::min(head_room, kDynamicCap * f_ns) : head_room;
       f_nd = clamp(peak_, 0.0, cap);
       if (peak_ > head_room) c.saturated = true;
     }
@@ -611,14 +581,10 @@ void GraspController::issue_command(bool valid, double slip) noexcept {
   peak_ = 0.0;
 
   double target = f_ns + f_nd;
-  // Reaction through the gripper's lag: overshoot so the force reaches the target in one period.
-  if (reacting && lag > 0.0 && target > f_est_)
-    target = std::min(target + (std::min(target, s_.f_max) - f_est_) * lag / (1.0 - lag), hi);
   double f = clamp(target, command_ - s_.max_rate_down * t_cmd_, command_ + s_.max_rate_up * t_cmd_);
   c.rate_limited = f != target;
   f = clamp(std::max(f, floor), s_.f_min, s_.f_max);
   command_ = f;
-  f_est_ = command_ + (f_est_ - command_) * lag;
 
   c.force = f;
   c.mu_belief = mu_;
@@ -645,8 +611,6 @@ void GraspController::clear_period() noexcept {
   n_load_.fill(0);
   peak_s_ = sum_s_ = 0.0;
   n_s_ = 0;
-  count_s_ = 0;
-  reflex_armed_ = false;
 }
 
 GraspController::PeriodLoad GraspController::period_load(int i) const noexcept {
@@ -738,7 +702,6 @@ void GraspController::probe_evaluate(double slip_mean) noexcept {
       solver_.set_mu(mu_);
     }
     probe_slip_ = true;
-    reflex_armed_ = true;  // a confirmed slip: the reflex raises the static part now
     probe_s_ = probe_f_ = 0.0;  // stick is proven again from the start
   } else if (answered) {
     // Stick proven up to the S before the probe, at the grip of then: the next probe waits
@@ -779,26 +742,6 @@ bool GraspController::probe_start(double slip_mean, bool reacting) noexcept {
   return true;
 }
 
-double GraspController::reaction_floor(double& slope_exponent, GraspControllerOutput& c) noexcept {
-  double lift = static_floor(slope_exponent);
-  c.feedforward_force = lift;
-  if (s_.slip_reflex && reflex_armed_) {
-    // On the grip the contact slid at: the static part (a transient f_nd would otherwise be
-    // multiplied into f_ns), or the measured f_n when the gripper has not reached it yet (a
-    // raise still on its way is not a grip that failed; compounding the command while the
-    // force lags would overshoot the load several times).
-    double base = std::min(last_.static_force, command_);
-    double fn_meas = 0.0;
-    for (int i = 0; i < kMaxFingers; ++i) fn_meas = std::max(fn_meas, period_load(i).fn);
-    if (fn_meas > 0.0) base = std::min(base, fn_meas);
-    const double reflex = s_.reflex_factor * base;
-    lift = std::max(lift, reflex);
-    floor_measured_ = std::max(floor_measured_, reflex);
-    c.reflex = true;
-  }
-  return lift;
-}
-
 double GraspController::static_floor(double& slope_exponent) noexcept {
   // Per finger: the mean load of the last command period; the feed-forward force is the larger
   // static grasp force, the slope exponent that of the finger nearest to slip at the command.
@@ -810,7 +753,7 @@ double GraspController::static_floor(double& slope_exponent) noexcept {
   double f_grasp = 0.0;
   for (int i = 0; i < kMaxFingers; ++i) {
     if (n_load_[i] == 0 || !s_.feedforward) continue;
-    f_mean[i] = solver_.solve(sum_f_t_[i] / n_load_[i], sum_tau_[i] / n_load_[i], s_.feedforward_slippage).force;
+    f_mean[i] = solver_.solve(sum_f_t_[i] / n_load_[i], sum_tau_[i] / n_load_[i], kFeedforwardSlippage).force;
     if (std::isfinite(f_mean[i])) f_grasp = std::max(f_grasp, f_mean[i]);
   }
   floor_measured_ = f_grasp;
@@ -824,16 +767,16 @@ double GraspController::static_floor(double& slope_exponent) noexcept {
       double f = f_mean[i];
       const double f_ref = f_grasp;  // a light finger's extrapolated noise is no edge
       const double den = n * sum_kk_[i] - sum_k_[i] * sum_k_[i];
-      if (s_.feedforward_horizon > 0.0 && n_load_[i] >= 3 && den > 0.0 && std::isfinite(f)) {
+      if (n_load_[i] >= 3 && den > 0.0 && std::isfinite(f)) {
         // Least-squares trend of the period's load, extrapolated from the last sample's index
         // by the horizon.
         const double k_mean = sum_k_[i] / n;
-        const double ahead = (n - 1.0 - k_mean) + s_.feedforward_horizon / dt_;
+        const double ahead = (n - 1.0 - k_mean) + kFeedforwardHorizon / dt_;
         const double slope_f = (n * sum_kf_[i] - sum_k_[i] * sum_f_t_[i]) / den;
         const double slope_t = (n * sum_kt_[i] - sum_k_[i] * sum_tau_[i]) / den;
         const double fx = solver_.solve(std::max(0.0, ft + slope_f * ahead), tau + slope_t * ahead,
-                                        s_.feedforward_slippage).force;
-        if (std::isfinite(fx) && fx > (1.0 + s_.feedforward_trend) * f_ref) {
+                                        kFeedforwardSlippage).force;
+        if (std::isfinite(fx) && fx > (1.0 + kFeedforwardTrend) * f_ref) {
           f = fx;
           load_ft = std::max(0.0, ft + slope_f * ahead);
           load_tau = tau + slope_t * ahead;
@@ -851,7 +794,7 @@ double GraspController::static_floor(double& slope_exponent) noexcept {
       if (std::isfinite(f)) force = std::max(force, f);
       if (std::isfinite(f)) ceiling_load_ = std::max(ceiling_load_, f);
     }
-    if (s_.slope_gain) {
+    if (s_.gain_force > 0.0) {
       const double s0 = solver_.slippage(command_, ft, tau), s1 = solver_.slippage(kStep * command_, ft, tau);
       if (std::isfinite(s0) && std::isfinite(s1) && s0 > 0.0 && s1 > 0.0 && s0 > s_max) {
         s_max = s0;

@@ -17,168 +17,86 @@ constexpr int kMaxFingers = 2;
 //! Settings of GraspController; every default is here. All forces per finger [N] (a parallel
 //! gripper applies the same normal force on both fingertips). Fields marked (*) may be changed
 //! at run time through GraspController::set_settings() (validated again).
+//!
+//! The fields come in the groups of the controller's layers (docs/controller.md §1): the
+//! gripper (rates, range, rate limits), the regulator (the paper's PI on S), the dynamic part
+//! (the paper's C_d), the floors and the ceiling built from the measured load (not in the
+//! paper), friction learned online (not in the paper) and pivoting. Every other number of the
+//! law is a constant of the code (docs/controller.md names each one and the campaign that
+//! showed that its setting did not pay). paper_settings() turns every addition off.
 struct GraspControllerSettings {
-  // --- rates ----------------------------------------------------------------------------------
+  // --- gripper: rates, range, rate limits (docs/model.md 9.5) --------------------------------
   double sensor_rate = 500.0;  //!< [Hz] rate of step() calls (tactile/observer rate), > 0
   int command_ratio = 10;      //!< step() calls per force command (500 Hz / 50 Hz), >= 1
-
-  // --- dynamic part f_nd = |C_d omega_hat|, C_d(s) = k_cd (s + z_cd)/(s + p_cd) (eqs. 35-36) --
-  double k_cd = 10.0;   //!< [N s/rad] high-frequency gain, > 0
-  double p_cd = 7.0;    //!< [rad/s] pole, > 0
-  double z_cd = 250.0;  //!< [rad/s] zero, > p_cd (lag network, DC gain k_cd z_cd / p_cd)
-  bool dynamic_enabled = true;  //!< (*) dynamic part active in slipping avoidance
-
-  // --- static part in slipping avoidance: PI on e = S - s_ref (docs/model.md 9.4) -----------------
-  double s_ref = 0.8;  //!< (*) reference of the slippage indicator S-bar_a, in (0, 1)
-  double k_p = 4.0;    //!< (*) [N] proportional gain (e > 0 raises the force), > 0
-  double k_i = 10.0;   //!< (*) [N/s] integral gain, > 0
-  bool anti_windup = true;  //!< (*) back-calculation I = f_ns,clipped - k_p e when clipped
-  //! (*) not in the paper (default 1; 0 = off = paper). Dead band of the dynamic part in multiples of each
-  //! finger's FingerInput::omega_resolution: C_d sees sign(w) max(0, |w| - band) with
-  //! band = omega_deadband * omega_resolution. The slip speed enters the wrench only through
-  //! viscous friction, so below the resolution omega_hat is sensor noise seen through 1/sigma_1;
-  //! rectified by |C_d .| it would add a noise-driven force. >= 0, finite.
-  double omega_deadband = 1.0;
-
-  // --- loop gain from the plant's slope (not in the paper) ------------------------------------
-  //! (*) default true; false = the paper's constant k_p, k_i. The loop gain of the PI on S is
-  //! k_p |dS/df_n|, and |dS/df_n| = n S / f_n (S ~ f_n^-n: n = 1 for a translational load,
-  //! 1 + gamma for a torsional one), so constant gains give a loop gain ~ 1/f_n that limit-cycles
-  //! at low force. With slope_gain the gains follow the slope at the operating point,
-  //! k_p = loop_gain_p / s_f, k_i = loop_gain_i / s_f, s_f = n s_ref / f (f: last command; n:
-  //! -d ln S_static / d ln f_n of the contact model for the load measured over the last command
-  //! period, clamped to [1, 1 + gamma]); the gains change bumplessly (velocity form).
-  bool slope_gain = true;
-  double loop_gain_p = 0.5;  //!< (*) [-] k_p |dS/df_n| with slope_gain, finite, > 0
-  double loop_gain_i = 2.0;  //!< (*) [1/s] k_i |dS/df_n| with slope_gain, finite, > 0
-
-  //! (*) default true; false = paper (S of the sample at the command). The PI's S is the mean of
-  //! max_i S_i over the valid samples of the command period: S is sampled at the sensor rate and
-  //! its noise would otherwise alias into the 50 Hz command (sqrt(command_ratio) less noise).
-  bool average_slippage = true;
-
-  // --- feed-forward from the measured wrench (not in the paper) -------------------------------
-  //! (*) default true; false = paper. At each command the static part is raised to at least the
-  //! static grasp force (StaticForceSolver) of the load measured over the last command period
-  //! (mean f_t and tau of each valid finger; the larger of the two forces) at
-  //! S = feedforward_slippage; the integrator then restarts from that force (bumpless). The load
-  //! arriving at lift-off is met at the next command instead of after the PI has integrated.
-  //! Not applied while pivoting.
-  bool feedforward = true;
-  //! (*) [-] S the feed-forward force is computed for, in (0, 1]: above s_ref, so in steady hold
-  //! the force stays the PI's (the feed-forward, noisier, only acts when the load jumps).
-  double feedforward_slippage = 0.9;
-
-  // --- standing reserve for the task's disturbances (not in the paper; docs/controller.md §8) --
-  //! (*) [N] default 0 = off. Per finger: the push the grasp must absorb without reacting (one
-  //! that arrives faster than the gripper's command period and lag). At each command the static
-  //! part is floored at the static grasp force (StaticForceSolver, at S = feedforward_slippage)
-  //! of the measured load with reserve_force added to |f_t| and reserve_torque to |tau|, so that
-  //! such a push keeps S below the reflex threshold while the reaction is on its way. Not applied
-  //! while pivoting. >= 0, finite.
-  double reserve_force = 0.0;
-  double reserve_torque = 0.0;  //!< (*) [N m] default 0 = off; the twist to absorb, as reserve_force. >= 0, finite.
-
-  // --- slip reflex (not in the paper) ---------------------------------------------------------
-  //! (*) default true; false = paper. When S = max_i S_i is at or above reflex_slippage on
-  //! reflex_samples valid samples of one command period, anywhere in it (a chattering slide of a
-  //! compliant pad alternates S between the bound and below it; the dry capacity is used up: the contact slides or
-  //! is about to), the next command raises the static part to at least reflex_factor x the static
-  //! part of the last command and restarts the integrator there. It acts whether or not the slip speed is observable (with
-  //! Coulomb-like contacts omega_hat carries no speed and C_d adds nothing). Not applied while
-  //! pivoting.
-  bool slip_reflex = true;
-  //! (*) [-] threshold on the peak of S, in (0, 1]. A translational slip with the CoR at the
-  //! c_max = 1.5 clip reads S = 0.95 at f_t = mu f_n, hence a threshold below 0.95.
-  double reflex_slippage = 0.93;
-  //! (*) samples of one command period at or above the threshold, >= 1 (S at the projection
-  //! bound S = 1 while sliding, not a single noisy sample); <= command_ratio, or the reflex
-  //! never fires.
-  int reflex_samples = 3;
-  double reflex_factor = 1.25;  //!< (*) [-] raise of the static part per period of detected slip, > 1
-
-  // --- reaction to fast load changes (not in the paper; docs/controller.md §6) ----------------
-  //! (*) [s] default 0.03; 0 = off (paper: the load of the period only). The feed-forward also
-  //! evaluates the load extrapolated this far ahead along its trend over the last command period
-  //! (least-squares slope of each finger's f_t and tau), so a load still rising at the command
-  //! (a pulse's edge) is met with the force it will need when the command has reached the
-  //! fingers. >= 0, finite.
-  double feedforward_horizon = 0.03;
-  //! (*) [-] the extrapolated load is used only when its static force exceeds the grasp's
-  //! mean-load force (the largest over the fingers) by more than this fraction (a trend, not
-  //! sensor noise). The next command checks the prediction: the part of the trend's lift that
-  //! the new period's mean load does not confirm is taken back from the integrator, while the
-  //! contact sticks. >= 0, finite.
-  double feedforward_trend = 0.5;
-  //! (*) [s] default 0.03; 0 = off (paper). Time constant of the gripper's force lag assumed by the
-  //! reaction: when the feed-forward or the reflex lifts the static part above the force the
-  //! gripper is estimated to apply, the command overshoots the target by the lag's shortfall over
-  //! one command period, (target - f_est) exp(-T/tau) / (1 - exp(-T/tau)), so the force reaches
-  //! the target within one period instead of ~3 tau; f_est follows the issued commands through
-  //! that lag. >= 0, finite.
-  double reaction_lag = 0.03;
-
-  // --- friction learned online (not in the paper; docs/controller.md "Friction learned") -------
-  //! (*) [-] default 0 = off (mu as told, the paper's); 0.08 learns mu online. Relative size of
-  //! the grip probe. Off by default: its answers mistake a load rising during the probe for a
-  //! slide and lower the belief of sticking contacts (docs/controller.md §9). While S is at least 0.5 and not falling, and no reaction is under way,
-  //! the static part is raised by this fraction for three command periods (the integrator does
-  //! not see it). The measured load's answer tells stick from slip with no speed signal: a
-  //! sticking contact's load does not follow the grip (elasticity d ln load / d ln f_n ~ 0), a
-  //! sliding one's does (~ 1: its load is its friction; a twist's after dividing by 1 + gamma).
-  //! The test: the mean of the probe's last two periods against the mean of the two periods
-  //! before it, elasticity >= 0.5 beyond two standard errors of the measured load (residuals
-  //! about each period's line). A slip found so is a measurement of mu (the load's friction
-  //! coefficient before the probe): the belief moves down to it, by at most 30 % per probe,
-  //! never below half the told mu; the belief never rises above the told mu. Probes repeat 3
-  //! commands apart while S rises above the last stick answer's, and back off (doubling, up to
-  //! 1 s) otherwise. Needs each finger's f_n (FingerInput::f_n). In [0, 0.5].
-  double mu_probe = 0.0;
-
-  // --- ceiling from the measured load (not in the paper; docs/controller.md §10) -------------
-  //! (*) [-] default 1.7; 0 = off (paper). In slipping avoidance the command never exceeds this
-  //! factor times the grip the measured load needs at S = 1 (StaticForceSolver at S = 1 of each
-  //! finger's period-mean load, or of the trend's load when the feed-forward uses it, or of the
-  //! load plus the standing reserve; the largest over the fingers), nor f_max. It caps raises
-  //! only: a command above it (the load fell) is lowered by the PI, not by the ceiling; a grip
-  //! probe may exceed it by its own size. A sticking
-  //! contact's load is the object's: the ceiling is this factor over the least grip that holds
-  //! it, so reactions that pile up (C_d on a lift-off's transfer slip, the reflex while the
-  //! force lags, the lag overshoot) cannot crush a fragile object. A sliding contact's load is
-  //! its friction, so the ceiling is this factor over the grip it slides at: the reaction still
-  //! grows by this factor per command period. 0 or in [1, 1000].
-  double ceiling_factor = 1.7;
-
-  // --- force range and rate limits (docs/model.md 9.5) --------------------------------------------
   double f_min = 0.1;   //!< [N] minimum force (keeps contact), > 0
   double f_max = 20.0;  //!< [N] maximum force (gripper limit), > f_min
   double max_rate_up = 200.0;    //!< (*) [N/s] limit on command increase, > 0 (inf: off)
   double max_rate_down = 200.0;  //!< (*) [N/s] limit on command decrease, > 0 (inf: off)
-  //! (*) [N] added to the held command at each command issued while the input is invalid
-  //! (NaN/Inf, InvalidSample, SensorFault, NoContact); 0 = hold. >= 0, finite.
-  double invalid_raise_step = 0.0;
+
+  // --- regulator: static part in slipping avoidance, PI on e = S - s_ref (docs/model.md 9.4) --
+  double s_ref = 0.8;  //!< (*) reference of the slippage indicator S-bar_a, in (0, 1)
+  double k_p = 4.0;    //!< (*) [N] proportional gain (e > 0 raises the force), > 0
+  double k_i = 16.0;   //!< (*) [N/s] integral gain (paper: 10), > 0
+  //! (*) [N] default 6.4; 0 = the paper's constant gains. The loop gain of the PI on S is
+  //! k |dS/df_n| = k n S / f_n (S ~ f_n^-n: n = 1 for a translational load, 1 + gamma for a
+  //! torsional one), so constant gains limit-cycle at low force. With gain_force > 0 the gains
+  //! are k_p f / (n gain_force) and k_i f / (n gain_force) (f: the last command; n from the
+  //! contact model for the load of the last command period, in [1, 1 + gamma]): k_p and k_i are
+  //! the gains at f = gain_force on a translational load. Gain changes are bumpless. >= 0, finite.
+  double gain_force = 6.4;
+
+  // --- dynamic part f_nd = |C_d omega_hat|, C_d(s) = k_cd (s + z_cd)/(s + p_cd) (eqs. 35-36) --
+  bool dynamic_enabled = true;  //!< (*) dynamic part active in slipping avoidance
+  double k_cd = 10.0;   //!< [N s/rad] high-frequency gain, > 0
+  double p_cd = 7.0;    //!< [rad/s] pole, > 0
+  double z_cd = 250.0;  //!< [rad/s] zero, > p_cd (lag network, DC gain k_cd z_cd / p_cd)
+
+  // --- floors and ceiling from the measured load (not in the paper; docs/controller.md) ------
+  //! (*) default true; false = paper. At each command the static part is raised to at least the
+  //! static grasp force (StaticForceSolver at S = 0.9) of the load measured over the last
+  //! command period (mean f_t and tau of each valid finger, the larger force), or of that load
+  //! extrapolated 30 ms ahead along its trend when that asks 50 % more (a load still rising at
+  //! the command); the integrator restarts there. Not applied while pivoting.
+  bool feedforward = true;
+  //! (*) [N] default 0 = off. The task's envelope of pushes per finger: the static part is
+  //! floored at the static grasp force at S = 1 of the measured load with reserve_force added
+  //! to |f_t| and reserve_torque to |tau| (such a push then keeps the contact at its limit while
+  //! the reaction is on its way). >= 0, finite.
+  double reserve_force = 0.0;
+  double reserve_torque = 0.0;  //!< (*) [N m] default 0 = off; the twist to absorb. >= 0, finite.
+  //! (*) [-] default 1.7; 0 = off (paper). In slipping avoidance a raise never takes the command
+  //! above this factor times the grip the measured load needs at S = 1 (the period-mean load,
+  //! the trend's load when the feed-forward uses it, or the load plus the reserve; the largest
+  //! over the fingers; that grip also read from S, command x S), nor f_max; lowering is the
+  //! PI's. A sticking contact's load is the object's, so reactions that pile up cannot crush a
+  //! fragile object; a sliding contact's load is its friction, so the reaction still grows by
+  //! this factor per command period. With the ceiling on, C_d adds at most 25 % of the static
+  //! part. 0 or in [1, 1000].
+  double ceiling_factor = 1.7;
+
+  // --- friction learned online (not in the paper; docs/controller.md §9) ----------------------
+  //! (*) [-] default 0 = off (mu as told, the paper's); 0.08 learns mu online. Relative size of
+  //! the grip probe: while S is at least 0.5 and not falling, the static part is raised by this
+  //! fraction for three command periods; a sliding contact's load follows the grip (elasticity
+  //! d ln load / d ln f_n ~ 1), a sticking one's does not. A slip found so lowers the belief to
+  //! the friction measured (by at most 30 % per probe, never below half the told mu, never
+  //! above it). Off by default: a load rising during the probe reads as a slide
+  //! (docs/controller.md §9). Needs each finger's f_n (FingerInput::f_n). In [0, 0.5].
+  double mu_probe = 0.0;
 
   // --- pivoting mode (docs/model.md 9.6) -----------------------------------------------------------
   double s_pivot = 1.3;      //!< (*) reference S-bar_p, > 1
   double tau_pivot = 2.0;    //!< (*) [s] time constant tau_p of the pivoting filter, > 0
   double k_f = 4.0;          //!< (*) [N] gain of the pivoting filter (paper: k_f = k_p), > 0
-  double pivot_floor_factor = 1.1;  //!< (*) floor max(f_min, factor f_t / mu), >= 1
   double pivot_end_c_tilde = 1.0;   //!< (*) pivoting ends when mean |c~_i| exceeds this, > 0
-  int pivot_end_samples = 3;        //!< (*) ... on this many consecutive samples, >= 1
-  double pivot_timeout = 10.0;      //!< (*) [s] pivoting ends after this time, > 0 (inf: never)
-  //! (*) [s] time constant of the first-order low-pass on the mean |c~_i| that the end test
-  //! compares, >= 0, finite (0: the sample itself, the paper's law)
-  double pivot_end_filter = 0.2;
-  //! (*) the end criterion counts only while the pivoting filter is held at its floor, i.e. the
-  //! force cannot fall further (false: from the first pivoting sample, the paper's law)
-  bool pivot_end_at_floor = true;
-  //! (*) [s] pivoting also ends once the filter has been held at its floor this long, > 0
-  //! (inf: never, the paper's law)
-  double pivot_floor_time = 1.0;
-  //! (*) [-] the end test counts only while max_i S_i is below this, > 0 (S at the projection
-  //! bound 1 means the contact slides: the object is still turning); inf: off, the paper's law
-  double pivot_end_slippage = 0.99;
 };
+
+//! The paper's law (eqs. 34-37): constant PI gains k_p = 4 N, k_i = 10 N/s, C_d as above, no
+//! floor, reserve, ceiling or learning. Three implementation choices of lugrip that have no
+//! setting apply to it too: the PI's S is the mean over the command period, C_d's input has a
+//! dead band of the observer's speed resolution, and the pivot's end test is lugrip's
+//! (docs/controller.md §1).
+GraspControllerSettings paper_settings() noexcept;
 
 //! Checks every field; one line per bad field ("k_p = -1: must be finite and > 0") in *message
 //! (if not null). Returns true when valid.
@@ -196,10 +114,10 @@ enum class ControllerMode : int {
 //! Why pivoting ended (reported in the call where it ends). Stable integer values.
 enum class PivotEnd : int {
   None = 0,          //!< pivoting did not end in this call
-  CorThreshold = 1,  //!< (low-passed) mean |c~| > pivot_end_c_tilde on pivot_end_samples samples
-  Timeout = 2,       //!< pivot_timeout elapsed
+  CorThreshold = 1,  //!< low-passed mean |c~| > pivot_end_c_tilde on 3 consecutive samples
+  Timeout = 2,       //!< 10 s of pivoting elapsed
   Requested = 3,     //!< request_slipping_avoidance() while pivoting
-  AtFloor = 4,       //!< the pivoting filter was held at its floor for pivot_floor_time
+  AtFloor = 4,       //!< the pivoting filter was held at its floor for 1 s
 };
 
 const char* to_string(ControllerMode m) noexcept;
@@ -214,8 +132,8 @@ struct FingerInput {
   double f_t = 0.0;        //!< tangential force [N] (magnitude is used; pivoting floor)
   Status status = Status::Ok;  //!< observer status of this sample
   bool present = true;     //!< false: this finger is not used (one-finger operation)
-  //! speed resolution of omega_hat [rad/s] (ObserverOutput::omega_resolution), >= 0; used by
-  //! the dead band (GraspControllerSettings::omega_deadband); 0: none
+  //! speed resolution of omega_hat [rad/s] (ObserverOutput::omega_resolution), >= 0; C_d sees
+  //! omega_hat shrunk by it (a dead band: below it omega_hat is sensor noise); 0: none
   double omega_resolution = 0.0;
   double tau = 0.0;  //!< measured torsional moment [N m] (signed; feed-forward and slope)
   double f_n = 0.0;  //!< measured normal force [N] (grip probe, mu_probe); 0: unknown, no probe
@@ -255,7 +173,6 @@ struct GraspControllerOutput {
   double gain_i = 0.0;         //!< k_i used at the last command [N/s]
   double feedforward_force = 0.0;  //!< feed-forward force at the last command [N] (0: none)
   double peak_slippage = 0.0;  //!< peak of max_i S_i over the period before the last command [-]
-  bool reflex = false;         //!< last command: the slip reflex raised the static part
   double mu_belief = 0.0;      //!< friction coefficient the controller believes now [-]
   double ceiling = 0.0;        //!< ceiling of the last command (ceiling_factor; f_max when off) [N]
   bool probing = false;        //!< last command: a grip probe raised the static part
@@ -348,24 +265,22 @@ class StaticForceSolver {
 //!   rate; f_ns clipped to [f_min, f_max] with back-calculation anti-windup; f_nd = the peak of
 //!   |C_d omega_hat| over the last command period clipped to [0, f_max - f_ns].
 //! * Pivoting: f_nd = 0; tau_p df/dt = -f + k_f (S - s_pivot), exact discretisation at the
-//!   command rate, started from the last command; floor max(f_min, factor max_i |f_t,i| / mu)
+//!   command rate, started from the last command; floor max(f_min, 1.1 max_i |f_t,i| / mu)
 //!   on the output and the filter state; ends on mean |c~_i| > pivot_end_c_tilde for
-//!   pivot_end_samples consecutive sensor samples (mean |c~_i| low-passed with the time
-//!   constant pivot_end_filter; counted, with pivot_end_at_floor, only while the pivoting filter
-//!   is held at the floor, and only while max_i S_i < pivot_end_slippage), after
-//!   pivot_floor_time at the floor, on timeout or on request,
-//!   then returns to
+//!   3 consecutive sensor samples (mean |c~_i| low-passed with a 0.2 s time constant; counted
+//!   only while the pivoting filter is held at the floor and max_i S_i < 0.99), after 1 s at
+//!   the floor, after 10 s, or on request, then returns to
 //!   slipping avoidance bumplessly (I = last command - k_p e at the next command, C_d reset).
 //! * Two fingers (docs/model.md 9.8): S = max_i S_i, f_nd from max_i |C_d omega_hat_i|, pivot end on
 //!   the mean of |c~_i|; absent fingers are ignored.
 //! * Rate limits act on the total command after the force range; the floor wins over them.
 //! * Invalid input (a present finger with NaN/Inf/out-of-range values or status InvalidSample,
 //!   SensorFault, NoContact): its C_d state is held; a command due in such a call holds the last
-//!   command (plus invalid_raise_step), never lower, and the static law restarts bumplessly.
+//!   command, never lower, and the static law restarts bumplessly.
 //! * Beyond the paper (each a setting, docs/controller.md): PI gains from the plant's slope
-//!   (slope_gain), a floor on the static part from the static grasp force of the measured load
-//!   (feedforward) and from reflex_factor x the last command after S reached reflex_slippage
-//!   (slip_reflex). Both floors act in slipping avoidance only, on the static part, before the
+//!   (gain_force), a floor on the static part from the static grasp force of the measured load
+//!   (feedforward, reserve), a ceiling from the same load (ceiling_factor) and a grip probe that
+//!   learns mu (mu_probe). They act in slipping avoidance only, on the static part, before the
 //!   force range and the rate limits.
 class GraspController {
  public:
@@ -416,8 +331,6 @@ class GraspController {
   void reset_dynamic() noexcept;
   void issue_command(bool valid, double slip) noexcept;
   double static_floor(double& slope_exponent) noexcept;
-  // static_floor() raised by the armed slip reflex; records both in c (feedforward_force, reflex)
-  double reaction_floor(double& slope_exponent, GraspControllerOutput& c) noexcept;
   void clear_period() noexcept;
   // The grip probe (mu_probe): probe_evaluate() counts a running probe down and, at its end,
   // compares the period's load with the reference period's (slip lowers mu_); probe_start()
@@ -455,7 +368,7 @@ class GraspController {
   long pivot_floor_samples_ = 0;  // consecutive samples with the filter held at the floor
   bool pivot_c_init_ = true;     // the low-pass on mean |c~| starts at the next valid sample
   double pivot_c_filtered_ = 0.0;  // low-passed mean |c~| of the pivot end test [-]
-  double pivot_c_alpha_ = 1.0;     // its coefficient 1 - exp(-dt / pivot_end_filter)
+  double pivot_c_alpha_ = 1.0;     // its coefficient 1 - exp(-dt / kPivotEndFilter)
   double last_f_t_ = 0.0;     // last valid max_i |f_t,i| [N] (pivot floor)
   double last_kp_ = 0.0;      // k_p of the last command [N] (bumpless gain change)
   double last_e_ = 0.0;       // proportional error of the last command [-]
@@ -464,16 +377,13 @@ class GraspController {
   std::array<double, kMaxFingers> sum_kf_{}, sum_kt_{};  // sums of k f_t, k tau (k: sample index in the period)
   std::array<double, kMaxFingers> sum_k_{}, sum_kk_{};   // sums of k, k^2 over those samples
   std::array<int, kMaxFingers> k_load_{};                // sample index in the period
-  double f_est_ = 0.0;        // gripper force estimated through reaction_lag [N]
-  double floor_measured_ = 0.0;  // reaction floor without the trend (mean load, reflex) [N]
+  double floor_measured_ = 0.0;  // floor of the period's mean load, without the trend [N]
   double ceiling_load_ = 0.0;    // grip the period's load needs at S = 1 (ceiling_factor) [N]
   double trend_lift_ = 0.0;      // part of the last restart of the integrator due to the trend [N]
   double trend_force_ = 0.0;     // static part the trend lifted to at the last command [N]
   double peak_s_ = 0.0;       // peak of max_i S_i since the last command
   double sum_s_ = 0.0;        // sum of max_i S_i over the valid samples since the last command
   int n_s_ = 0;
-  int count_s_ = 0;            // valid samples with S >= reflex_slippage since the last command
-  bool reflex_armed_ = false;  // such a run reached reflex_samples since the last command
   // grip probe (mu_probe)
   std::array<double, kMaxFingers> sum_f_n_{};  // sum of f_n over the load samples of the period
   std::array<bool, kMaxFingers> fn_ok_{{true, true}};  // every load sample of the period had f_n

@@ -7,7 +7,6 @@ Thin layer over the C++ ``lugrip::GraspController`` and ``lugrip::StaticForceSol
 from __future__ import annotations
 
 import enum
-import math
 from dataclasses import make_dataclass
 from typing import Any
 
@@ -42,26 +41,16 @@ _INT_FIELDS = tuple(name for name, kind, _doc in _core.GraspControllerSettings.f
 _BOOL_FIELDS = tuple(name for name, kind, _doc in _core.GraspControllerSettings.fields if kind == "bool")
 
 
-#: The settings that turn off every addition to the paper's law (eqs. 34-37): constant PI gains,
-#: no feed-forward, no slip reflex, the PI on S itself, no dead band on C_d. Pass them to compare
-#: with lugrip's defaults: ``GraspController(params, **PAPER_SETTINGS)``.
+#: The paper's law (eqs. 34-37) as settings, from the C++ preset ``paper_settings()``: constant
+#: PI gains (k_p = 4 N, k_i = 10 N/s), no feed-forward, reserve, ceiling or learned mu. Pass them
+#: to compare with lugrip's defaults: ``GraspController(params, **PAPER_SETTINGS)``. Three
+#: implementation choices without a setting apply to it too (docs/controller.md §1): the PI's S
+#: is the mean over the command period, C_d's input has a dead band of the observer's speed
+#: resolution, and the pivot's end test is lugrip's.
 PAPER_SETTINGS: dict[str, Any] = {
-    "s_ref": 0.8,
-    "slope_gain": False,
-    "feedforward": False,
-    "slip_reflex": False,
-    "average_slippage": False,
-    "omega_deadband": 0.0,
-    "feedforward_horizon": 0.0,
-    "reaction_lag": 0.0,
-    "mu_probe": 0.0,
-    "ceiling_factor": 0.0,
-    "reserve_force": 0.0,
-    "reserve_torque": 0.0,
-    "pivot_end_filter": 0.0,
-    "pivot_end_at_floor": False,
-    "pivot_floor_time": math.inf,
-    "pivot_end_slippage": math.inf,
+    name: getattr(_core.paper_settings(), name)
+    for name in _SETTINGS_FIELDS
+    if getattr(_core.paper_settings(), name) != getattr(_core.GraspControllerSettings(), name)
 }
 
 
@@ -76,10 +65,10 @@ class PivotEnd(enum.IntEnum):
     """Why pivoting ended; values equal the C++ lugrip::PivotEnd."""
 
     NONE = 0
-    COR_THRESHOLD = 1  #: (low-passed) mean |c~| > pivot_end_c_tilde on pivot_end_samples samples
+    COR_THRESHOLD = 1  #: low-passed mean |c~| > pivot_end_c_tilde on 3 consecutive samples
     TIMEOUT = 2
     REQUESTED = 3
-    AT_FLOOR = 4  #: the pivoting filter held at its floor for pivot_floor_time
+    AT_FLOOR = 4  #: the pivoting filter held at its floor for 1 s
 
 
 def _code(e) -> int:
@@ -179,32 +168,24 @@ class GraspController(NoCopy):
     * Pivoting: f_nd = 0, tau_p df/dt = -f + k_f (S - s_pivot) (exact discretisation), floor
       max(f_min, 1.1 f_t / mu); ends when a 0.2 s low-pass of the mean |c~_i| exceeds 1 on 3
       samples while the force sits at that floor and S < 0.99 (the paper: the sample's mean
-      |c~_i| on 3 samples from the start, PAPER_SETTINGS), after 1 s at the floor, on timeout
-      or on request, then returns bumplessly to slipping avoidance.
+      |c~_i| on 3 samples from the start), after 1 s at the floor, after 10 s or on request, then returns bumplessly to slipping avoidance.
     * step() at the sensor rate (500 Hz); a command every ``command_ratio`` calls (50 Hz), held.
     * Two fingers: S = max_i S_i, f_nd from max_i |C_d omega_hat_i|, pivot end on the mean |c~_i|.
     * Invalid input (NaN/Inf, Status INVALID_SAMPLE / SENSOR_FAULT / NO_CONTACT on a present
-      finger): the command is held (plus ``invalid_raise_step``), never lowered.
+      finger): the command is held, never lowered.
 
     Args:
         params: ContactParams, a preset name or a dict (mu for the pivoting floor; the whole
             contact model for the feed-forward and the slope).
         **settings: any GraspControllerSettings field (see :func:`controller_settings` for the
-            names and defaults): rates (sensor_rate [Hz], command_ratio), C_d (k_cd [N s/rad],
-            p_cd, z_cd [rad/s], dynamic_enabled), PI (s_ref, k_p [N], k_i [N/s], anti_windup;
-            omega_deadband: dead band of C_d in omega resolutions, 0 = off),
-            slope_gain, loop_gain_p [-], loop_gain_i [1/s]: PI gains from the plant's slope
-            dS/df_n; feedforward, feedforward_slippage: static part floored at the static grasp
-            force of the measured load (feedforward_horizon, feedforward_trend: the load's
-            trend); slip_reflex, reflex_slippage, reflex_samples, reflex_factor: raise the
-            command when S reaches the threshold; mu_probe: the grip probe that learns mu
-            (needs f_n; output mu_belief) (see
-            :data:`PAPER_SETTINGS` for the paper's law),
-            range (f_min, f_max [N]), rate
-            limits (max_rate_up, max_rate_down [N/s], inf = off), invalid_raise_step [N], pivoting
-            (s_pivot, tau_pivot [s], k_f [N], pivot_floor_factor, pivot_end_c_tilde,
-            pivot_end_samples, pivot_timeout [s], pivot_end_filter [s], pivot_end_at_floor,
-            pivot_floor_time [s], pivot_end_slippage).
+            names and defaults): the gripper (sensor_rate [Hz], command_ratio, f_min, f_max [N],
+            max_rate_up, max_rate_down [N/s], inf = off), the PI (s_ref, k_p [N], k_i [N/s],
+            gain_force [N]: gains that follow the plant's slope dS/df_n, 0 = constant), C_d
+            (dynamic_enabled, k_cd [N s/rad], p_cd, z_cd [rad/s]), the floors and ceiling from
+            the measured load (feedforward, reserve_force [N], reserve_torque [N m],
+            ceiling_factor), mu_probe: the grip probe that learns mu (needs f_n; output
+            mu_belief), pivoting (s_pivot, tau_pivot [s], k_f [N], pivot_end_c_tilde). See
+            :data:`PAPER_SETTINGS` for the paper's law.
 
     Raises:
         ValueError: unknown or invalid setting (one line per bad field) or invalid params.
@@ -294,9 +275,9 @@ class GraspController(NoCopy):
             c_tilde: normalized CoR [-]; f_t: tangential force [N]; status: observer Status;
             present: per-finger bools (default: the fingers given).
             omega_resolution: the observer's speed resolution [rad/s] (``omega_resolution`` of
-                its output), used by the dead band of the dynamic part (``omega_deadband``).
+                its output): the dead band of C_d's input.
             tau: measured torsional moment [N m] (signed), with f_t the load of the
-                feed-forward and of the slope (``feedforward``, ``slope_gain``).
+                feed-forward and of the slope (``feedforward``, ``gain_force``).
             f_n: measured normal force [N] (the grip probe, ``mu_probe``; 0: unknown, no probe).
         """
         vals = [np.atleast_1d(np.asarray(v, dtype=np.float64))
@@ -331,8 +312,8 @@ class GraspController(NoCopy):
             requests: (N,) ints applied before each sample (REQUEST_NONE, REQUEST_PIVOTING,
                 REQUEST_SLIPPING_AVOIDANCE), or a dict {sample index: "pivoting" |
                 "slipping_avoidance"}.
-            omega_resolution: the observers' speed resolution [rad/s], like omega_hat (used by
-                the dead band ``omega_deadband``; default 0: no dead band).
+            omega_resolution: the observers' speed resolution [rad/s], like omega_hat (the
+                dead band of C_d's input; default 0: none).
             tau: measured torsional moment [N m], like f_t (feed-forward and slope load).
             f_n: measured normal force [N], like f_t (the grip probe; 0: unknown, no probe).
 

@@ -66,7 +66,7 @@ class SlipControl(NoCopy):
     finger, i.e. a (2, 4) array for two fingers, and returns the command to send with each
     finger's observer output. Every observer status reaches the controller: on contact loss
     (f_n below the contact threshold), a NaN/Inf/out-of-range sample or a sensor fault the
-    command due is held (plus ``invalid_raise_step``), never lowered.
+    command due is held, never lowered.
 
     Args:
         params: ContactParams, a preset name, a dict, or a parameter YAML (a path, or a str

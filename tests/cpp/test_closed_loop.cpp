@@ -188,9 +188,7 @@ TEST(ClosedLoop, ForceDecaysToTheFloorBeforeTheLiftAndRisesAtLiftOff) {
   // The paper's PI (constant gains) drains the unloaded command at k_i S_ref = 8 N/s; lugrip's
   // default slope gain drains it exponentially (below).
   ClosedLoopConfig c = lift_config();
-  c.controller.slope_gain = c.controller.feedforward = c.controller.slip_reflex = false;
-  c.controller.average_slippage = false;
-  c.controller.ceiling_factor = 0.0;  // the unloaded grip would go to f_min at once (below)
+  c.controller = paper_settings();  // constant gains, no feed-forward, no ceiling  // the unloaded grip would go to f_min at once (below)
   ClosedLoop loop(c);
   const auto log = run(loop, 3.0);
   // At the floor f_min = 0.1 N: no load on the table. The mean sits a little above it: at 0.1 N
@@ -212,8 +210,9 @@ TEST(ClosedLoop, DefaultControllerDrainsTheUnloadedCommandExponentiallyAndHoldsA
   ClosedLoop loop(c);
   const auto log = run(loop, 3.0);
   const double f0 = mean_command(log, 0.0, 0.02);
-  const double rate = GraspControllerSettings().loop_gain_i;  // [1/s]
-  // f(t) = f0 exp(-loop_gain_i t) while S ~ 0 (within the S noise and the 20 ms steps)
+  const GraspControllerSettings d;
+  const double rate = d.k_i * d.s_ref / d.gain_force;  // [1/s]
+  // f(t) = f0 exp(-k_i s_ref t / gain_force) while S ~ 0 (within the S noise and the 20 ms steps)
   EXPECT_NEAR(mean_command(log, 0.4, 0.5), f0 * std::exp(-rate * 0.45), 0.15 * f0 * std::exp(-rate * 0.45));
   EXPECT_GT(mean_command(log, 2.5, 3.0), 0.5 * 0.5 * kG / 0.85) << "above the translational slip force";
 }

@@ -75,34 +75,32 @@ TEST(ControllerBounds, EdgesAreInsideAndJustOutsideIsNot) {
   EXPECT_TRUE(accepted(s));
   s.f_min = std::nextafter(1e-6, 0.0);
   EXPECT_FALSE(accepted(s));
-  for (double GraspControllerSettings::*field :
-       {&GraspControllerSettings::s_ref, &GraspControllerSettings::feedforward_slippage,
-        &GraspControllerSettings::reflex_slippage}) {
-    s = {};
-    s.*field = 1e-3;
-    EXPECT_TRUE(accepted(s));
-    s.*field = std::nextafter(1e-3, 0.0);
-    EXPECT_FALSE(accepted(s));
-  }
   s = {};
-  s.loop_gain_p = s.loop_gain_i = 1e9;
-  s.reflex_factor = 1e3;
+  s.s_ref = 1e-3;
   EXPECT_TRUE(accepted(s));
-  s.loop_gain_p = std::nextafter(1e9, 2e9);
+  s.s_ref = std::nextafter(1e-3, 0.0);
   EXPECT_FALSE(accepted(s));
-  s.loop_gain_p = 1e9;
-  s.reflex_factor = std::nextafter(1e3, 2e3);
+  s = {};
+  s.gain_force = 0.0;  // the paper's constant gains
+  EXPECT_TRUE(accepted(s));
+  s.gain_force = 1e-6;
+  EXPECT_TRUE(accepted(s));
+  s.gain_force = std::nextafter(1e-6, 0.0);
+  EXPECT_FALSE(accepted(s));
+  s.gain_force = 1e6;
+  EXPECT_TRUE(accepted(s));
+  s.gain_force = std::nextafter(1e6, 2e6);
   EXPECT_FALSE(accepted(s));
 }
 
 // Every range at its worst end at once, inputs at the largest magnitudes step() accepts
-// (|S| = 1e3, |omega_hat| = 1e6), no anti-windup: the command stays finite and in range.
+// (|S| = 1e3, |omega_hat| = 1e6): the command stays finite and in range.
 TEST(ControllerBounds, WorstEdgeSettingsKeepTheCommandFinite) {
   for (int variant = 0; variant < 8; ++variant) {
     GraspControllerSettings s;
-    // variants 0-3: constant gains; 4-7: gains from the slope dS/df
+    // variants 0-3: constant gains; 4-7: gains from the slope dS/df at the smallest gain_force
     // with every addition of the default law at its extreme
-    s.slope_gain = variant >= 4;
+    s.gain_force = variant >= 4 ? 1e-6 : 0.0;
     s.sensor_rate = variant % 2 ? 1e9 : 1e-3;
     s.command_ratio = variant % 4 < 2 ? 1 : 1000000;
     s.k_cd = 1e9;
@@ -110,18 +108,13 @@ TEST(ControllerBounds, WorstEdgeSettingsKeepTheCommandFinite) {
     s.z_cd = 1e12;
     s.k_p = 1e9;
     s.k_i = 1e9;
-    s.anti_windup = false;
     s.mu_probe = variant % 2 ? 0.5 : 0.0;
-    s.loop_gain_p = s.loop_gain_i = 1e9;
-    s.s_ref = s.feedforward_slippage = s.reflex_slippage = 1e-3;
-    s.reflex_factor = 1e3;
-    s.reflex_samples = 1;
+    s.s_ref = 1e-3;
     s.f_min = 1e-6;
     s.f_max = 1e6;
     s.max_rate_up = s.max_rate_down = std::numeric_limits<double>::infinity();
     s.s_pivot = 1e3;
     s.k_f = 1e9;
-    s.omega_deadband = 0.0;
     ASSERT_TRUE(accepted(s)) << message(s);
     GraspController c(object_params("aluminium_can"), s);
     GraspControllerInput in;

@@ -44,7 +44,6 @@ double settle(GraspController& c, const GraspControllerInput& in, int periods = 
 
 GraspControllerSettings quiet() {
   GraspControllerSettings s;
-  s.slip_reflex = false;
   s.dynamic_enabled = false;
   return s;
 }
@@ -55,7 +54,7 @@ TEST(ControllerReserve, TranslationalReserveHoldsTheLoadPlusThePushAtTheSlidingL
   // Pure translation: g = mu f_n at the clip, so the force at S = 1 for f_t + r is (f_t + r) / mu
   // (the estimator's |c~| clip at c_max makes S = 0.95 at f_t = mu f_n: the solver's force is
   // the model's, compared with the closed form to 6 %). Without the reserve the PI, at
-  // S = 0.3 << s_ref, unwinds to the feed-forward of the load alone (at feedforward_slippage).
+  // S = 0.3 << s_ref, unwinds to the feed-forward of the load alone (at S = 0.9).
   const ContactParams p = box();
   GraspControllerSettings s = quiet();
   s.reserve_force = 1.5;
@@ -67,7 +66,7 @@ TEST(ControllerReserve, TranslationalReserveHoldsTheLoadPlusThePushAtTheSlidingL
   EXPECT_NEAR(f, (2.2 + 1.5) / 0.6, 0.06 * (2.2 + 1.5) / 0.6);
   GraspController off(p, quiet());
   off.reset(2.0);
-  const double ff = solver.solve(2.2, 0.0, s.feedforward_slippage).force;
+  const double ff = solver.solve(2.2, 0.0, 0.9).force;  // the feed-forward's S = 0.9
   EXPECT_NEAR(settle(off, both(0.3, 2.2, 0.0)), ff, 1e-9);
   EXPECT_GT(f, 1.5 * ff);
 }
@@ -89,7 +88,7 @@ TEST(ControllerReserve, TorqueReserveAddsToTheMeasuredTwistWhateverItsSign) {
 TEST(ControllerReserve, AboveTheReserveThePiStillRegulates) {
   // S held above s_ref (the observer reads a load the model underrates) raises the force beyond
   // the floor: the reserve is a floor, never a cap. 2 s at e = 0.15 with the slope gains
-  // (k_i = loop_gain_i f / s_ref) grow the force by about exp(2.5 * 0.15 * 2) = 2.1.
+  // (k_i f / gain_force = 2.5 f) grow the force by about exp(2.5 * 0.15 * 2) = 2.1.
   const ContactParams p = box();
   GraspControllerSettings s = quiet();
   s.reserve_force = 1.0;

@@ -85,7 +85,7 @@ TEST(SlipControl, HandWiringWithoutStatusesDropsTheObjectOnContactLoss) {
   // Negative control for the test above: the same loop wired by hand with the status left at
   // its default (Ok) lowers the command to f_min within 0.2 s of contact loss.
   SlipControlSettings s;
-  s.controller.slope_gain = false;  // the paper's gains drain the unloaded command within 0.2 s
+  s.controller.gain_force = 0.0;  // the paper's constant gains drain the unloaded command within 0.2 s
   Observer obs0(can(), s.observer), obs1(can(), s.observer);
   GraspController ctrl(can(), s.controller);
   QuasiStaticGrip grip;

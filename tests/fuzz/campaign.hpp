@@ -310,29 +310,18 @@ class Campaign {
     obs_.init([](const ObserverSettings& s) { return validate(s, nullptr); });
     // controller settings
     using G = GraspControllerSettings;
-    ctl_.reals = {LUGRIP_FUZZ_REAL(G, sensor_rate),   LUGRIP_FUZZ_REAL(G, k_cd),
-                  LUGRIP_FUZZ_REAL(G, p_cd),          LUGRIP_FUZZ_REAL(G, z_cd),
-                  LUGRIP_FUZZ_REAL(G, s_ref),         LUGRIP_FUZZ_REAL(G, k_p),
-                  LUGRIP_FUZZ_REAL(G, k_i),           LUGRIP_FUZZ_REAL(G, mu_probe),      LUGRIP_FUZZ_REAL(G, ceiling_factor),
-                  LUGRIP_FUZZ_REAL(G, omega_deadband), LUGRIP_FUZZ_REAL(G, f_min),
+    ctl_.reals = {LUGRIP_FUZZ_REAL(G, sensor_rate),   LUGRIP_FUZZ_REAL(G, f_min),
                   LUGRIP_FUZZ_REAL(G, f_max),         LUGRIP_FUZZ_REAL(G, max_rate_up),
-                  LUGRIP_FUZZ_REAL(G, max_rate_down), LUGRIP_FUZZ_REAL(G, invalid_raise_step),
+                  LUGRIP_FUZZ_REAL(G, max_rate_down), LUGRIP_FUZZ_REAL(G, s_ref),
+                  LUGRIP_FUZZ_REAL(G, k_p),           LUGRIP_FUZZ_REAL(G, k_i),
+                  LUGRIP_FUZZ_REAL(G, gain_force),    LUGRIP_FUZZ_REAL(G, k_cd),
+                  LUGRIP_FUZZ_REAL(G, p_cd),          LUGRIP_FUZZ_REAL(G, z_cd),
+                  LUGRIP_FUZZ_REAL(G, reserve_force), LUGRIP_FUZZ_REAL(G, reserve_torque),
+                  LUGRIP_FUZZ_REAL(G, ceiling_factor), LUGRIP_FUZZ_REAL(G, mu_probe),
                   LUGRIP_FUZZ_REAL(G, s_pivot),       LUGRIP_FUZZ_REAL(G, tau_pivot),
-                  LUGRIP_FUZZ_REAL(G, k_f),           LUGRIP_FUZZ_REAL(G, pivot_floor_factor),
-                  LUGRIP_FUZZ_REAL(G, pivot_end_c_tilde), LUGRIP_FUZZ_REAL(G, pivot_timeout),
-                  LUGRIP_FUZZ_REAL(G, pivot_end_filter), LUGRIP_FUZZ_REAL(G, pivot_floor_time),
-                  LUGRIP_FUZZ_REAL(G, pivot_end_slippage),
-                  LUGRIP_FUZZ_REAL(G, feedforward_horizon), LUGRIP_FUZZ_REAL(G, feedforward_trend),
-                  LUGRIP_FUZZ_REAL(G, reaction_lag),      LUGRIP_FUZZ_REAL(G, reserve_force),
-                  LUGRIP_FUZZ_REAL(G, reserve_torque),    LUGRIP_FUZZ_REAL(G, loop_gain_p),
-                  LUGRIP_FUZZ_REAL(G, loop_gain_i),       LUGRIP_FUZZ_REAL(G, feedforward_slippage),
-                  LUGRIP_FUZZ_REAL(G, reflex_slippage),   LUGRIP_FUZZ_REAL(G, reflex_factor)};
-    ctl_.ints = {LUGRIP_FUZZ_INT(G, command_ratio), LUGRIP_FUZZ_INT(G, pivot_end_samples),
-                 LUGRIP_FUZZ_INT(G, reflex_samples)};
-    ctl_.bools = {LUGRIP_FUZZ_BOOL(G, dynamic_enabled), LUGRIP_FUZZ_BOOL(G, anti_windup),
-                  LUGRIP_FUZZ_BOOL(G, slope_gain),      LUGRIP_FUZZ_BOOL(G, average_slippage),
-                  LUGRIP_FUZZ_BOOL(G, feedforward),     LUGRIP_FUZZ_BOOL(G, slip_reflex),
-                  LUGRIP_FUZZ_BOOL(G, pivot_end_at_floor)};
+                  LUGRIP_FUZZ_REAL(G, k_f),           LUGRIP_FUZZ_REAL(G, pivot_end_c_tilde)};
+    ctl_.ints = {LUGRIP_FUZZ_INT(G, command_ratio)};
+    ctl_.bools = {LUGRIP_FUZZ_BOOL(G, dynamic_enabled), LUGRIP_FUZZ_BOOL(G, feedforward)};
     ctl_.init([](const G& s) { return validate(s, nullptr); });
   }
 

@@ -13,12 +13,8 @@ from lugrip import ControllerMode, GraspController, PivotEnd, Status
 from scipy import signal
 
 CAN = lugrip.ContactParams.preset("aluminium_can")
-#: The paper's static law (constant gains, S of the sample, no feed-forward, no reflex); the
-#: dead band (omega_deadband) keeps its default here.
-PAPER_PI = {k: lugrip.PAPER_SETTINGS[k]
-            for k in ("slope_gain", "feedforward", "slip_reflex", "average_slippage", "s_ref",
-                      "pivot_end_filter", "pivot_end_at_floor", "pivot_floor_time",
-                      "pivot_end_slippage")}
+#: The paper's static law (constant gains, no feed-forward); the ceiling keeps its default here.
+PAPER_PI = {k: lugrip.PAPER_SETTINGS[k] for k in ("gain_force", "feedforward", "k_i")}
 T_SENSOR = 1.0 / 500.0
 T_CMD = 10 * T_SENSOR
 
@@ -96,21 +92,15 @@ def test_pi_direction(S, sign):
     assert sign * (forces[-1] - 5.0) > 0.5
 
 
-@pytest.mark.parametrize("anti_windup", [True, False])
-def test_anti_windup_leaves_the_ceiling_at_once(anti_windup):
+def test_anti_windup_leaves_the_ceiling_at_once():
     """After 20 s at f_max the force leaves it at the first command after the error reverses
-    with back-calculation, only after hundreds of commands without."""
-    ctrl = GraspController(CAN, anti_windup=anti_windup, max_rate_up=math.inf,
-                           max_rate_down=math.inf, **PAPER_PI)
+    (back-calculation; without it the integrator would have wound up by 40 N)."""
+    ctrl = GraspController(CAN, max_rate_up=math.inf, max_rate_down=math.inf, **PAPER_PI)
     ctrl.reset(5.0)
     hold = ctrl.run(np.zeros(10000), np.ones(10000), 0.5, 0.5)
     assert hold.force[-1] == 20.0
     after = ctrl.run(np.zeros(5000), np.full(5000, 0.5), 0.5, 0.5)
-    first_below = int(np.argmax(after.force < 20.0))
-    if anti_windup:
-        assert first_below == 0
-    else:
-        assert first_below > 300 * 10
+    assert int(np.argmax(after.force < 20.0)) == 0
 
 
 def test_ceiling_and_floor_and_validation_messages():
@@ -163,16 +153,15 @@ def test_two_fingers_combine_max_s_and_max_dynamic_part():
 
 
 @pytest.mark.parametrize("status", [Status.INVALID_SAMPLE, Status.SENSOR_FAULT, Status.NO_CONTACT])
-def test_bad_status_holds_or_raises(status):
-    ctrl = GraspController(CAN, invalid_raise_step=0.05)
+def test_bad_status_holds(status):
+    ctrl = GraspController(CAN)
     ctrl.reset(3.0)
     n = 100
     st_ = np.full((n, 2), int(Status.OK))
     st_[:, 1] = int(status)
     run = ctrl.run(np.zeros((n, 2)), np.zeros((n, 2)), 0.5, 0.5, status=st_)
     assert np.all(run.status == int(status))
-    np.testing.assert_allclose(run.force[run.command_issued], 3.0 + 0.05 * np.arange(1, 11))
-    assert np.all(np.diff(run.force) >= 0)
+    np.testing.assert_array_equal(run.force, 3.0)  # held: never lowered, never raised
 
 
 @settings(max_examples=40, deadline=None)
@@ -188,7 +177,7 @@ def test_command_always_finite_and_in_range(seed):
         x[(mask >= 0.03) & (mask < 0.05)] = np.inf
         x[(mask >= 0.05) & (mask < 0.07)] = -1e300
         return x
-    ctrl = GraspController(CAN, f_min=0.2, f_max=15.0, pivot_timeout=0.3)
+    ctrl = GraspController(CAN, f_min=0.2, f_max=15.0)
     run = ctrl.run(junk(0.5), np.abs(junk(1.0)), junk(2.0), junk(5.0),
                    status=rng.integers(0, 7, (n, 2)), present=rng.uniform(size=(n, 2)) < 0.9,
                    requests=rng.choice(3, n, p=[0.996, 0.002, 0.002]))
@@ -221,9 +210,9 @@ def test_step_and_run_agree():
 def test_pivoting_decay_floor_end_and_bumpless_return():
     ctrl = GraspController(CAN, max_rate_up=math.inf, max_rate_down=math.inf, **PAPER_PI)
     ctrl.reset(8.0)
-    ctrl.run(np.full(20, 0.01), np.full(20, 0.8), 0.3, 0.5)
+    ctrl.run(np.full(20, 0.01), np.full(20, 1.0), 0.3, 0.5)
     f0 = ctrl.command
-    n = 1500  # 3 s of sliding (S = 1) with |c~| < 1, f_t = 1.5 N: floor 1.1 * 1.5 / 0.75 = 2.2 N
+    n = 1200  # 2.4 s of sliding (S = 1) with |c~| < 1, f_t = 1.5 N: floor 1.1 * 1.5 / 0.75 = 2.2 N
     run = ctrl.run(np.full(n, 5.0), np.ones(n), 0.3, 1.5, requests={0: "pivoting"})
     assert np.all(run.mode == int(ControllerMode.PIVOTING))
     assert np.all(run.dynamic_force == 0) and np.all(run.dynamic_sample == 0)
@@ -231,13 +220,17 @@ def test_pivoting_decay_floor_end_and_bumpless_return():
     k = np.arange(n // 10)
     expected = np.maximum(-1.2 + (f0 + 1.2) * np.exp(-k * T_CMD / 2.0), 2.2)
     np.testing.assert_allclose(run.force[run.command_issued], expected, rtol=1e-9)
-    # |c~| crosses 1: ends on the third consecutive sample, command unchanged at the switch.
+    # At the floor, |c~| goes to 1.3 (S below the sliding bound): the end test's 0.2 s low-pass
+    # of |c~| (from 0.3) crosses 1 after 0.2 ln(1 / 0.3) = 0.24 s, then three samples; the
+    # command is unchanged at the switch.
     last = ctrl.command
-    end = ctrl.run(np.zeros(40), np.full(40, 0.9), [0.9, 1.2, 1.1] + [1.3] * 37, 1.5)
+    m = 200
+    end = ctrl.run(np.zeros(m), np.full(m, 0.9), 1.3, 1.5)
     i = int(np.argmax(end.pivot_finished))
-    assert i == 3 and end.pivot_end[i] == int(PivotEnd.COR_THRESHOLD)
+    assert end.pivot_end[i] == int(PivotEnd.COR_THRESHOLD)
+    assert abs(i - (0.2 * math.log(1 / 0.3) / T_SENSOR + 3)) <= 2
     assert np.all(end.mode[i:] == int(ControllerMode.SLIPPING_AVOIDANCE))
-    first_pi = np.flatnonzero(end.command_issued & (np.arange(40) >= i))[0]
+    first_pi = np.flatnonzero(end.command_issued & (np.arange(m) >= i))[0]
     assert end.force[first_pi] == pytest.approx(last, abs=1e-12)  # bumpless
     assert end.integrator[first_pi] == pytest.approx(last - 4 * 0.1 + 10 * T_CMD * 0.1)
 
@@ -304,30 +297,11 @@ def test_closed_loop_settles_at_the_static_force(obj, ft, tau):
     assert np.all(np.abs(tail / f_static - 1) < 0.01)
 
 
-def test_dead_band_ignores_speeds_below_the_observer_resolution():
-    """omega_deadband (in multiples of the observer's omega_resolution) removes the noise-level
-    speeds from C_d: no dynamic force below the band, the force of the shrunk speed above it."""
-    kw = {"omega_deadband": 2.0, "ceiling_factor": 0.0}  # the C_d layer alone
-    below = lugrip.GraspController("aluminium_can", **kw).run(
-        np.full(40, 0.015), 0.8, omega_resolution=0.01
-    )
-    assert np.all(below.dynamic_force == 0.0)
-    blind = lugrip.GraspController("aluminium_can", **kw).run(np.full(40, 0.015), 0.8)
-    assert blind.dynamic_force[-1] > 0.5  # resolution 0 (not given): no band
-    above = lugrip.GraspController("aluminium_can", **kw).run(
-        np.full(40, 0.035), 0.8, omega_resolution=0.01
-    )
-    shrunk = lugrip.GraspController("aluminium_can", **kw).run(np.full(40, 0.015), 0.8)
-    np.testing.assert_allclose(above.force, shrunk.force, rtol=1e-12)
-    out = lugrip.GraspController("aluminium_can", **kw).step(0.015, 0.8, omega_resolution=0.01)
-    assert out.dynamic_force == 0.0
-
-
-# --- beyond the paper: slope gain, feed-forward, slip reflex (docs/controller.md) ----------------
+# --- beyond the paper: slope gain, feed-forward (docs/controller.md) ----------------
 
 def test_feedforward_is_the_static_grasp_force_of_the_measured_load():
     """Consistency: the feed-forward force of a command is static_grasp_force of the mean load of
-    the period at S = feedforward_slippage, and lifts the static part at that command."""
+    the period at S = 0.9, and lifts the static part at that command."""
     ctrl = GraspController(CAN, max_rate_up=math.inf)
     ctrl.reset(0.1)
     ft, tau = 1.5, 2e-3
@@ -343,43 +317,22 @@ def test_feedforward_is_the_static_grasp_force_of_the_measured_load():
     assert r_off.force[10] < 0.2 < expected
 
 
-def test_slip_reflex_reacts_within_one_command_period_without_speed():
-    """S at the projection bound for 3 samples, omega_hat = 0 (no speed information): the next
-    command raises the static part by reflex_factor."""
-    ctrl = GraspController(CAN, feedforward=False, max_rate_up=math.inf)
-    ctrl.reset(2.0)
-    S = np.r_[np.full(11, 0.8), 0.8, 0.8, 1.0, 1.0, 1.0, np.full(5, 0.8)]
-    run = ctrl.run(np.zeros(S.size), S, 1.5, 1.0)
-    cmd = np.flatnonzero(run.command_issued)
-    assert cmd[-1] == 20 and run.reflex[20]
-    assert run.force[20] >= 1.25 * run.force[10] - 1e-12
-
-
 @given(
-    name=st.sampled_from(["loop_gain_p", "loop_gain_i", "feedforward_slippage", "reflex_slippage",
-                          "reflex_factor", "reflex_samples"]),
+    name=st.sampled_from(["gain_force", "ceiling_factor", "mu_probe", "reserve_force"]),
     value=st.one_of(st.floats(max_value=0.0), st.just(math.nan), st.just(math.inf),
-                    st.floats(min_value=1.0001, max_value=1e9),
-                    st.sampled_from([1e-3, 9.99e-4, 0.5, 1e3, 1000.5, 1e9, 1.01e9])),
+                    st.floats(min_value=1e-9, max_value=2e6),
+                    st.sampled_from([1e-6, 9.99e-7, 0.5, 0.51, 1.0, 0.999, 1e3, 1000.5, 1e6, 1.01e6])),
 )
 @settings(max_examples=60, deadline=None)
-def test_new_settings_are_validated(name, value):
-    """Out-of-range values of the new settings are refused, naming the field; values inside
-    their range are accepted."""
+def test_settings_beyond_the_paper_are_validated(name, value):
+    """Out-of-range values of lugrip's settings beyond the paper are refused, naming the field;
+    values inside their range are accepted."""
     valid = {
-        "loop_gain_p": lambda v: 0 < v <= 1e9,
-        "loop_gain_i": lambda v: 0 < v <= 1e9,
-        "feedforward_slippage": lambda v: 1e-3 <= v <= 1,
-        "reflex_slippage": lambda v: 1e-3 <= v <= 1,
-        "reflex_factor": lambda v: 1 < v <= 1e3,
-        "reflex_samples": lambda v: math.isfinite(v) and v >= 1 and v == int(v) and v < 2**31,
+        "gain_force": lambda v: v == 0 or 1e-6 <= v <= 1e6,
+        "ceiling_factor": lambda v: v == 0 or 1 <= v <= 1e3,
+        "mu_probe": lambda v: 0 <= v <= 0.5,
+        "reserve_force": lambda v: 0 <= v <= 1e6,
     }[name]
-    if name == "reflex_samples" and not (math.isfinite(value) and value == int(value)):
-        with pytest.raises(ValueError, match=name):
-            GraspController(CAN, **{name: value})
-        return
-    if name == "reflex_samples" and abs(value) >= 2**31:
-        return
     if valid(value):
         GraspController(CAN, **{name: value})
     else:
@@ -391,7 +344,10 @@ def test_removed_settings_are_refused_by_name():
     """The superseded settings and the 'earlier rule' switches are gone: naming one is an
     error that names it (no silent acceptance of a setting that does nothing)."""
     for name in ("gain_schedule_force", "static_equivalent_slippage", "reflex_in_period",
-                 "feedforward_trend_grasp", "feedforward_trend_check", "react_when_invalid"):
+                 "feedforward_trend_grasp", "feedforward_trend_check", "react_when_invalid",
+                 "slip_reflex", "reflex_factor", "reaction_lag", "omega_deadband", "slope_gain",
+                 "loop_gain_p", "average_slippage", "anti_windup", "invalid_raise_step",
+                 "feedforward_horizon", "pivot_timeout", "pivot_end_filter"):
         with pytest.raises(ValueError, match=name):
             GraspController(CAN, **{name: 1.0})
 
@@ -423,8 +379,10 @@ def test_light_object_on_the_patch_plant_holds_without_a_limit_cycle():
 
 def test_light_cup_on_mujoco_holds_without_a_limit_cycle():
     """Independent plant (MuJoCo's contact solver): the 30 g cup lifted at 1 s; in the hold
-    (3.5-5 s) the default controller's command varies by < 10 % of its mean, the paper's
-    constant gains limit-cycle; neither slips more than 1 mm from the lift start."""
+    (3.5-5 s) the default controller's command varies by < 10 % of its mean, and so does the
+    paper's law now that C_d's dead band is part of the law for both (measured 2 %; without the
+    band the paper's C_d turned the observer's noise into a limit cycle of > 50 %); neither
+    slips more than 1 mm from the lift start."""
     pytest.importorskip("mujoco")
     from lugrip.sim import scenarios as sc
     from lugrip.sim.mujoco.loop import run_mujoco_loop
@@ -441,7 +399,7 @@ def test_light_cup_on_mujoco_holds_without_a_limit_cycle():
         assert float(np.max(slip[lift])) < 1e-3, label
         out[label] = _steady_ptp(run, 3.5, 5.0)
     assert out["lugrip"] < 0.10
-    assert out["paper"] > 0.5
+    assert out["paper"] < 0.10
 
 
 def test_the_seeded_fuzz_campaign_draws_every_controller_field():

@@ -1,6 +1,6 @@
 """Lift-offs of the paper's objects on an independent plant (MuJoCo's contact solver, compliant
 pads, the gripper's 30 ms lag and 200 N/s rate limit in the loop, parameters identified on MuJoCo
-rubbing data): a chattering lift-off caught by the reflex and the grip probe, and a rocking can
+rubbing data): a rocking can
 whose load trend is checked by the next period. Not consistency tests: neither the plant nor the
 gripper is lugrip's model."""
 
@@ -24,27 +24,11 @@ def _lift(name, over, seed=None, duration=4.0):
     return run, on, float(np.max(slip[on])), float(np.degrees(np.max(rot[on])))
 
 
-def test_big_block_stick_slip_at_lift_off_is_caught_by_the_reflex_and_the_probe():
-    """Seed 401 of experiment 1: the block's pads slide in stick-slip at lift-off, S alternates
-    around the reflex threshold from sample to sample. The reflex (its samples counted anywhere
-    in the period) and the grip probe (mu_probe 0.08; off by default) catch it within 0.3 mm
-    (measured 0.17 mm); with neither,
-    the block slides 2.1 mm before the PI catches the load."""
-    run, on, slip, _ = _lift("exp1_big_resin_block", {"mu_probe": 0.08}, seed=401, duration=3.0)
-    _, _, slip_old, _ = _lift("exp1_big_resin_block", {"slip_reflex": False, "mu_probe": 0.0},
-                              seed=401, duration=3.0)
-    assert run.scene["status"] == "ok"
-    assert slip < 0.3e-3
-    assert slip_old > 1.0e-3
-
-
 def test_full_can_rocking_after_lift_off_is_met_by_the_trend():
     """Experiment 4, full can: after the lift-off the can rocks on its pads (torque swinging
     around its mean at ~12 Hz). The trend meets each rising half-cycle (and the next period
     takes back what its load did not confirm): the can is held (measured 0.004 mm, 0.10 deg, mean
-    grip 5.0 N over 1-4 s); without the trend the ceiling lets it slide 3.0 mm and turn 1.4 deg
-    (mean grip 4.5 N)."""
+    grip 5.0 N over 1-4 s; without the trend, before it became part of the law, it slid 3.0 mm
+    and turned 1.4 deg)."""
     run, on, slip, rot = _lift("exp4_aluminium_can_full", {})
-    run0, on0, slip0, rot0 = _lift("exp4_aluminium_can_full", {"feedforward_horizon": 0.0})
     assert slip < 0.1e-3 and rot < 1.0
-    assert slip0 > 1.0e-3

@@ -11,10 +11,6 @@ import pytest
 
 import lugrip
 
-#: the settings that turn the fast reaction off (the controller before it)
-NO_FAST_REACTION = {"feedforward_horizon": 0.0, "reaction_lag": 0.0}
-
-
 def _cup_down_pulse(over):
     pytest.importorskip("mujoco")
     from lugrip.sim import scenarios as sc
@@ -36,11 +32,10 @@ def _cup_down_pulse(over):
 
 
 def test_cup_holds_a_pulse_twice_its_weight():
-    """Defaults: the command rises at the command after the edge (trend feed-forward, overshoot
-    for the gripper's lag, the reflex even on samples where a pad briefly loses contact); the cup
-    stays in the grasp (it slides ~1 mm on the standing reserve of S_ref = 0.8 before the force
-    arrives); 0.3 s after the pulse the PI (loop_gain_i = 2/s) has drained the command below 60 %
-    of its peak."""
+    """Defaults: the command rises at the command after the edge (the trend feed-forward); the
+    cup stays in the grasp (it slides ~1 mm on the standing reserve of S_ref = 0.8 before the
+    force arrives); 0.3 s after the pulse the PI (k_i s_ref / gain_force = 2/s) has drained the
+    command below 60 % of its peak."""
     run, slip = _cup_down_pulse({})
     assert run.scene["status"] == "ok"
     assert slip < 1.5e-3
@@ -49,11 +44,3 @@ def test_cup_holds_a_pulse_twice_its_weight():
     peak = float(np.max(cmd[(t > 3.5) & (t < 3.56)]))
     assert peak > 1.5 * before  # within the edge + 2 commands
     assert float(np.mean(cmd[(t > 4.0 - 0.1)])) < 0.6 * peak
-
-
-def test_cup_falls_out_without_the_fast_reaction():
-    """Without the trend, the overshoot and the reactions on invalid samples, the same pulse
-    takes the cup out of the grasp (a pad loses contact; the command is held)."""
-    run, slip = _cup_down_pulse(NO_FAST_REACTION)
-    assert run.scene["status"] == "lost_contact" or slip > 1e-3
-    assert np.all(np.isfinite(run["command"]))

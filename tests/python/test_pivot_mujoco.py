@@ -17,7 +17,6 @@ import pytest
 
 mujoco = pytest.importorskip("mujoco")
 
-from lugrip import PAPER_SETTINGS
 from lugrip.sim import scenarios as sc
 
 SCENARIOS = Path(__file__).resolve().parents[2] / "scenarios"
@@ -47,14 +46,3 @@ def test_default_pivot_hangs_the_bottle_within_5_deg_of_vertical():
     assert m["returned_to_avoidance"]
     assert abs(m["pivot_rotation_deg"]) > 70.0  # it did turn (from lying to hanging)
     assert m["final_hang_deg"] < 5.0, m["final_hang_deg"]
-
-
-def test_paper_pivot_end_stops_at_the_turning_point():
-    # mu as told (no grip probe): the grip probe lowers this bottle's belief before the pivot
-    # (0.84 -> 0.42), and the higher pivoting floor then stops the swing short whatever the end
-    # rule (4.1 deg); with the told mu the two end rules differ by the swing (3.6 against 14.6)
-    paper = {k: PAPER_SETTINGS[k] for k in ("pivot_end_filter", "pivot_end_at_floor")}
-    m = _bottle({**paper, "mu_probe": 0.0})
-    assert not m["dropped"]
-    assert m["returned_to_avoidance"]
-    assert m["final_hang_deg"] > 8.0, m["final_hang_deg"]

@@ -81,7 +81,7 @@ def test_hand_wiring_without_statuses_drops_the_command():
     command to f_min within 0.2 s of contact loss."""
     obs = [lugrip.Observer(CAN), lugrip.Observer(CAN)]
     # the paper's constant gains drain the unloaded command within 0.2 s (the slope gain more slowly)
-    ctrl = lugrip.GraspController(CAN, slope_gain=False)
+    ctrl = lugrip.GraspController(CAN, gain_force=0.0)
     grip = QuasiStaticGrip()
 
     def cycle(w):
