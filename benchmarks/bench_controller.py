@@ -35,13 +35,9 @@ from sections import markers, write_section  # noqa: E402
 
 #: the additions to the paper's law, each switched off alone
 SINGLE_OFF = {
-    "no_slope_gain": {"slope_gain": False},
+    "no_slope_gain": {"gain_force": 0.0},
     "no_feedforward": {"feedforward": False},
-    "no_slip_reflex": {"slip_reflex": False},
-    "no_average_S": {"average_slippage": False},
-    # the reaction to loads faster than one command (trend feed-forward, lag overshoot, reactions
-    # on samples with an invalid finger) off together: the controller before it
-    "no_fast_reaction": {"feedforward_horizon": 0.0, "reaction_lag": 0.0},
+    "no_ceiling": {"ceiling_factor": 0.0},
     # the standing reserve the unseen scenes derive from their pulses (the paper's scenes have none)
     "no_reserve": {"reserve_force": 0.0, "reserve_torque": 0.0},
 }
