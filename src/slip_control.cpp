@@ -70,7 +70,7 @@ Status SlipControl::observe(const SlipControlInput& in, SlipControlOutput& out) 
       const bool same = w.f_n == p.f_n && w.f_x == p.f_x && w.f_y == p.f_y && w.tau == p.tau;
       repeats_[i] = same ? (repeats_[i] < s_.stuck_samples ? repeats_[i] + 1 : repeats_[i]) : 0;
       prev_[i] = w;
-      if (repeats_[i] >= s_.stuck_samples) o.status = Status::SensorFault;
+      if (repeats_[i] >= s_.stuck_samples && is_valid(o.status)) o.status = Status::SensorFault;
     }
     FingerInput& f = cin_.fingers[i];
     f.omega_hat = o.omega_hat;

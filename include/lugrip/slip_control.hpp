@@ -20,9 +20,11 @@ struct SlipControlSettings {
   ObserverSettings observer;            //!< settings of each finger's Observer
   GraspControllerSettings controller;   //!< settings of the GraspController
   int fingers = 2;                      //!< fingertips measured: 1 or 2
-  //! A finger whose four channels repeat bit for bit for this many consecutive samples is
-  //! reported SensorFault (a frozen sensor; a noisy sensor never repeats exactly). 0: off.
-  int stuck_samples = 0;                //!< [samples], >= 0
+  //! A finger with a valid estimate whose four channels repeat bit for bit for this many
+  //! consecutive samples is reported SensorFault (a frozen sensor, or a link that repeats its
+  //! last sample; a noisy sensor never repeats exactly). 0: off (for a noise-free simulated or
+  //! coarsely quantised sensor, which repeats legitimately). Default 25: 50 ms at 500 Hz.
+  int stuck_samples = 25;               //!< [samples], >= 0
   //! Two fingers, one without a valid estimate (dead, frozen, no contact, invalid samples):
   //! the other finger alone drives the controller instead of holding the command. The cycle
   //! status still reports the faulty finger. false: hold (the default).
@@ -69,9 +71,11 @@ struct SlipControlOutput {
 //! speed resolution and the observer status to the GraspController and returns its command.
 //! The statuses travel inside: when a finger's observer reports anything but a valid estimate
 //! (NoContact on contact loss, InvalidSample, SensorFault, an unknown code) the command due in
-//! that cycle is held at the last command (plus invalid_raise_step), never lowered. With
-//! stuck_samples > 0 a finger whose wrench repeats exactly that many times in a row is reported
-//! SensorFault (its observer keeps running) until the wrench changes.
+//! that cycle is held at the last command, never lowered. With
+//! stuck_samples > 0 (the default) a finger whose wrench repeats exactly that many times in a row
+//! while its observer has a valid estimate is reported SensorFault (its observer keeps running)
+//! until the wrench changes; a repeated reading that is already invalid (no contact, NaN) keeps
+//! its own status.
 //!
 //! Lifecycle: construct (validates, allocates the contact tables) -> step() / the run-time
 //! calls (noexcept, no allocation; set_mu() included) -> reset().

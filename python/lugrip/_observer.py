@@ -317,7 +317,8 @@ class Observer(NoCopy):
         """As :meth:`step` with the in-plane force vector (f_t = hypot(f_x, f_y))."""
         return self.step(f_n, float(np.hypot(f_x, f_y)), tau, dt)
 
-    def run(self, log, *, reset: bool = True, reset_on_maneuver: bool = True) -> ObserverRun:
+    def run(self, log, *, reset: bool = True, reset_on_maneuver: bool = True,
+            t_before: float | None = None) -> ObserverRun:
         """Replay a log in C++ and return the per-sample outputs.
 
         Args:
@@ -327,6 +328,10 @@ class Observer(NoCopy):
                 sample periods, otherwise the nominal dt is used. An optional ``maneuver``
                 column restarts the observer where it changes (``reset_on_maneuver``).
             reset: start from a fresh state (default) instead of continuing.
+            t_before: with ``reset=False`` and ``t``, the time of the sample the observer
+                stepped last [s]: the first sample's period is ``t[0] - t_before`` (a log
+                replayed in pieces gives the outputs of one run over the whole log), instead
+                of the nominal dt.
 
         Raises:
             ValueError: missing columns, different lengths, non-increasing or non-finite t.
@@ -363,6 +368,11 @@ class Observer(NoCopy):
                     f" <= t[{bad[0]}] = {t[bad[0]]!r}"
                 )
             dt[1:] = d
+            if t_before is not None and not reset and n:
+                d0 = t[0] - float(t_before)
+                if not d0 > 0.0:
+                    raise ValueError(f"t[0] = {t[0]!r} must be after t_before = {t_before!r}")
+                dt[0] = d0
         if reset:
             self._obs.reset()
         man = _column(log, "maneuver") if reset_on_maneuver else None
@@ -375,10 +385,10 @@ class Observer(NoCopy):
         else:
             parts = []
             for a, b in zip(np.r_[0, cuts], np.r_[cuts, n]):
+                seg_dt = dt[a:b].copy()
                 if a > 0:
                     self._obs.reset()
-                seg_dt = dt[a:b].copy()
-                seg_dt[0] = 0.0
+                    seg_dt[0] = 0.0
                 parts.append(self._obs.run(f_n[a:b], f_t[a:b], tau[a:b], seg_dt))
             raw = {k: np.concatenate([p[k] for p in parts]) for k in parts[0]}
         return ObserverRun(t=t, **raw)

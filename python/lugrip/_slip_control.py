@@ -74,8 +74,10 @@ class SlipControl(NoCopy):
             parameters were identified with (its ``observer:`` block): that is the observer used,
             with ``observer`` overriding it key by key.
         fingers: 1 or 2 fingertips measured.
-        stuck_samples: a finger whose four channels repeat bit for bit this many samples in a
-            row is reported SensorFault (a frozen sensor) and the command is held; 0: off.
+        stuck_samples: a finger with a valid estimate whose four channels repeat bit for bit
+            this many samples in a row is reported SensorFault (a frozen sensor, or a link
+            repeating its last sample) and the command is held; 0: off (a noise-free simulated
+            sensor repeats legitimately). None: the C++ default, 25 (50 ms at 500 Hz).
         healthy_finger_fallback: two fingers, one without a valid estimate: the other finger
             alone computes the command (the status still reports the faulty finger) instead of
             the command being held.
@@ -108,7 +110,7 @@ class SlipControl(NoCopy):
         *,
         fingers: int = 2,
         observer: Mapping[str, Any] | None = None,
-        stuck_samples: int = 0,
+        stuck_samples: int | None = None,
         healthy_finger_fallback: bool = False,
         **controller: Any,
     ):
@@ -125,9 +127,12 @@ class SlipControl(NoCopy):
         if isinstance(fingers, bool) or fingers not in (1, 2):
             raise ValueError(f"fingers = {fingers!r}: must be 1 or 2")
         s.fingers = int(fingers)
-        if isinstance(stuck_samples, bool) or not isinstance(stuck_samples, int) or stuck_samples < 0:
-            raise ValueError(f"stuck_samples = {stuck_samples!r}: must be an integer >= 0 (0: off)")
-        s.stuck_samples = int(stuck_samples)
+        if stuck_samples is not None:
+            if (isinstance(stuck_samples, bool) or not isinstance(stuck_samples, int)
+                    or stuck_samples < 0):
+                raise ValueError(
+                    f"stuck_samples = {stuck_samples!r}: must be an integer >= 0 (0: off)")
+            s.stuck_samples = int(stuck_samples)
         s.healthy_finger_fallback = bool(healthy_finger_fallback)
         try:
             self._sc = _core.SlipControl(_model(self._params), s)

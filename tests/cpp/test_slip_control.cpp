@@ -81,6 +81,46 @@ TEST(SlipControl, HoldsTheCommandOnContactLoss) {
   EXPECT_EQ(out.fingers[0].status, Status::NoContact);
 }
 
+TEST(SlipControl, FrozenSensorReportedByDefault) {
+  // Default settings: the frozen-sensor check is on (25 samples). A reading with noise in its
+  // last bits never repeats and stays valid; the same wrench repeated (a link that repeats its
+  // last sample) is SensorFault from its 25th repeat on, with the command held; a repeated
+  // no-contact reading keeps its own status (NoContact), and the check resets when the
+  // readings move again.
+  ASSERT_EQ(SlipControlSettings{}.stuck_samples, 25);
+  SlipControl sc(can());
+  QuasiStaticGrip grip;
+  SlipControlOutput out;
+  for (int i = 0; i < 1000; ++i) {
+    SlipControlInput in = grip.input();
+    for (auto& f : in.fingers) f.f_x += 1e-6 * ((i * 7919) % 13 - 6);  // sensor noise
+    sc.step(in, out);
+    grip.follow(out.force);
+    ASSERT_TRUE(is_valid(out.fingers[0].status)) << "sample " << i;
+  }
+  const SlipControlInput frozen = grip.input();
+  const double held = out.force;
+  int first = -1;
+  for (int i = 0; i < 100; ++i) {
+    sc.step(frozen, out);
+    if (first < 0 && out.fingers[0].status == Status::SensorFault) first = i;
+    EXPECT_GE(out.force, held) << "sample " << i;
+  }
+  EXPECT_EQ(first, 25);  // the first frozen sample differs from the noisy one before it
+  EXPECT_EQ(out.status, Status::SensorFault);
+  SlipControlInput lost;  // f_n = 0: a repeated no-contact reading stays NoContact
+  for (int i = 0; i < 100; ++i) sc.step(lost, out);
+  EXPECT_EQ(out.fingers[0].status, Status::NoContact);
+  EXPECT_EQ(out.fingers[1].status, Status::NoContact);
+  for (int i = 0; i < 500; ++i) {  // the readings move again
+    SlipControlInput in = grip.input();
+    for (auto& f : in.fingers) f.f_x += 1e-6 * ((i * 7919) % 13 - 6);
+    sc.step(in, out);
+    grip.follow(out.force);
+  }
+  EXPECT_TRUE(is_valid(out.fingers[0].status));
+}
+
 TEST(SlipControl, HandWiringWithoutStatusesDropsTheObjectOnContactLoss) {
   // Negative control for the test above: the same loop wired by hand with the status left at
   // its default (Ok) lowers the command to f_min within 0.2 s of contact loss.
@@ -115,7 +155,12 @@ TEST(SlipControl, HandWiringWithoutStatusesDropsTheObjectOnContactLoss) {
 }
 
 TEST(SlipControl, HoldsTheCommandOnInvalidSamplesAndSensorFault) {
-  SlipControl sc(can());
+  // the quasi-static grip is noise-free: with the command held, finger 0's wrench repeats
+  // exactly, which the frozen-sensor check (on by default) would report; this test is about
+  // the invalid finger 1, so the check is off here
+  SlipControlSettings s;
+  s.stuck_samples = 0;
+  SlipControl sc(can(), s);
   QuasiStaticGrip grip;
   const double held = settle(sc, grip, 3000).force;
   SlipControlOutput out;

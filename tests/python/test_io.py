@@ -145,15 +145,20 @@ def test_csv_head_and_header_units(tmp_path):
 
 
 def test_csv_fast_and_line_by_line_readers_agree(tmp_path, monkeypatch):
-    """The pyarrow CSV path and the line-by-line path read identical arrays."""
+    """The streaming pyarrow CSV path (in blocks of 16 MiB, and of 512 bytes: many blocks of
+    a few rows each) and the line-by-line path read identical arrays."""
     import lugrip.io._csv as lio
 
     log = make_log(n=200, seed=9)
     path = write_log(log, tmp_path / "both.csv")
     fast = read_log(path)
-    monkeypatch.setattr(lio, "_read_csv_fast", lambda *a: None)
+    monkeypatch.setattr(lio, "STREAM_BLOCK_BYTES", 512)
+    blocks = read_log(path)
+    assert path.stat().st_size > 20 * 512
+    monkeypatch.setattr(lio, "_read_csv_stream", lambda *a: (None, "test"))
     slow = read_log(path)
     assert_same(fast, slow)
+    assert_same(blocks, slow)
     assert_same(log, slow)
 
 

@@ -95,3 +95,23 @@ def test_simulate_sliding_refuses_an_unbounded_request(tmp_path, capsys):
     err = capsys.readouterr().err
     assert rc == 2 and "may need up to" in err and len(err.strip().splitlines()) == 1
     assert not (tmp_path / "s.csv").exists()
+
+
+def test_damaged_csv_over_the_line_reader_limit_names_the_file(tmp_path, monkeypatch):
+    """A CSV the streaming reader cannot parse (a text cell) and too large for the line-by-line
+    reader (limit lowered for the test) is refused with the streaming reader's words and the
+    limit; under the limit the line reader names the row and column."""
+    import lugrip.io._csv as csv_mod
+
+    path = write_log(_small_log(200), tmp_path / "bad.csv")
+    lines = path.read_text().splitlines()
+    cells = lines[50].split(",")
+    cells[1] = "abc"
+    lines[50] = ",".join(cells)
+    path.write_text("\n".join(lines) + "\n")
+    with pytest.raises(LogError, match=r"bad\.csv: row 51, column 'f_n': 'abc' is not a number"):
+        read_log(path)
+    monkeypatch.setattr(csv_mod, "MAX_LINE_READER_BYTES", 1000)
+    with pytest.raises(LogError, match=r"bad\.csv: the streaming CSV reader cannot read this file "
+                                       r"\(.*abc.*\).*up to 0 MiB"):
+        read_log(path)

@@ -208,17 +208,37 @@ def test_writability_is_checked_before_the_work(exit_2, tmp_path):
     assert "--out" in err and time.perf_counter() - t0 < 5.0
 
 
-@pytest.mark.skipif(os.geteuid() == 0, reason="root writes in read-only folders")
+def _make_unwritable(folder: Path):
+    """Make ``folder`` unwritable for this process; returns the undo. Root writes in a folder
+    of mode 0555, so as root the folder is made immutable (chattr +i, which binds root too);
+    skips when the file system or the container does not allow that."""
+    if os.geteuid() != 0:
+        folder.chmod(0o555)
+        return lambda: folder.chmod(0o755)
+    try:
+        subprocess.run(["chattr", "+i", str(folder)], check=True, capture_output=True)
+    except (OSError, subprocess.CalledProcessError):
+        pytest.skip("root, and chattr +i is not available here")
+    return lambda: subprocess.run(["chattr", "-i", str(folder)], check=True)
+
+
 def test_an_unwritable_folder_is_refused_before_the_work(exit_2, tmp_path):
+    """A folder the process cannot create files in (mode 0555; as root an immutable folder):
+    exit 2 naming the option and the folder, before the fit; nothing is left in the folder."""
     log = _log(tmp_path / "x.csv")
     ro = tmp_path / "ro"
     ro.mkdir()
-    ro.chmod(0o555)
+    undo = _make_unwritable(ro)
     try:
+        with pytest.raises(OSError):  # the folder really is unwritable for this process
+            (ro / "probe").write_text("x")
+        t0 = time.perf_counter()
         err = exit_2(["identify", log, "--out", ro / "p.yaml", "--quiet"])
-        assert "cannot write" in err
+        assert "--out: cannot write in" in err and str(ro) in err
+        assert time.perf_counter() - t0 < 5.0
     finally:
-        ro.chmod(0o755)
+        undo()
+    assert list(ro.iterdir()) == []
 
 
 # --- folder outputs ---------------------------------------------------------------------------

@@ -5,10 +5,12 @@ the slip-detection figures; optionally draw the paper's Figure 5 for the replay.
 from __future__ import annotations
 
 import argparse
+import io
 import math
 import sys
 import textwrap
 import time
+import types
 from pathlib import Path
 
 from . import CliError, observer_options, positive_float
@@ -16,7 +18,7 @@ from ._log_options import add_log_options, read_log_from_args
 from ._output import atomic_write, check_file, is_same_file
 from .simulate_sliding import add_params_arguments, load_params
 
-__all__ = ["OUTPUT_COLUMNS", "demo_section", "register", "run", "write_estimates"]
+__all__ = ["OUTPUT_COLUMNS", "demo_section", "register", "replay", "run", "write_estimates"]
 
 OUTPUT_COLUMNS = (
     "t",
@@ -154,13 +156,18 @@ def _atomic_write(path: Path, force: bool, body, what: str = "--out") -> None:
     atomic_write(path, body, what, force=force)
 
 
-def _columns(log, run) -> dict:
+#: Samples per piece of a replay: the observer runs and the estimates are written piece by
+#: piece, so that only the outputs the scores read are held over the whole log.
+CHUNK_ROWS = 1 << 17
+
+
+def _columns(t, maneuver, run) -> dict:
+    """The :data:`OUTPUT_COLUMNS` of one piece of a run."""
     import numpy as np
 
     from .. import Status
 
     names = {int(s): s.name.lower() for s in Status}
-    t = run.t if run.t is not None else np.asarray(log.t)
     return {
         "t": np.asarray(t, dtype=float),
         "omega_hat": run.omega_hat,
@@ -169,58 +176,163 @@ def _columns(log, run) -> dict:
         "S": run.S,
         "status": [names.get(int(v), str(int(v))) for v in run.status],
         "speed_observable": np.asarray(run.speed_observable, dtype=np.int64),
-        "maneuver": np.asarray(log.maneuver, dtype=np.int64),
+        "maneuver": np.asarray(maneuver, dtype=np.int64),
         "c_tilde_unclipped": run.c_tilde_unclipped,
         "omega_object": run.omega_object,
         "v_slip": run.v_slip,
     }
 
 
-def _beyond_clip_line(log, run) -> str | None:
-    """One line comparing omega_hat and omega_object with the ground truth where the CoR was
-    clipped (None when no valid sample was)."""
+def _csv_text(cols: dict) -> bytes:
+    """CSV lines of one piece; every float reads back exactly (pyarrow's writer, the shortest
+    text that round-trips; without pyarrow Python's repr)."""
+    try:
+        import pyarrow as pa
+        import pyarrow.csv as pacsv
+    except ImportError:
+        pa = None
+    if pa is not None:
+        sink = io.BytesIO()
+        pacsv.write_csv(pa.table({k: cols[k] for k in OUTPUT_COLUMNS}), sink,
+                        write_options=pacsv.WriteOptions(include_header=False,
+                                                         quoting_style="none"))
+        pa.default_memory_pool().release_unused()
+        return sink.getvalue()
+    lists = {k: (cols[k].tolist() if k != "status" else cols[k]) for k in OUTPUT_COLUMNS}
+    lines = [
+        ",".join(repr(v) if isinstance(v, float) else str(v) for v in row)
+        for row in zip(*(lists[k] for k in OUTPUT_COLUMNS))
+    ]
+    return ("\n".join(lines) + "\n").encode() if lines else b""
+
+
+class _ScoredRun:
+    """The observer outputs :func:`lugrip.sliding.score` reads, over the whole log (the other
+    outputs are written piece by piece and not kept)."""
+
+    def __init__(self, omega_hat, S, c_tilde, valid, diverged):
+        self.omega_hat, self.S, self.c_tilde = omega_hat, S, c_tilde
+        self.valid, self.diverged = valid, diverged
+
+    def __len__(self) -> int:
+        return len(self.omega_hat)
+
+
+class Replay:
+    """What a replay keeps: counts over the whole log, the clipped-CoR comparison with the
+    ground truth, and the run (``keep='all'``), the scored outputs (``'score'``, filled piece
+    by piece into arrays over the whole log) or nothing."""
+
+    _SCORED = ("omega_hat", "S", "c_tilde", "valid", "diverged")
+
+    def __init__(self, keep: str, n: int):
+        import numpy as np
+
+        self.keep = keep
+        self.n = self.valid = self.diverged = 0
+        self.seconds = 0.0  # in the observer
+        self.clip = [0, 0.0, 0.0, 0.0]  # samples; squared errors of omega_hat, omega_object, 0
+        self.parts: list = []
+        self.run = None
+        self._scored = None
+        if keep == "score":
+            self._scored = {k: np.empty(n, dtype=bool if k in ("valid", "diverged") else float)
+                            for k in self._SCORED}
+
+    def add(self, run, omega) -> None:
+        import numpy as np
+
+        valid = run.valid
+        a, b = self.n, self.n + len(run)
+        self.n = b
+        self.valid += int(valid.sum())
+        self.diverged += int(np.sum(run.diverged))
+        if omega is not None:
+            m = valid & run.saturated & np.isfinite(omega)
+            if m.any():
+                w = omega[m]
+                self.clip[0] += int(m.sum())
+                self.clip[1] += float(np.sum((run.omega_hat[m] - w) ** 2))
+                self.clip[2] += float(np.sum((run.omega_object[m] - w) ** 2))
+                self.clip[3] += float(np.sum(w**2))
+        if self.keep == "all":
+            self.parts.append(run)
+        elif self._scored is not None:
+            for k in self._SCORED:
+                self._scored[k][a:b] = valid if k == "valid" else getattr(run, k)
+
+    def finish(self, t) -> None:
+        import numpy as np
+
+        from .._observer import ObserverRun
+
+        if self.keep == "all" and self.parts:
+            fields = {k: np.concatenate([getattr(p, k) for p in self.parts])
+                      for k in self.parts[0].to_dict() if k != "t"}
+            self.run = ObserverRun(t=np.asarray(t, dtype=float), **fields)
+        elif self._scored is not None:
+            self.run = _ScoredRun(*(self._scored[k] for k in self._SCORED))
+        self.parts, self._scored = [], None
+
+    def beyond_clip_line(self) -> str | None:
+        """One line comparing omega_hat and omega_object with the ground truth where the CoR
+        was clipped (None when no valid sample was)."""
+        k, e_hat, e_obj, e_zero = self.clip
+        if not k:
+            return None
+        return (
+            f"CoR clipped at c_max on {k} samples: RMSE omega_hat {math.sqrt(e_hat / k):.4g}, "
+            f"omega_object {math.sqrt(e_obj / k):.4g}, predicting zero "
+            f"{math.sqrt(e_zero / k):.4g} rad/s"
+        )
+
+
+def replay(observer, log, path: Path | None, *, force: bool = False, keep: str = "all",
+           chunk: int | None = None) -> Replay:
+    """Run ``observer`` over ``log`` piece by piece (``chunk`` samples; the outputs equal one
+    run over the whole log: the state carries over, the observer restarts where the maneuver
+    changes) and write the :data:`OUTPUT_COLUMNS` of each piece to ``path`` (CSV or Parquet by
+    suffix, atomically, an existing file replaced only with ``force``; None: not written).
+    ``chunk``: default :data:`CHUNK_ROWS`."""
     import numpy as np
 
-    omega = np.asarray(log.omega, dtype=float)
-    m = run.valid & run.saturated & np.isfinite(omega)
-    if not m.any():
-        return None
+    chunk = CHUNK_ROWS if chunk is None else int(chunk)
+    if chunk < 1:
+        raise ValueError(f"chunk = {chunk!r}: must be >= 1")
+    t = np.asarray(log.t, dtype=float)
+    man = np.asarray(log.maneuver)
+    omega = None if log.omega is None else np.asarray(log.omega, dtype=float)
+    result = Replay(keep, len(t))
 
-    def rmse(x):
-        return float(np.sqrt(np.mean((x[m] - omega[m]) ** 2)))
+    def pieces():
+        for a in range(0, len(t), chunk):
+            b = min(a + chunk, len(t))
+            fresh = a == 0 or man[a] != man[a - 1]
+            piece = {"t": t[a:b], "f_n": log.f_n[a:b], "f_t": log.f_t[a:b],
+                     "tau": log.tau[a:b], "maneuver": man[a:b]}
+            t0 = time.perf_counter()
+            run = observer.run(piece, reset=fresh, t_before=None if fresh else t[a - 1])
+            result.seconds += time.perf_counter() - t0
+            result.add(run, None if omega is None else omega[a:b])
+            yield _columns(t[a:b], man[a:b], run)
 
-    return (
-        f"CoR clipped at c_max on {int(m.sum())} samples: RMSE omega_hat {rmse(run.omega_hat):.4g}, "
-        f"omega_object {rmse(run.omega_object):.4g}, predicting zero {rmse(np.zeros_like(omega)):.4g} rad/s"
-    )
+    if path is None:
+        for _ in pieces():
+            pass
+    else:
+        _write_pieces(Path(path), pieces(), force)
+    result.finish(t)
+    return result
 
 
-def write_estimates(path: Path, log, run, *, force: bool = False) -> Path:
-    """Write the :data:`OUTPUT_COLUMNS` of an observer run as CSV or Parquet (by suffix),
-    atomically, refusing to replace an existing file unless ``force``."""
-    path = Path(path)
+def _write_pieces(path: Path, pieces, force: bool) -> None:
     suffix = path.suffix.lower()
-    cols = _columns(log, run)
     if suffix == ".csv":
 
         def body(fh):
-            n = len(cols["t"])
             fh.write((",".join(OUTPUT_COLUMNS) + "\n").encode())
-            chunk = 50_000  # rows per write: the text of the whole file is never in memory
-            for a in range(0, n, chunk):
-                b = min(a + chunk, n)
-                reprs = {k: (cols[k][a:b].tolist() if k != "status" else cols[k][a:b])
-                         for k in OUTPUT_COLUMNS}
-                out = []
-                for i in range(b - a):
-                    out.append(
-                        ",".join(
-                            repr(reprs[k][i]) if isinstance(reprs[k][i], float)
-                            else str(reprs[k][i])
-                            for k in OUTPUT_COLUMNS
-                        )
-                    )
-                fh.write(("\n".join(out) + "\n").encode())
+            for cols in pieces:
+                fh.write(_csv_text(cols))
     elif suffix in (".parquet", ".pq"):
         try:
             import pyarrow as pa
@@ -229,13 +341,29 @@ def write_estimates(path: Path, log, run, *, force: bool = False) -> Path:
             raise CliError("writing Parquet needs pyarrow (pip install pyarrow)") from None
 
         def body(fh):
-            table = pa.table({k: cols[k] for k in OUTPUT_COLUMNS})
-            pq.write_table(table, fh)
+            writer = None
+            for cols in pieces:
+                table = pa.table({k: cols[k] for k in OUTPUT_COLUMNS})
+                if writer is None:
+                    writer = pq.ParquetWriter(fh, table.schema)
+                writer.write_table(table)
+            if writer is not None:
+                writer.close()
     else:
         raise CliError(
             f"argument --out: {path}: unknown suffix {path.suffix!r}; use .csv or .parquet"
         )
     _atomic_write(path, force, body)
+
+
+def write_estimates(path: Path, log, run, *, force: bool = False) -> Path:
+    """Write the :data:`OUTPUT_COLUMNS` of an observer run as CSV or Parquet (by suffix),
+    atomically, refusing to replace an existing file unless ``force``."""
+    import numpy as np
+
+    path = Path(path)
+    t = run.t if run.t is not None else np.asarray(log.t)
+    _write_pieces(path, iter([_columns(t, log.maneuver, run)]), force)
     return path
 
 
@@ -269,6 +397,8 @@ def _observer(params, args, dt: float, block: dict | None = None):
 
 
 def run(args) -> int:
+    import numpy as np
+
     from ..sliding import score
 
     out = Path(args.out)
@@ -293,13 +423,14 @@ def run(args) -> int:
     log = read_log_from_args(args.log, args)
     if len(log) == 0:
         raise CliError(f"{args.log}: the log holds no samples")
+    log = log._without_force_vector()  # the replay reads f_t: two columns fewer in memory
     dt = log.sample_period if len(log) > 1 else 0.002
     observer = _observer(params, args, dt, block)
-    t0 = time.perf_counter()
-    est = observer.run(log)
-    elapsed = time.perf_counter() - t0
-    write_estimates(out, log, est, force=args.force)
-    n_man = len(set(log.maneuver.tolist()))
+    n_man = len(np.unique(log.maneuver))  # before the replay keeps its outputs (memory)
+    keep = "all" if fig_path is not None else ("score" if log.omega is not None else "none")
+    rep = replay(observer, log, out, force=args.force, keep=keep)
+    elapsed = rep.seconds
+    est = rep.run
     st = observer.settings
     gain = (
         f"l = {st['bandwidth']:g}/sigma_1"
@@ -312,20 +443,22 @@ def run(args) -> int:
         f"({st['integrator']}, {gain}{origin}) "
         f"{1e9 * elapsed / max(len(log), 1):.0f} ns/sample; wrote {out}"
     )
-    n_valid = int(est.valid.sum())
-    if n_valid < len(log):
-        print(f"  {len(log) - n_valid} samples without an estimate (no contact, invalid)")
-    if int(est.diverged.sum()):
+    if rep.valid < len(log):
+        print(f"  {len(log) - rep.valid} samples without an estimate (no contact, invalid)")
+    if rep.diverged:
         print(
-            f"  the divergence guard re-initialised the observer on {int(est.diverged.sum())} "
+            f"  the divergence guard re-initialised the observer on {rep.diverged} "
             "samples (try the default --integrator rosenbrock)"
         )
     sc = None
     if log.omega is not None:
+        if fig_path is None:  # the scores read t, omega and the maneuvers: the forces can go
+            log = types.SimpleNamespace(t=log.t, omega=log.omega, maneuver=log.maneuver,
+                                        meta=log.meta)
         sc = score(log, est, omega_threshold=args.omega_threshold, s_threshold=args.s_threshold)
         for line in sc.lines():
             print("  " + line)
-        line = _beyond_clip_line(log, est)
+        line = rep.beyond_clip_line()
         if line:
             print("  " + line)
     else:

@@ -327,7 +327,7 @@ def _read(path, *, format, wrench_topic, omega_topic, maneuver_topic, maneuvers,
     meta["units"] = {c: UNITS[c] for c in COLUMNS if c in cols or c in ("f_t", "maneuver")}
     if converted:
         meta["converted_from"] = converted
-    log = SlidingLog._from_columns(cols, source=file, meta=meta)
+    log = SlidingLog._from_columns(cols, source=file, meta=meta, owned=True)
     if isinstance(maneuvers, str):
         log = SlidingLog(t=log.t, f_n=log.f_n, f_t=log.f_t, tau=log.tau, f_x=log.f_x,
                          f_y=log.f_y, omega=log.omega, maneuver=find_maneuvers(log),

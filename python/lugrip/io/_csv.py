@@ -16,9 +16,17 @@ import numpy as np
 
 from ._log import UNITS, LogError, SlidingLog, _Locator
 
-#: Largest CSV file read [bytes]: the reader holds the file and its columns in memory, about
-#: 4 times the file's size at the peak (measured: 53 MB file, 208 MB), so under 1 GB.
-MAX_CSV_BYTES = 192 * 1024 * 1024
+#: Largest CSV file read [bytes]. Clean files are streamed (pyarrow's CSV reader, block by
+#: block): the reader then holds only the columns of the format, 8 bytes per cell (a 1.1 GB file
+#: of 10**7 rows and seven columns: 0.56 GB).
+MAX_CSV_BYTES = 2 * 1024**3
+#: Largest CSV file the line-by-line reader takes [bytes]: it finds and names any problem (the
+#: row and the column of a text cell, a ragged row, a blank line) but holds the file's text and
+#: its cells in memory, about 4 times the file's size at the peak (53 MB file: 208 MB). A larger
+#: file that the streaming reader cannot parse is refused with the streaming reader's message.
+MAX_LINE_READER_BYTES = 192 * 1024 * 1024
+#: Bytes per block of the streaming reader.
+STREAM_BLOCK_BYTES = 1024 * 1024
 
 _HEADER_RE = re.compile(r"^\s*([A-Za-z_][A-Za-z0-9_]*)\s*(?:[\[(]\s*([^\])]*?)\s*[\])])?\s*$")
 
@@ -116,16 +124,24 @@ def _read_csv(path: Path, file: str, finger: int | None = None
     size = path.stat().st_size
     if size > MAX_CSV_BYTES:
         raise LogError(file, f"{size / 2**20:.0f} MiB is more than the {MAX_CSV_BYTES // 2**20} "
-                       "MiB a CSV log may hold (the reader keeps it in memory); split the "
-                       "recording or convert it to Parquet")
-    raw = path.read_bytes()
-    if raw[:2] in (b"\xff\xfe", b"\xfe\xff") or b"\x00" in raw[:4096]:
+                       "MiB a CSV log may hold (the reader keeps its columns in memory); split "
+                       "the recording or convert it to Parquet")
+    with open(path, "rb") as fh:
+        head = fh.read(4096)
+    if head[:2] in (b"\xff\xfe", b"\xfe\xff") or b"\x00" in head:
         raise LogError(file, "not UTF-8 text (UTF-16 or a binary file?); save the table as "
                        "UTF-8 CSV")
-    raw = raw.removeprefix(codecs.BOM_UTF8)
-    fast = _read_csv_fast(raw, file, finger)
+    fast, why = _read_csv_stream(path, file, finger)
     if fast is not None:
         return fast
+    if size > MAX_LINE_READER_BYTES:
+        reason = f" ({why})" if why else ""
+        raise LogError(file, f"the streaming CSV reader cannot read this file{reason}; the "
+                       "line-by-line reader that names the row takes files up to "
+                       f"{MAX_LINE_READER_BYTES // 2**20} MiB: mend the file (one header row, "
+                       "no blank lines, a number in every cell), split it or convert it to "
+                       "Parquet")
+    raw = path.read_bytes().removeprefix(codecs.BOM_UTF8)
     try:
         text = raw.decode("utf-8")
     except UnicodeDecodeError as exc:
@@ -185,55 +201,87 @@ def _delimiter(first_line: str) -> str:
     return next((d for d in (",", ";", "\t") if d in first_line), ",")
 
 
-_BLANK_LINE = re.compile(rb"(?:^|\n)[ \t\r]*(?:\n|$)")
+def _header_line(path: Path) -> bytes | None:
+    """The first line of the file (UTF-8 BOM removed, line end kept); None when the file has no
+    line end within its first MiB."""
+    with open(path, "rb") as fh:
+        first = fh.readline(1 << 20)
+    first = first.removeprefix(codecs.BOM_UTF8)
+    return first if first.endswith(b"\n") else None
 
 
-def _read_csv_fast(raw: bytes, file: str, finger: int | None = None):
-    """pyarrow's CSV parser on the file's bytes for clean files (no blank lines, every cell
-    of the format's columns a number); None to fall back to the line-by-line reader, which
-    finds and names any problem. Holds no second copy of the text."""
+def _count_lines(path: Path) -> int:
+    """Lines of the file (a last line without a line end counts), read block by block."""
+    n, last = 0, b""
+    with open(path, "rb") as fh:
+        while block := fh.read(STREAM_BLOCK_BYTES):
+            n += block.count(b"\n")
+            last = block[-1:]
+    return n if last == b"\n" else n + 1
+
+
+def _read_csv_stream(path: Path, file: str, finger: int | None = None):
+    """pyarrow's streaming CSV reader for clean files (one header row, no blank lines, every
+    cell of the format's columns a number), block by block into the format's columns; only
+    those columns are ever held. Returns (result, None), or (None, reason) to fall back to the
+    line-by-line reader, which finds and names any problem (reason: the streaming reader's
+    words, for files too large for that reader)."""
     try:
         import pyarrow as pa
         import pyarrow.csv as pacsv
     except ImportError:
-        return None
-    body = raw[:-2] if raw.endswith(b"\r\n") else raw[:-1] if raw.endswith(b"\n") else raw
-    if not body or _BLANK_LINE.search(body) or (b"\r" in body and b"\n" not in body):
-        return None
-    n_lines = body.count(b"\n") + 1
-    if n_lines < 2:
-        return None
+        return None, "pyarrow is not installed"
+    first = _header_line(path)
+    if first is None:
+        return None, "no line end in the first MiB"
     try:
-        first = body[:body.index(b"\n")].decode("utf-8")
+        line = first.rstrip(b"\r\n").decode("utf-8")
     except UnicodeDecodeError:
-        return None
-    delim = _delimiter(first)
+        return None, "the header row is not UTF-8 text"
+    if "\r" in line or not line.strip():
+        return None, "a stray carriage return or a blank first line"
+    delim = _delimiter(line)
     try:
-        header = [c.strip() for c in next(csv.reader([first], delimiter=delim))]
-    except (csv.Error, StopIteration):  # e.g. a bare CR in the header: the slow reader names it
-        return None
+        header = [c.strip() for c in next(csv.reader([line], delimiter=delim))]
+    except (csv.Error, StopIteration):  # e.g. quotes the csv module refuses: it names them
+        return None, "the header row is not one CSV record"
     index, units, ignored = _parse_header(header, file, finger)
     if not index:
-        return None
+        return None, "the first row names none of the format's columns"
     _check_required(index, header, file, finger)
     names = [f"c{i}" for i in range(len(header))]
+    rows = _count_lines(path) - 1
+    if rows < 1:
+        return None, "no data rows"
+    # the columns are allocated once and filled block by block (no second copy of them)
+    cols = {name: np.empty(rows) for name in index}
+    done = 0
     try:
-        table = pacsv.read_csv(
-            pa.BufferReader(pa.py_buffer(raw)),
-            read_options=pacsv.ReadOptions(skip_rows=1, column_names=names),
+        reader = pacsv.open_csv(
+            pa.OSFile(str(path)),  # read(2), not a memory map: the file's pages stay out of RSS
+            read_options=pacsv.ReadOptions(skip_rows=1, column_names=names,
+                                           block_size=STREAM_BLOCK_BYTES),
             parse_options=pacsv.ParseOptions(delimiter=delim),
             convert_options=pacsv.ConvertOptions(
                 column_types={names[pos]: pa.float64() for pos in index.values()},
                 include_columns=[names[pos] for pos in index.values()],
                 null_values=[""], strings_can_be_null=False))
-    except (pa.ArrowException, ValueError):
-        return None
-    if table.num_rows != n_lines - 1:
-        return None
-    cols = {name: np.asarray(table.column(names[pos]).fill_null(math.nan).to_numpy(),
-                             dtype=np.float64) for name, pos in index.items()}
+        for batch in reader:
+            k = batch.num_rows
+            if done + k > rows:
+                return None, "more records than lines"
+            for name, pos in index.items():  # an empty cell (null) becomes NaN
+                cols[name][done:done + k] = batch.column(names[pos]).to_numpy(
+                    zero_copy_only=False)
+            done += k
+    except (pa.ArrowException, ValueError, OSError) as exc:
+        return None, " ".join(str(exc).split())[:300]
+    finally:
+        pa.default_memory_pool().release_unused()  # the blocks' buffers back to the system
+    if done != rows:  # blank lines (skipped by pyarrow) or line ends inside quotes
+        return None, "blank lines or line ends inside quotes"
     meta = {"format": "csv", "columns": header, "ignored_columns": ignored}
-    return cols, units, _Locator(file), meta
+    return (cols, units, _Locator(file), meta), None
 
 
 def _is_number(text: str) -> bool:

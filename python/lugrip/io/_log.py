@@ -147,8 +147,22 @@ class _Locator:
 # The log
 # ---------------------------------------------------------------------------------------------
 
+class _Owned:
+    """An array a reader built and hands over: :class:`SlidingLog` keeps it without a copy
+    (a 10**7-row log holds each column once)."""
+
+    __slots__ = ("array",)
+
+    def __init__(self, array: np.ndarray):
+        self.array = array
+
+
 def _as_float(name: str, value: Any) -> np.ndarray:
-    arr = np.array(value, dtype=np.float64, copy=True)
+    if isinstance(value, _Owned) and value.array.dtype == np.float64:
+        arr = value.array
+    else:
+        arr = np.array(value.array if isinstance(value, _Owned) else value, dtype=np.float64,
+                       copy=True)
     if arr.ndim != 1:
         raise ValueError(f"SlidingLog.{name} must be 1-D, got shape {arr.shape}")
     arr.setflags(write=False)
@@ -196,6 +210,8 @@ class SlidingLog:
         n = len(arrays["t"])
         if self.maneuver is None:
             man = np.zeros(n, dtype=np.int64)
+        elif isinstance(self.maneuver, _Owned) and self.maneuver.array.dtype == np.int64:
+            man = self.maneuver.array
         else:
             raw = np.asarray(self.maneuver)
             if raw.ndim != 1:
@@ -205,6 +221,8 @@ class SlidingLog:
                 if not np.all(np.isfinite(as_f)) or np.any(as_f != np.round(as_f)):
                     raise ValueError("SlidingLog.maneuver must hold integers")
             man = raw.astype(np.int64, copy=True)
+        if man.ndim != 1:
+            raise ValueError(f"SlidingLog.maneuver must be 1-D, got shape {man.shape}")
         man.setflags(write=False)
         arrays["maneuver"] = man
         bad = {name: len(a) for name, a in arrays.items() if len(a) != n}
@@ -258,17 +276,33 @@ class SlidingLog:
         return cls._from_columns(cols, source=source, meta=dict(meta or {}))
 
     @classmethod
-    def _from_columns(cls, cols: Mapping[str, np.ndarray], *, source, meta) -> SlidingLog:
+    def _from_columns(cls, cols: Mapping[str, np.ndarray], *, source, meta,
+                      owned: bool = False) -> SlidingLog:
+        """The log of a reader's columns; ``owned``: the arrays are the caller's to hand over
+        (kept without a copy and made read-only; nothing else may write to them)."""
         f_t = cols.get("f_t")
         if "f_x" in cols:
             f_t = np.hypot(cols["f_x"], cols["f_y"])
         meta = dict(meta)
         meta.setdefault("units", {c: UNITS[c] for c in COLUMNS
                                   if c in cols or c == "f_t" or c == "maneuver"})
-        return cls(t=cols["t"], f_n=cols["f_n"], f_t=f_t, tau=cols["tau"],
-                   f_x=cols.get("f_x"), f_y=cols.get("f_y"), omega=cols.get("omega"),
-                   maneuver=None if "maneuver" not in cols else cols["maneuver"].astype(np.int64),
+        own = _Owned if owned else (lambda a: a)
+        opt = {k: own(cols[k]) if k in cols else None for k in ("f_x", "f_y", "omega")}
+        return cls(t=own(cols["t"]), f_n=own(cols["f_n"]), f_t=_Owned(f_t) if "f_x" in cols
+                   else own(f_t), tau=own(cols["tau"]), **opt,
+                   maneuver=None if "maneuver" not in cols
+                   else _Owned(cols["maneuver"].astype(np.int64)),
                    source=source, meta=meta)
+
+    def _without_force_vector(self) -> SlidingLog:
+        """The same log without f_x and f_y (f_t kept), sharing the other arrays (read-only):
+        for a replay that reads f_t only, two columns fewer in memory."""
+        if self.f_x is None:
+            return self
+        keep = {k: _Owned(getattr(self, k)) for k in ("t", "f_n", "f_t", "tau", "maneuver")}
+        if self.omega is not None:
+            keep["omega"] = _Owned(self.omega)
+        return SlidingLog(**keep, source=self.source, meta=self.meta)
 
     # -- views ----------------------------------------------------------------------------------
 
@@ -423,10 +457,11 @@ def _validate(cols: dict[str, np.ndarray], loc: _Locator, *, max_nan_run: int,
     if n > 1:
         step = np.diff(t)
         back = np.flatnonzero(step <= 0)
+        step = step[back[:1]] if back.size else None  # the first backward step only
         if back.size:
             i = int(back[0]) + 1
             prev = loc.where(i - 1, None)
-            if step[i - 1] == 0:
+            if step[0] == 0:
                 raise loc.error(f"duplicated time t = {float(t[i])!r} s (same as {prev}); "
                                 "time must increase strictly", i, "t")
             raise loc.error(f"time goes backwards: t = {float(t[i])!r} s after "
@@ -516,8 +551,8 @@ def _check_units(cols: dict[str, np.ndarray], loc: _Locator, explicit: set[str])
     n = len(t)
     override = "; if the values really are in {si}, pass [[units:{c}={si}]]"
     if "t" not in explicit and n > 1:
-        dt = float(np.median(np.diff(t)))
-        tmax = float(np.max(np.abs(t)))
+        dt = float(np.median(np.diff(t), overwrite_input=True))
+        tmax = max(abs(float(np.max(t))), abs(float(np.min(t))))
         if tmax > 1e11 or dt > 100.0 or (n > 1000 and dt > 0.5):
             unit, scale = "ns", 1e-9
             for u, s in (("ms", 1e-3), ("us", 1e-6), ("ns", 1e-9)):
@@ -531,7 +566,8 @@ def _check_units(cols: dict[str, np.ndarray], loc: _Locator, explicit: set[str])
     for c in _FORCES:
         if c in cols and c not in explicit:
             x = cols[c][np.isfinite(cols[c])]
-            if x.size and (med := float(np.median(np.abs(x)))) > _MAX_FORCE_MEDIAN:
+            np.abs(x, out=x)
+            if x.size and (med := float(np.median(x, overwrite_input=True))) > _MAX_FORCE_MEDIAN:
                 i = _near(np.abs(cols[c]), med)
                 raise loc.error(f"{c} does not look like newtons (median |{c}| = {med:.4g}, "
                                 f"more than a fingertip carries); mN? divide by 1000 or pass "
@@ -542,11 +578,16 @@ def _check_units(cols: dict[str, np.ndarray], loc: _Locator, explicit: set[str])
         tau, f_n = cols["tau"], cols["f_n"]
         ok = np.isfinite(tau) & np.isfinite(f_n)
         if ok.any():
-            med_tau = float(np.median(np.abs(tau[ok])))
-            med_fn = float(np.median(f_n[ok]))
+            x = tau[ok]
+            np.abs(x, out=x)
+            med_tau = float(np.median(x, overwrite_input=True))
+            del x
+            med_fn = float(np.median(f_n[ok], overwrite_input=True))
             contact = ok & (f_n > max(0.1 * med_fn, 1e-3))
-            ratio = np.abs(tau[contact]) / f_n[contact]
-            p90 = float(np.percentile(ratio, 90)) if ratio.size else 0.0
+            ratio = np.abs(tau[contact])
+            ratio /= f_n[contact]
+            del contact
+            p90 = float(np.percentile(ratio, 90, overwrite_input=True)) if ratio.size else 0.0
             if (med_tau > 0.5 and med_fn < 50.0) or p90 > _MAX_TAU_PER_FORCE:
                 i = _near(np.abs(tau), med_tau)
                 raise loc.error(f"tau does not look like N m (median |tau| = {med_tau:.4g} at "
@@ -560,15 +601,17 @@ def _window_stat(x: np.ndarray, use: np.ndarray, width: int, q: float) -> tuple[
                                                                                 np.ndarray]:
     """(starts, stat): the q-th percentile of x over the samples ``use`` of each window of
     ``width`` rows (windows at 0, width, 2 width, ... and one ending at the last row); NaN
-    where fewer than a quarter of a window's samples are used."""
+    where fewer than a quarter of a window's samples are used. x is overwritten (NaN where
+    not used)."""
     n = len(x)
     k = n // width
     starts = np.arange(k) * width
     if n % width:
         starts = np.append(starts, n - width)
     stat = np.full(len(starts), np.nan)
-    vals = np.where(use, x, np.nan)
-    chunk = max(1, 2_000_000 // width)  # windows per pass: bounded temporary memory
+    vals = x  # x is the caller's temporary: the unused samples become NaN in place
+    np.copyto(vals, np.nan, where=~use)
+    chunk = max(1, 1_000_000 // width)  # windows per pass: bounded temporary memory
     for a in range(0, len(starts), chunk):
         idx = starts[a:a + chunk, None] + np.arange(width)
         block = np.sort(vals[idx], axis=1)  # NaN last
@@ -601,23 +644,36 @@ def _check_unit_blocks(cols: dict[str, np.ndarray], loc: _Locator,
     finite = np.isfinite(f_n)
     if not finite.any():
         return
-    med_fn = float(np.median(f_n[finite]))
+    med_fn = float(np.median(f_n[finite], overwrite_input=True))
     contact = finite & (f_n > max(0.1 * med_fn, 1e-3))
+
+    # each checked quantity is computed when its check runs (one at a time in memory)
+    def tau_per_force():
+        return np.abs(cols["tau"]) / f_n
+
+    def friction_ratio():
+        if "f_t" in cols:
+            return cols["f_t"] / f_n
+        x = np.hypot(cols["f_x"], cols["f_y"])
+        x /= f_n
+        return x
+
     with np.errstate(divide="ignore", invalid="ignore"):
         checks = []
         if "f_n" not in explicit:
-            checks.append(("f_n", np.abs(f_n), finite, 50.0, _MAX_FORCE_MEDIAN, "N",
+            checks.append(("f_n", lambda: np.abs(f_n), finite, 50.0, _MAX_FORCE_MEDIAN, "N",
                            "median f_n", "N", "mN or gram-force"))
         if "tau" in cols and "tau" not in explicit:
-            checks.append(("tau", np.abs(cols["tau"]) / f_n, contact, 90.0, _MAX_TAU_PER_FORCE,
+            checks.append(("tau", tau_per_force, contact, 90.0, _MAX_TAU_PER_FORCE,
                            "N m", "|tau|/f_n", "m", "N mm"))
         ft_col = "f_t" if "f_t" in cols else ("f_y" if "f_y" in cols else None)
         if ft_col is not None and ft_col not in explicit and "f_n" not in explicit:
-            f_t = cols["f_t"] if "f_t" in cols else np.hypot(cols["f_x"], cols["f_y"])
-            checks.append((ft_col, f_t / f_n, contact, 90.0, _MAX_FRICTION_RATIO, "N",
+            checks.append((ft_col, friction_ratio, contact, 90.0, _MAX_FRICTION_RATIO, "N",
                            "f_t/f_n", "", "mN (f_n in N)"))
-        for col, x, use, q, bound, si, what, unit, likely in checks:
+        for col, quantity, use, q, bound, si, what, unit, likely in checks:
+            x = quantity()
             starts, stat = _window_stat(x, use & np.isfinite(x), width, q)
+            del x
             bad = np.flatnonzero(stat > bound)
             if not bad.size:
                 continue

@@ -6,7 +6,8 @@ A scenario's ``faults:`` block::
     faults:
       inject:                        # lugrip._core.FaultSpec fields (sim._closed_loop.fault_specs)
         - {kind: nan_burst, finger: -1, t_start: 6.0, duration: 2.0, burst: 20, every: 200}
-      stuck_samples: 25              # SlipControl's frozen-sensor check (0: off)
+      stuck_samples: 25              # SlipControl's frozen-sensor check (0: off; default:
+                                     # SlipControl's, 25)
       healthy_finger_fallback: false # one faulty finger: the other computes the command
       expect_status: [invalid_sample, sensor_fault]  # statuses that count as "fault raised"
       onset: 6.0                     # [s] default: the earliest t_start of `inject`
@@ -96,7 +97,7 @@ def fault_block(value: Any, where: str) -> dict:
     ]
     if bad:
         raise ValueError(f"{where}: {bad[0]}")
-    stuck = d.get("stuck_samples", 0)
+    stuck = d.get("stuck_samples", _core.SlipControlSettings().stuck_samples)
     if isinstance(stuck, bool) or not isinstance(stuck, int) or stuck < 0:
         raise ValueError(f"{where}: faults.stuck_samples = {stuck!r}: must be an integer >= 0")
     expect = d.get("expect_status") or []

@@ -148,7 +148,7 @@ def run_mujoco_loop(
     estimator: ContactParams | Mapping[str, Any] | str | None = None,
     frame_callback: Callable[[mujoco.MjModel, mujoco.MjData, float], None] | None = None,
     faults=None,
-    stuck_samples: int = 0,
+    stuck_samples: int | None = None,
     healthy_finger_fallback: bool = False,
 ) -> MujocoRun:
     """Simulate the scenario's grasp on MuJoCo in closed loop for `duration` seconds.
@@ -164,7 +164,8 @@ def run_mujoco_loop(
             force then); before that the gripper closes with ``actuator.f_init``.
         frame_callback: called as f(model, data, t) at every sensor sample (rendering).
         faults, stuck_samples, healthy_finger_fallback: injected sensor/actuator faults, the
-            frozen-sensor check and the one-faulty-finger policy, as
+            frozen-sensor check (None: SlipControl's default, on) and the one-faulty-finger
+            policy, as
             :func:`lugrip.sim.run_closed_loop` (the same C++ FaultInjector: sensor faults change
             the wrenches SlipControl receives, actuator faults the command the gripper gets).
 
