@@ -53,6 +53,7 @@ from ._log import (
     SlidingLog,
     _validate,
 )
+from ._ros import contact_wrench
 from ._units import _expand_units, _unit_factor
 
 __all__ = [
@@ -65,6 +66,7 @@ __all__ = [
     "LogWarning",
     "MissingExtraError",
     "SlidingLog",
+    "contact_wrench",
     "find_maneuvers",
     "maneuvers_from_windows",
     "read_grasp_log",

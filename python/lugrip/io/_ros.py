@@ -256,17 +256,26 @@ def hold_last(ns_src: np.ndarray, y_src: np.ndarray, ns_dst: np.ndarray,
     return np.where(k >= 0, y_src[np.maximum(k, 0)], before)
 
 
-def to_contact(f: np.ndarray, m: np.ndarray, offset: float) -> tuple[np.ndarray, np.ndarray]:
+def contact_floor(f_n: np.ndarray) -> float:
+    """The normal force [N] below which a batch's centre of pressure is not located: 5 % of
+    the median pressing force, at least 1 mN (inf without a pressing sample)."""
+    fz = np.asarray(f_n, dtype=np.float64)
+    pressed = fz[np.isfinite(fz) & (fz > 0)]
+    return max(1e-3, 0.05 * float(np.median(pressed))) if pressed.size else np.inf
+
+
+def to_contact(f: np.ndarray, m: np.ndarray, offset: float,
+               floor: float | None = None) -> tuple[np.ndarray, np.ndarray]:
     """Torsional moment about the contact normal at the centre of pressure, from the wrench
     (f, m) [N], [N m] of shape (n, 3) measured at a sensor origin ``offset`` [m] behind the
     pad surface along the normal (the frame has f_n = f[:, 2] > 0 in contact; the surface is
-    the plane z = -offset). Returns (tau [N m], centre of pressure (n, 2) [m]); samples
-    without a usable normal force keep m_z and get a NaN centre (docs/sliding_log.md,
-    "Wrench at the sensor origin")."""
+    the plane z = -offset). Returns (tau [N m], centre of pressure (n, 2) [m]); samples whose
+    normal force is not above ``floor`` [N] (None: :func:`contact_floor` of the batch) keep
+    m_z and get a NaN centre (docs/sliding_log.md, "Wrench at the sensor origin")."""
     fx, fy, fz = f[:, 0], f[:, 1], f[:, 2]
     mx, my, mz = m[:, 0], m[:, 1], m[:, 2]
-    pressed = fz[np.isfinite(fz) & (fz > 0)]
-    floor = max(1e-3, 0.05 * float(np.median(pressed))) if pressed.size else np.inf
+    if floor is None:
+        floor = contact_floor(fz)
     ok = np.isfinite(fz) & (fz > floor)
     x = np.full(len(fz), np.nan)
     y = np.full(len(fz), np.nan)
@@ -275,6 +284,40 @@ def to_contact(f: np.ndarray, m: np.ndarray, offset: float) -> tuple[np.ndarray,
     tau = mz.copy()
     tau[ok] = mz[ok] - x[ok] * fy[ok] + y[ok] * fx[ok]
     return tau, np.c_[x, y]
+
+
+def contact_wrench(force, moment, *, flip_normal: bool = False,
+                   contact_offset: float | None = None,
+                   floor: float | None = None) -> np.ndarray:
+    """A fingertip sensor's wrench in lugrip's contact frame: rows (f_n, f_x, f_y, tau), the
+    layout :meth:`lugrip.SlipControl.step` takes, from force and moment [N], [N m] of shape
+    (3,) or (n, 3) in the sensor's frame (a ``geometry_msgs/Wrench``). The one transform of
+    the log readers (:func:`lugrip.io.read_log`) and the ROS node (:mod:`lugrip.ros`):
+
+    * ``flip_normal``: the sensor's z axis points toward the object, so its force z is
+      negative while pressed: the frame is rotated by pi about x (y and z of force and
+      moment change sign) so that f_n > 0 in contact;
+    * ``contact_offset`` [m] (None: the wrench is already at the contact): the sensor origin
+      lies this far behind the pad surface along the normal; the torsional moment is moved
+      to the centre of pressure (:func:`to_contact`; ``floor`` as there).
+
+    Returns shape (4,) for one wrench, (n, 4) for n."""
+    f = np.asarray(force, dtype=np.float64)
+    m = np.asarray(moment, dtype=np.float64)
+    one = f.ndim == 1
+    f, m = np.atleast_2d(f), np.atleast_2d(m)
+    if f.shape != m.shape or f.shape[1] != 3:
+        raise ValueError(f"force and moment: expected shape (3,) or (n, 3) each, got "
+                         f"{np.shape(force)} and {np.shape(moment)}")
+    sign = -1.0 if flip_normal else 1.0  # rotation by pi about x: y and z components flip
+    f = f * [1.0, sign, sign]
+    m = m * [1.0, sign, sign]
+    if contact_offset is None:
+        tau = m[:, 2]
+    else:
+        tau, _cop = to_contact(f, m, float(contact_offset), floor)
+    out = np.c_[f[:, 2], f[:, 0], f[:, 1], tau]
+    return out[0] if one else out
 
 
 def _metadata_t0(src: RosSource) -> int:
@@ -320,14 +363,10 @@ def read_ros(src: RosSource, *, wrench_topic: str | None, omega_topic: str | Non
     t0 = _metadata_t0(src) if "t0_ns" in src.metadata else int(stamps[0])
     t = (stamps - t0) / 1e9
     v = np.asarray(wrench.values, dtype=np.float64)[keep]
-    sign = -1.0 if flip_normal else 1.0  # rotation by pi about x: y and z components flip
-    force = v[:, 0:3] * [1.0, sign, sign]
-    moment = v[:, 3:6] * [1.0, sign, sign]
-    if contact_offset is None:
-        tau = moment[:, 2]
-    else:
-        tau, _cop = to_contact(force, moment, float(contact_offset))
-    cols = {"t": t, "f_x": force[:, 0], "f_y": force[:, 1], "f_n": force[:, 2], "tau": tau}
+    sign = -1.0 if flip_normal else 1.0  # omega below: the same rotation by pi about x
+    w = contact_wrench(v[:, 0:3], v[:, 3:6], flip_normal=flip_normal,
+                       contact_offset=contact_offset)
+    cols = {"t": t, "f_x": w[:, 1], "f_y": w[:, 2], "f_n": w[:, 0], "tau": w[:, 3]}
     if src.metadata.get("force_vector") == "false":
         cols["f_t"] = np.hypot(cols.pop("f_x"), cols.pop("f_y"))
     prefix = "wrench." if _TYPES[wrench.type][0] else ""

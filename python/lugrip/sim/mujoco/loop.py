@@ -150,6 +150,7 @@ def run_mujoco_loop(
     faults=None,
     stuck_samples: int = 0,
     healthy_finger_fallback: bool = False,
+    controller_factory: Callable[..., Any] | None = None,
 ) -> MujocoRun:
     """Simulate the scenario's grasp on MuJoCo in closed loop for `duration` seconds.
 
@@ -167,6 +168,10 @@ def run_mujoco_loop(
             frozen-sensor check and the one-faulty-finger policy, as
             :func:`lugrip.sim.run_closed_loop` (the same C++ FaultInjector: sensor faults change
             the wrenches SlipControl receives, actuator faults the command the gripper gets).
+        controller_factory: called with SlipControl's arguments instead of
+            :class:`lugrip.SlipControl` (an object with its ``step``, ``reset``, ``settings``,
+            ``request_*`` and ``set_dynamic_enabled``): ``lugrip ros sim`` puts the controller
+            on the other side of the ROS 2 middleware this way.
 
     Returns:
         :class:`MujocoRun`, one row per sensor sample.
@@ -191,7 +196,7 @@ def run_mujoco_loop(
     obs_kw = {"torque_noise": float(plant.sensor.torque_noise), "dt": T_s}
     obs_kw.update(dict(observer_settings or {}))
     # the baselines command by their own law; SlipControl's observers still run for the log
-    ctrl = SlipControl(est, fingers=2, observer=obs_kw, stuck_samples=stuck_samples,
+    ctrl = (controller_factory or SlipControl)(est, fingers=2, observer=obs_kw, stuck_samples=stuck_samples,
         healthy_finger_fallback=healthy_finger_fallback, **ctrl_s)
     injector = _core.FaultInjector(fault_specs(faults), T_s) if faults else None
     limits = {
