@@ -168,8 +168,9 @@ class SlipControl(NoCopy):
 
         Args:
             wrenches: (fingers, 4) values (f_n, f_x, f_y, tau) per finger, a float64 array for
-                the fast path (any array-like is converted). One finger also takes (4,); any
-                other shape (a transposed (4, 2), a flat (8,)) raises ValueError.
+                the fast path (any array-like is converted). One finger also takes (4,), and
+                a (2, 4) array's first row; any other shape (a transposed (4, 2), a flat (8,))
+                raises ValueError.
             dt: [s] time since the previous cycle; 0 means the nominal period.
             command: when this cycle computes a command: ``"clock"`` (the first cycle after
                 reset and every ``command_ratio``-th after it), ``"now"`` (from the samples up
@@ -190,11 +191,12 @@ class SlipControl(NoCopy):
         if not isinstance(wrenches, np.ndarray):
             wrenches = np.ascontiguousarray(wrenches, dtype=np.float64)
         shape = wrenches.shape
-        if shape != (self._sc.fingers, 4) and not (shape == (4,) and self._sc.fingers == 1):
+        n = self._sc.fingers
+        if shape != (n, 4) and not (n == 1 and shape in ((4,), (2, 4))):
             # a transposed (4, 2) or a flat (8,) array would otherwise be read row by row
-            one = " or (4,)" if self._sc.fingers == 1 else ""
-            raise ValueError(f"wrenches: expected shape ({self._sc.fingers}, 4){one}: one row "
-                             f"(f_n, f_x, f_y, tau) per finger, got {shape}")
+            one = ", or (4,)" if n == 1 else ""
+            raise ValueError(f"wrenches of shape {shape}: expected 4 values (f_n, f_x, f_y, "
+                             f"tau) per finger, a ({n}, 4) array{one}")
         try:
             return self._sc.step(wrenches, dt, code)
         except TypeError:

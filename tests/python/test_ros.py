@@ -18,12 +18,13 @@ from diagnostic_msgs.msg import DiagnosticArray  # noqa: E402
 from geometry_msgs.msg import WrenchStamped  # noqa: E402
 from lifecycle_msgs.msg import Transition  # noqa: E402
 from lifecycle_msgs.srv import ChangeState, GetState  # noqa: E402
-from rcl_interfaces.msg import Parameter, ParameterType, ParameterValue  # noqa: E402
+from rcl_interfaces.msg import Parameter  # noqa: E402
 from rcl_interfaces.srv import SetParameters  # noqa: E402
 from rclpy.qos import HistoryPolicy, QoSProfile, ReliabilityPolicy  # noqa: E402
 from sensor_msgs.msg import JointState  # noqa: E402
 
 from lugrip.ros._parameters import settings_parameters  # noqa: E402
+from lugrip.ros.sim import parameter_value  # noqa: E402
 
 _DOMAIN_BASE = 100 + os.getpid() % 60  # 100..219: one domain per test, apart from others'
 
@@ -104,14 +105,7 @@ class _Driver:
         return self.call(self.change, req).success
 
     def set(self, name: str, value):
-        v = ParameterValue()
-        if isinstance(value, bool):
-            v.type, v.bool_value = ParameterType.PARAMETER_BOOL, value
-        elif isinstance(value, int):
-            v.type, v.integer_value = ParameterType.PARAMETER_INTEGER, value
-        else:
-            v.type, v.double_value = ParameterType.PARAMETER_DOUBLE, float(value)
-        req = SetParameters.Request(parameters=[Parameter(name=name, value=v)])
+        req = SetParameters.Request(parameters=[Parameter(name=name, value=parameter_value(value))])
         return self.call(self.params, req).results[0]
 
     def publish(self, k: int, stamp_ns: int, wrench, frame: str) -> None:

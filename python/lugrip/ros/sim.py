@@ -63,6 +63,20 @@ def _parse(status) -> dict[str, Any]:
     return out
 
 
+def parameter_value(value) -> ParameterValue:
+    """An rcl_interfaces ParameterValue of a bool, int, str or float."""
+    v = ParameterValue()
+    if isinstance(value, bool):
+        v.type, v.bool_value = ParameterType.PARAMETER_BOOL, value
+    elif isinstance(value, int):
+        v.type, v.integer_value = ParameterType.PARAMETER_INTEGER, value
+    elif isinstance(value, str):
+        v.type, v.string_value = ParameterType.PARAMETER_STRING, value
+    else:
+        v.type, v.double_value = ParameterType.PARAMETER_DOUBLE, float(value)
+    return v
+
+
 class GripperSimNode(Node):
     """Publishes the fingertip wrenches, takes the command, calls the controller's services."""
 
@@ -123,18 +137,8 @@ class GripperSimNode(Node):
 
     def set_parameters(self, values: dict[str, Any]) -> None:
         """Set the controller's parameters (bool, int, float or str values)."""
-        params = []
-        for name, value in values.items():
-            v = ParameterValue()
-            if isinstance(value, bool):
-                v.type, v.bool_value = ParameterType.PARAMETER_BOOL, value
-            elif isinstance(value, int):
-                v.type, v.integer_value = ParameterType.PARAMETER_INTEGER, value
-            elif isinstance(value, str):
-                v.type, v.string_value = ParameterType.PARAMETER_STRING, value
-            else:
-                v.type, v.double_value = ParameterType.PARAMETER_DOUBLE, float(value)
-            params.append(Parameter(name=name, value=v))
+        params = [Parameter(name=name, value=parameter_value(value))
+                  for name, value in values.items()]
         results = self.call(self.param_client, SetParameters.Request(parameters=params)).results
         for name, result in zip(values, results):
             if not result.successful:
