@@ -208,15 +208,23 @@ def test_paper_experiments_over_ros(tmp_path, scenario):
     run equals the in-process run (same samples, stamps exact to the nanosecond)."""
     domain = _DOMAIN_BASE + 1 + (scenario.startswith("exp3"))
     node = _lugrip("run", domain=domain)
+    record = scenario.startswith("exp3")
+    if record:  # exp3 slides: its recording must identify like the run's own columns
+        rec = _lugrip("record", str(tmp_path / "rec"), "--topics", "/fingertip_0/wrench",
+                      "/lugrip_gripper_sim/omega_true_0", "/lugrip/command", domain=domain)
     out = tmp_path / "m.json"
     try:
+        time.sleep(1.0 if record else 0.0)
         sim = subprocess.run([sys.executable, "-m", "lugrip", "ros", "sim", scenario,
-                              "--json", str(out)], env=_env(domain), capture_output=True,
-                             text=True, timeout=240)
+                              "--json", str(out), "--csv", str(tmp_path / "run.csv")],
+                             env=_env(domain), capture_output=True, text=True, timeout=240)
         assert node.poll() is None
     finally:
         log = _stop(node)
+        rec_log = _stop(rec) if record else ""
     assert sim.returncode == 0, sim.stdout + sim.stderr + log
+    if record:
+        _identify_recording_like_csv(tmp_path, rec_log)
     import json
 
     doc = json.loads(out.read_text())
@@ -231,6 +239,39 @@ def test_paper_experiments_over_ros(tmp_path, scenario):
     assert m["hold_slip_mm"] == pytest.approx(r["hold_slip_mm"], rel=1e-9, abs=1e-12)
     if scenario.startswith("exp3"):
         assert m["returned_to_avoidance"] and m["final_hang_deg"] <= 5.0
+
+
+def _identify_recording_like_csv(tmp_path, rec_log: str) -> None:
+    """mu identified from the MCAP `lugrip ros record` wrote (finger 0's wrench through the
+    middleware, the sim's ground truth topic) and from the same samples in the run's CSV
+    (the sim's own columns, written as a sliding log CSV) agree within 1 %; the MCAP read
+    without its ground truth names --omega-topic in the identification error."""
+    import lugrip
+    from lugrip.identification import IdentificationError
+    from lugrip.io import SlidingLog, read_log, write_log
+    from lugrip.ros.record import mcap_file
+
+    mcap = mcap_file(tmp_path / "rec")
+    assert mcap.is_file(), rec_log
+    rec = read_log(mcap, wrench_topic="/fingertip_0/wrench",
+                   omega_topic="/lugrip_gripper_sim/omega_true_0")
+    run = np.genfromtxt(tmp_path / "run.csv", delimiter=",", names=True)
+    started = np.flatnonzero(run["status"] != 3)[0]  # the controller's start: first published
+    cols = {c: run[f"{c}_meas_0"][started:] for c in ("f_n", "f_t", "tau")}
+    assert len(rec) >= 0.99 * len(cols["f_n"]), (len(rec), len(cols["f_n"]))
+    n = len(cols["f_n"])
+    csv_path = tmp_path / "run_finger0.csv"
+    write_log(SlidingLog.from_arrays(run["t"][started:], cols["f_n"], cols["tau"],
+                                     f_t=cols["f_t"], omega=run["omega_true_0"][started:]),
+              csv_path)
+    from_csv = read_log(csv_path)
+    assert n == len(from_csv)
+    params0 = lugrip.ContactParams.table1()
+    mu_mcap = lugrip.identify(rec, params0=params0).params.mu
+    mu_csv = lugrip.identify(from_csv, params0=params0).params.mu
+    assert mu_mcap == pytest.approx(mu_csv, rel=0.01)
+    with pytest.raises(IdentificationError, match="--omega-topic"):
+        lugrip.identify(read_log(mcap, wrench_topic="/fingertip_0/wrench"), params0=params0)
 
 
 def test_bad_traffic_holds_the_command_and_names_the_cause():

@@ -60,3 +60,58 @@ def test_step_refuses_any_shape_but_fingers_by_4(shape):
     assert one.step([5.0, 0.1, 0.0, 1e-4]).force > 0
     with pytest.raises(ValueError, match=r"a \(1, 4\) array, or \(4,\)"):
         one.step(np.ones((4, 2)))
+
+
+def _write_pose_mcap(out, t, omega_of, angle_of, f_n=5.0):
+    """A rosbag2 MCAP (rosbags' writer, no ROS needed) with a WrenchStamped and a PoseStamped
+    whose orientation is a fixed 20 degree swing about x composed with a twist of
+    angle_of(t) about z (q = q_swing q_twist: the twist about z is angle_of(t), the swing
+    must be left out)."""
+    from rosbags.rosbag2 import StoragePlugin, Writer
+    from rosbags.typesys import Stores, get_typestore
+
+    ts = get_typestore(Stores.ROS2_KILTED)
+    T = ts.types
+    Time, Header = T["builtin_interfaces/msg/Time"], T["std_msgs/msg/Header"]
+    V, W, WS = T["geometry_msgs/msg/Vector3"], T["geometry_msgs/msg/Wrench"], T["geometry_msgs/msg/WrenchStamped"]
+    P, PS = T["geometry_msgs/msg/Pose"], T["geometry_msgs/msg/PoseStamped"]
+    Pt, Q = T["geometry_msgs/msg/Point"], T["geometry_msgs/msg/Quaternion"]
+    wt, pt = "geometry_msgs/msg/WrenchStamped", "geometry_msgs/msg/PoseStamped"
+    with Writer(out, version=9, storage_plugin=StoragePlugin.MCAP) as w:
+        cw = w.add_connection("/fingertip_0/wrench", wt, typestore=ts)
+        cp = w.add_connection("/truth/pose", pt, typestore=ts)
+        for ti in t:
+            ns = 10**9 + int(round(ti * 1e9))
+            h = Header(stamp=Time(sec=ns // 10**9, nanosec=ns % 10**9), frame_id="fingertip_0")
+            w.write(cw, ns, ts.serialize_cdr(WS(header=h, wrench=W(
+                force=V(x=0.3, y=0.0, z=f_n), torque=V(x=0.0, y=0.0, z=1e-4))), wt))
+            a = angle_of(ti)
+            # q_swing(x, b) q_twist(z, a) written out, with a sign flip of the quaternion on
+            # every other sample (q and -q are one rotation)
+            s = -1.0 if int(round(ti * 500)) % 2 else 1.0
+            px, pw = np.sin(np.radians(10.0)), np.cos(np.radians(10.0))
+            qz, qw = np.sin(a / 2), np.cos(a / 2)
+            q = Q(x=s * qw * px, y=-s * px * qz, z=s * pw * qz, w=s * pw * qw)
+            w.write(cp, ns, ts.serialize_cdr(PS(header=h, pose=P(position=Pt(x=0.0, y=0.0, z=0.0),
+                                                                   orientation=q)), pt))
+    return out / f"{out.name}.mcap"
+
+
+def test_pose_topic_as_ground_truth_is_differentiated(tmp_path):
+    """Independent reference: an analytic twist angle(t) = 0.8 sin(2 pi 3 t) + 7 t rad (past
+    pi, so it must be unwrapped) under a fixed 20 degree swing, quaternion signs alternating:
+    omega read from the PoseStamped topic equals its derivative within the central-difference
+    error. No plant."""
+    from lugrip.io import read_log
+
+    t = np.arange(0, 1.0, 0.002)
+    angle = lambda x: 0.8 * np.sin(2 * np.pi * 3 * x) + 7.0 * x  # noqa: E731
+    rate = lambda x: 0.8 * 2 * np.pi * 3 * np.cos(2 * np.pi * 3 * x) + 7.0  # noqa: E731
+    path = _write_pose_mcap(tmp_path / "run", t, rate, angle)
+    log = read_log(path, wrench_topic="/fingertip_0/wrench", omega_topic="/truth/pose")
+    # central differences: error <= h^2/6 max|angle'''| = (0.002^2 / 6) 0.8 (6 pi)^3
+    bound = 0.002**2 / 6 * 0.8 * (6 * np.pi) ** 3
+    inner = slice(1, -1)
+    np.testing.assert_allclose(log.omega[inner], rate(log.t[inner]), rtol=0, atol=1.01 * bound)
+    assert "atan2" in log.meta["omega_method"]
+    np.testing.assert_array_equal(log.f_n, 5.0)

@@ -1,5 +1,6 @@
 """``lugrip ros``: lugrip on ROS 2 (the ``[ros]`` extra): ``run`` starts the controller node,
-``sim`` runs a scenario on the MuJoCo gripper node against it (docs/ros.md)."""
+``sim`` runs a scenario on the MuJoCo gripper node against it, ``record`` writes topics to an
+MCAP file the log readers take (docs/ros.md)."""
 
 from __future__ import annotations
 
@@ -18,6 +19,7 @@ examples:
   lugrip ros run ros_params.yaml               # a ROS parameter file (node name: lugrip)
   lugrip ros run fit.yaml --ros-args -p controller.f_max:=15.0 -r fingertip_0/wrench:=/left/ft
   lugrip ros sim exp3_plastic_bottle_pivot     # in a second shell: the MuJoCo gripper
+  lugrip ros record run1 --topics /fingertip_0/wrench /truth/pose   # -> run1/run1.mcap
 The node is configured and activated at start (--no-autostart: left unconfigured for a
 lifecycle manager). `lugrip ros sim` exits 0 when the scenario's MuJoCo criteria pass, 1 when
 one fails.
@@ -27,7 +29,8 @@ one fails.
 def register(subparsers) -> None:
     p = subparsers.add_parser(
         "ros",
-        help="ROS 2 nodes: the slip controller (run) and a MuJoCo gripper to test it (sim)",
+        help="ROS 2 nodes: the slip controller (run), a MuJoCo gripper to test it (sim), a "
+             "recorder to MCAP (record)",
         description="lugrip on ROS 2 (needs the [ros] extra: pip install \"lugrip[ros]\").",
         epilog=_EPILOG,
         formatter_class=argparse.RawDescriptionHelpFormatter,
@@ -55,6 +58,17 @@ def register(subparsers) -> None:
                    help="write the metrics and criteria here")
     s.add_argument("--csv", type=Path, default=None, metavar="FILE",
                    help="write the run's columns here")
+    c = sub.add_parser("record", help="topics to an MCAP file lugrip identify/replay read")
+    c.add_argument("out", type=Path, metavar="OUT",
+                   help="new rosbag2 directory; the file to read is OUT/OUT.mcap")
+    c.add_argument("--topics", nargs="+", metavar="TOPIC",
+                   default=["/fingertip_0/wrench", "/fingertip_1/wrench", "/lugrip/command",
+                            "/lugrip/joint_command"],
+                   help="topics to record (default: the node's wrench inputs and commands)")
+    c.add_argument("--duration", type=float, default=None, metavar="S",
+                   help="stop after S seconds (default: at Ctrl-C or SIGTERM)")
+    c.add_argument("--ros-args", dest="ros_args", nargs=argparse.REMAINDER, default=None,
+                   metavar="ARG", help="the rest of the line goes to rclpy")
     s.add_argument("--ros-args", dest="ros_args", nargs=argparse.REMAINDER, default=None,
                    metavar="ARG", help="the rest of the line goes to rclpy")
     p.set_defaults(run=run)
@@ -82,7 +96,27 @@ def run(args) -> int:
         raise CliError(missing_message())
     if args.ros_command == "run":
         return _run_node(args)
+    if args.ros_command == "record":
+        return _run_record(args)
     return _run_sim(args)
+
+
+def _run_record(args) -> int:
+    import rclpy
+
+    from ..ros.record import mcap_file, record
+
+    if args.out.exists():
+        raise CliError(f"{args.out}: exists (a new directory is written)")
+    rclpy.init(args=_init_args(args))
+    try:
+        counts = record(args.out, args.topics, args.duration)
+    finally:
+        rclpy.try_shutdown()
+    for topic in args.topics:
+        print(f"{topic}: {counts.get(topic if topic.startswith('/') else '/' + topic, 0)} messages")
+    print(f"wrote {mcap_file(args.out)}")
+    return 0
 
 
 def _run_node(args) -> int:

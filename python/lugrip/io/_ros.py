@@ -33,11 +33,17 @@ _TYPES: dict[str, tuple[bool, tuple[str, ...]]] = {
     "geometry_msgs/Twist": (False, ("angular.z",)),
     "geometry_msgs/Vector3Stamped": (True, ("vector.z",)),
     "geometry_msgs/Vector3": (False, ("z",)),
+    "geometry_msgs/PoseStamped": (True, tuple(f"pose.orientation.{a}" for a in "xyzw")),
     **{t: (False, ("data",)) for t in _FLOAT_TYPES + _INT_TYPES},
 }
 WRENCH_TYPES = ("geometry_msgs/WrenchStamped", "geometry_msgs/Wrench")
 OMEGA_TYPES = ("geometry_msgs/TwistStamped", "geometry_msgs/Twist",
-               "geometry_msgs/Vector3Stamped", "geometry_msgs/Vector3") + _FLOAT_TYPES
+               "geometry_msgs/Vector3Stamped", "geometry_msgs/Vector3",
+               "geometry_msgs/PoseStamped") + _FLOAT_TYPES
+#: Ground truth given as a pose (motion capture): differentiated by :func:`pose_rate`.
+POSE_TYPES = ("geometry_msgs/PoseStamped",)
+POSE_METHOD = ("d/dt of the twist angle about z, 2 atan2(q_z, q_w) (swing-twist "
+               "decomposition) unwrapped, by second-order central differences on the stamps")
 ID_TYPES = _INT_TYPES + _FLOAT_TYPES  # maneuver ids (floats must hold integers)
 SCALAR_TYPES = _FLOAT_TYPES + _INT_TYPES  # recorded commands and similar scalars
 #: Most messages read from one topic (about 330 bytes each in memory: 2e6 = 66 min at 500 Hz).
@@ -256,6 +262,19 @@ def hold_last(ns_src: np.ndarray, y_src: np.ndarray, ns_dst: np.ndarray,
     return np.where(k >= 0, y_src[np.maximum(k, 0)], before)
 
 
+def pose_rate(t: np.ndarray, quaternions: np.ndarray) -> np.ndarray:
+    """Angular velocity [rad/s] about z of a pose (object relative to the fingertip, z along
+    the contact normal; e.g. motion capture of both expressed in the fingertip's frame) from its
+    orientation quaternions (n, 4) as (x, y, z, w) at times t [s]: :data:`POSE_METHOD`. The
+    twist about z is the part of the rotation that slides the contact; the swing (tilt of the
+    normal) is left out."""
+    q = np.asarray(quaternions, dtype=np.float64)
+    angle = np.unwrap(2.0 * np.arctan2(q[:, 2], q[:, 3]))
+    if len(t) < 2:
+        return np.full(len(t), np.nan)
+    return np.gradient(angle, t)
+
+
 def contact_floor(f_n: np.ndarray) -> float:
     """The normal force [N] below which a batch's centre of pressure is not located: 5 % of
     the median pressing force, at least 1 mN (inf without a pressing sample)."""
@@ -388,11 +407,17 @@ def read_ros(src: RosSource, *, wrench_topic: str | None, omega_topic: str | Non
         o_ns, o_source = om.times(time_source)
         pick = ordered(file, om, o_ns, "omega", stacklevel + 1, o_source)
         o_t = (o_ns[pick] - t0) / 1e9
-        y = sign * np.asarray(om.values, dtype=np.float64)[pick, 0]
+        values = np.asarray(om.values, dtype=np.float64)[pick]
+        if om.type in POSE_TYPES:
+            y = sign * pose_rate(o_t, values)
+            fields["omega"] = f"pose of '{omega_topic}' differentiated: {POSE_METHOD}; resampled"
+            meta["omega_method"] = POSE_METHOD
+        else:
+            y = sign * values[:, 0]
+            fields["omega"] = f"{_TYPES[om.type][1][0]} of '{omega_topic}' resampled"
         step = np.diff(o_t)
         max_gap = 10.0 * float(np.median(step)) if step.size else 0.0
         cols["omega"] = resample(o_t, y, t, max_gap)
-        fields["omega"] = f"{_TYPES[om.type][1][0]} of '{omega_topic}' resampled"
         meta.update(omega_topic=omega_topic, omega_type=om.type, omega_time_source=o_source)
 
     if maneuver_topic is not None:

@@ -4,8 +4,10 @@ The plant, the sensors (500 Hz, noise, bias) and the actuator (lag, rate limit) 
 :func:`lugrip.sim.mujoco.loop.run_mujoco_loop`; only the controller is replaced by a proxy
 that talks to the controller node over the middleware: each sensor sample is published as two
 ``geometry_msgs/WrenchStamped`` (stamped with the simulated time from the start of the run,
-frame ids ``fingertip_0``/``fingertip_1``), the gripper takes its command from the node's
-``~/joint_command`` (effort [N]) and holds it between commands, and the scenario's schedule
+frame ids ``fingertip_0``/``fingertip_1``), with the true slip rate of the object on each pad
+as ``~/omega_true_k`` (``TwistStamped`` angular.z: ground truth for recordings); the gripper
+takes its command from the node's ``~/joint_command`` (effort [N]) and holds it between
+commands, and the scenario's schedule
 calls the node's ``~/pivot`` / ``~/slipping_avoidance`` services and sets
 ``controller.dynamic_enabled``. Before the run the simulation gives the node the scenario's
 settings (contact model, observer, controller: deactivate, set the parameters, activate),
@@ -26,7 +28,7 @@ from typing import Any
 
 import rclpy
 from diagnostic_msgs.msg import DiagnosticArray
-from geometry_msgs.msg import WrenchStamped
+from geometry_msgs.msg import TwistStamped, WrenchStamped
 from lifecycle_msgs.msg import Transition
 from lifecycle_msgs.srv import ChangeState
 from rcl_interfaces.msg import Parameter, ParameterType, ParameterValue
@@ -89,6 +91,8 @@ class GripperSimNode(Node):
                          history=HistoryPolicy.KEEP_LAST, depth=10)
         self.frame_ids = list(frame_ids)
         self.wrench = [self.create_publisher(WrenchStamped, t, qos) for t in wrench_topics]
+        self.truth = [self.create_publisher(TwistStamped, f"~/omega_true_{k}", qos)
+                      for k in range(len(wrench_topics))]
         self.statuses: dict[int, dict] = {}
         self.commands: dict[int, float] = {}
         self.last_command: float | None = None
@@ -161,6 +165,16 @@ class GripperSimNode(Node):
         self.transition(Transition.TRANSITION_ACTIVATE)
         self.wait_for_controller()
 
+    def publish_truth(self, stamp_ns: int, omegas) -> None:
+        """The true slip rate of the object relative to each pad [rad/s] (angular.z)."""
+        sec, nsec = divmod(stamp_ns, 1_000_000_000)
+        for k, pub in enumerate(self.truth):
+            msg = TwistStamped()
+            msg.header.stamp.sec, msg.header.stamp.nanosec = int(sec), int(nsec)
+            msg.header.frame_id = self.frame_ids[k]
+            msg.twist.angular.z = float(omegas[k])
+            pub.publish(msg)
+
     def publish(self, stamp_ns: int, meas) -> None:
         sec, nsec = divmod(stamp_ns, 1_000_000_000)
         for k, pub in enumerate(self.wrench):
@@ -231,9 +245,14 @@ class RemoteSlipControl:
     def set_dynamic_enabled(self, enabled: bool) -> None:
         self.node.set_parameter("controller.dynamic_enabled", bool(enabled))
 
+    def ground_truth(self, omegas) -> None:
+        """Publish the last sample's true slip rates (``~/omega_true_k``, stamped with it)."""
+        self.node.publish_truth(self._stamp, omegas)
+
     def step(self, meas):
         node = self.node
         stamp = self.base_ns + round(self.count * self._period * 1e9)
+        self._stamp = stamp
         self.count += 1
         if not self.lockstep:
             if self._next_wall is None:

@@ -171,7 +171,9 @@ def run_mujoco_loop(
         controller_factory: called with SlipControl's arguments instead of
             :class:`lugrip.SlipControl` (an object with its ``step``, ``reset``, ``settings``,
             ``request_*`` and ``set_dynamic_enabled``): ``lugrip ros sim`` puts the controller
-            on the other side of the ROS 2 middleware this way.
+            on the other side of the ROS 2 middleware this way. An object with a
+            ``ground_truth(omegas)`` method gets each sample's ``omega_true_0/1`` after its
+            step (published for recordings).
 
     Returns:
         :class:`MujocoRun`, one row per sensor sample.
@@ -500,6 +502,8 @@ def run_mujoco_loop(
             cols[f"pad_deflection_{k}"][i] = math.hypot(d.qpos[q[f"p{k}x"]], d.qpos[q[f"p{k}y"]])
             cols[f"pad_twist_{k}"][i] = twist[k]
             cols[f"contact_{k}"][i] = int(in_contact[k])
+        if started and hasattr(ctrl, "ground_truth"):  # a remote controller's recording
+            ctrl.ground_truth([cols[f"omega_true_{k}"][i] for k in (0, 1)])
         row_ok = math.isfinite(command) and all(
             math.isfinite(cols[c][i]) for c in ("slip", "theta")
         )
