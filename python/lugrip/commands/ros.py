@@ -109,6 +109,10 @@ def _run_record(args) -> int:
     if args.out.exists():
         raise CliError(f"{args.out}: exists (a new directory is written)")
     rclpy.init(args=_init_args(args))
+    import signal
+
+    # SIGTERM is how a recording is normally ended: stop spinning, close the file, report
+    signal.signal(signal.SIGTERM, lambda signum, frame: rclpy.try_shutdown())
     try:
         counts = record(args.out, args.topics, args.duration)
     finally:
