@@ -8,7 +8,6 @@ import pytest
 
 import lugrip
 from lugrip.io import contact_wrench
-from lugrip.io._ros import to_contact
 
 
 def test_contact_wrench_flip_and_offset_against_a_hand_computed_wrench():
@@ -32,15 +31,19 @@ def test_contact_wrench_flip_and_offset_against_a_hand_computed_wrench():
 
 
 def test_batch_and_row_agree_with_the_log_readers_rule():
-    """A batch uses the log readers' floor (5 % of the median pressing force); rows above it
-    get the same tau one by one with that floor."""
+    """A batch uses the log readers' floor (5 % of the median pressing force): tau moved to
+    the centre of pressure above it (the formula written out here in numpy), m_z below; rows
+    one by one with that floor give the same values."""
     rng = np.random.default_rng(3)
     f = np.c_[rng.normal(0, 0.5, (50, 2)), rng.uniform(0.0, 8.0, 50)]
     m = rng.normal(0, 1e-3, (50, 3))
     batch = contact_wrench(f, m, contact_offset=0.01)
-    tau, _ = to_contact(f, m, 0.01)
-    np.testing.assert_array_equal(batch[:, 3], tau)
     floor = max(1e-3, 0.05 * float(np.median(f[:, 2][f[:, 2] > 0])))
+    x = -(m[:, 1] + 0.01 * f[:, 0]) / f[:, 2]
+    y = (m[:, 0] - 0.01 * f[:, 1]) / f[:, 2]
+    tau = np.where(f[:, 2] > floor, m[:, 2] - x * f[:, 1] + y * f[:, 0], m[:, 2])
+    np.testing.assert_allclose(batch[:, 3], tau, rtol=1e-14, atol=1e-18)
+    assert np.any(f[:, 2] <= floor) and np.any(f[:, 2] > floor)
     rows = np.array([contact_wrench(f[i], m[i], contact_offset=0.01, floor=floor)
                      for i in range(50)])
     np.testing.assert_allclose(rows, batch, rtol=0, atol=1e-15)

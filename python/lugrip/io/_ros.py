@@ -15,6 +15,7 @@ from typing import Any
 
 import numpy as np
 
+from .. import _core
 from ._log import LogError, LogWarning, _Locator
 
 _DEFAULT_WRENCH_TOPIC = "/lugrip/wrench"
@@ -283,60 +284,39 @@ def contact_floor(f_n: np.ndarray) -> float:
     return max(1e-3, 0.05 * float(np.median(pressed))) if pressed.size else np.inf
 
 
-def to_contact(f: np.ndarray, m: np.ndarray, offset: float,
-               floor: float | None = None) -> tuple[np.ndarray, np.ndarray]:
-    """Torsional moment about the contact normal at the centre of pressure, from the wrench
-    (f, m) [N], [N m] of shape (n, 3) measured at a sensor origin ``offset`` [m] behind the
-    pad surface along the normal (the frame has f_n = f[:, 2] > 0 in contact; the surface is
-    the plane z = -offset). Returns (tau [N m], centre of pressure (n, 2) [m]); samples whose
-    normal force is not above ``floor`` [N] (None: :func:`contact_floor` of the batch) keep
-    m_z and get a NaN centre (docs/sliding_log.md, "Wrench at the sensor origin")."""
-    fx, fy, fz = f[:, 0], f[:, 1], f[:, 2]
-    mx, my, mz = m[:, 0], m[:, 1], m[:, 2]
-    if floor is None:
-        floor = contact_floor(fz)
-    ok = np.isfinite(fz) & (fz > floor)
-    x = np.full(len(fz), np.nan)
-    y = np.full(len(fz), np.nan)
-    x[ok] = -(my[ok] + offset * fx[ok]) / fz[ok]
-    y[ok] = (mx[ok] - offset * fy[ok]) / fz[ok]
-    tau = mz.copy()
-    tau[ok] = mz[ok] - x[ok] * fy[ok] + y[ok] * fx[ok]
-    return tau, np.c_[x, y]
-
-
 def contact_wrench(force, moment, *, flip_normal: bool = False,
                    contact_offset: float | None = None,
                    floor: float | None = None) -> np.ndarray:
     """A fingertip sensor's wrench in lugrip's contact frame: rows (f_n, f_x, f_y, tau), the
     layout :meth:`lugrip.SlipControl.step` takes, from force and moment [N], [N m] of shape
-    (3,) or (n, 3) in the sensor's frame (a ``geometry_msgs/Wrench``). The one transform of
-    the log readers (:func:`lugrip.io.read_log`) and the ROS node (:mod:`lugrip.ros`):
+    (3,) or (n, 3) in the sensor's frame (a ``geometry_msgs/Wrench``). The C++ core's
+    ``lugrip::contact_wrench`` (include/lugrip/sensor_frame.hpp), shared by the log readers
+    (:func:`lugrip.io.read_log`), the ROS node (:mod:`lugrip.ros`) and C++ robot loops:
 
     * ``flip_normal``: the sensor's z axis points toward the object, so its force z is
       negative while pressed: the frame is rotated by pi about x (y and z of force and
       moment change sign) so that f_n > 0 in contact;
     * ``contact_offset`` [m] (None: the wrench is already at the contact): the sensor origin
       lies this far behind the pad surface along the normal; the torsional moment is moved
-      to the centre of pressure (:func:`to_contact`; ``floor`` as there).
+      to the centre of pressure, x = -(m_y + d f_x) / f_z, y = (m_x - d f_y) / f_z,
+      tau = m_z - x f_y + y f_x (docs/sliding_log.md, "Wrench at the sensor origin"), where
+      f_z > ``floor`` [N]; below it tau = m_z. ``floor`` None: :func:`contact_floor` of the
+      batch (one wrench: 1 mN).
 
     Returns shape (4,) for one wrench, (n, 4) for n."""
+    offset = -1.0 if contact_offset is None else float(contact_offset)
     f = np.asarray(force, dtype=np.float64)
     m = np.asarray(moment, dtype=np.float64)
-    one = f.ndim == 1
-    f, m = np.atleast_2d(f), np.atleast_2d(m)
-    if f.shape != m.shape or f.shape[1] != 3:
+    if f.shape == (3,) and m.shape == (3,):
+        return np.array(_core.contact_wrench(f.tolist(), m.tolist(), bool(flip_normal), offset,
+                                             1e-3 if floor is None else float(floor)))
+    if f.ndim != 2 or f.shape != m.shape or f.shape[1] != 3:
         raise ValueError(f"force and moment: expected shape (3,) or (n, 3) each, got "
                          f"{np.shape(force)} and {np.shape(moment)}")
-    sign = -1.0 if flip_normal else 1.0  # rotation by pi about x: y and z components flip
-    f = f * [1.0, sign, sign]
-    m = m * [1.0, sign, sign]
-    if contact_offset is None:
-        tau = m[:, 2]
-    else:
-        tau, _cop = to_contact(f, m, float(contact_offset), floor)
-    out = np.c_[f[:, 2], f[:, 0], f[:, 1], tau]
-    return out[0] if one else out
+    if floor is None:
+        floor = contact_floor(f[:, 2] * (-1.0 if flip_normal else 1.0))
+    return _core.contact_wrenches(np.ascontiguousarray(f), np.ascontiguousarray(m),
+                                  bool(flip_normal), offset, float(floor))
 
 
 def _metadata_t0(src: RosSource) -> int:

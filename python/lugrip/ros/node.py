@@ -61,6 +61,9 @@ CAUSES = {
     "silent": "a finger sent nothing for silence_timeout",
 }
 
+_MODES = {int(m): m.name for m in ControllerMode}
+_STATUS_NAMES = {int(st): st.name for st in Status}
+
 _TYPES = {"float": ParameterType.PARAMETER_DOUBLE, "int": ParameterType.PARAMETER_INTEGER,
           "bool": ParameterType.PARAMETER_BOOL, "string": ParameterType.PARAMETER_STRING}
 
@@ -248,6 +251,7 @@ class SlipControlNode(LifecycleNode):
                                                lambda msg, k=k: self._on_wrench(k, msg), qos)
                       for k, topic in enumerate(list(self._io("wrench_topics"))[:n])]
         self._load_timing()
+        self._status = self._status_message()
         self._reset_controller()
         self._timer = self.create_timer(float(self._io("watchdog_period")), self._watchdog)
         self._active = True
@@ -352,7 +356,7 @@ class SlipControlNode(LifecycleNode):
             self._fault("wrong_frame", f"finger {k}: frame_id '{msg.header.frame_id}', "
                         f"expected '{frame}'")
             row = np.full(4, np.nan)
-        elif not np.all(np.isfinite(row)):
+        elif not all(map(math.isfinite, row)):
             self._fault("nan_wrench", f"finger {k}: non-finite wrench at stamp {stamp} ns")
             row = np.full(4, np.nan)
         self._queues[k].append((stamp, row))
@@ -372,7 +376,7 @@ class SlipControlNode(LifecycleNode):
             if abs(t0 - t1) <= skew:
                 q0.popleft()
                 q1.popleft()
-                self._step(max(t0, t1), np.vstack((w0, w1)))
+                self._step(max(t0, t1), np.array((w0, w1)))
             elif t0 < t1:  # finger 1 has nothing at t0 and never will (its stamps increase)
                 q0.popleft()
                 self._fault("missing", f"finger 1: no sample within {skew} ns of {t0} ns")
@@ -415,31 +419,41 @@ class SlipControlNode(LifecycleNode):
             self._pubs["joint"].publish(js)
         self._publish_status(sec, nsec, out)
 
+    def _status_message(self) -> DiagnosticArray:
+        """The ~/status message, built once per activation; each sample fills its values."""
+        arr = DiagnosticArray()
+        keys = ("command", "command_issued", "mode", "mu_belief", "held", "status",
+                "static_force", "dynamic_force", "pivot_finished", "pivot_end")
+        arr.status.append(DiagnosticStatus(name=f"{self.get_name()}: controller",
+                                           values=[KeyValue(key=k) for k in keys]))
+        for k in range(self._sc.fingers):
+            arr.status.append(DiagnosticStatus(
+                name=f"{self.get_name()}: finger {k}",
+                values=[KeyValue(key=key) for key in ("S", "omega_hat", "c_tilde", "status")]))
+        return arr
+
     def _publish_status(self, sec: int, nsec: int, out) -> None:
         c = out.controller
-        arr = DiagnosticArray()
+        arr = self._status
         arr.header.stamp.sec, arr.header.stamp.nanosec = int(sec), int(nsec)
         held = bool(c.held)
-        code = int(getattr(out.status, "value", out.status))
-        top = DiagnosticStatus(
-            level=DiagnosticStatus.WARN if held else DiagnosticStatus.OK,
-            name=f"{self.get_name()}: controller", message="held" if held else "ok",
-            values=_key_values({
-                "command": float(out.force), "command_issued": int(c.command_issued),
-                "mode": ControllerMode(int(getattr(c.mode, "value", c.mode))).name,
-                "mu_belief": float(c.mu_belief), "held": int(held), "status": code,
-                "static_force": float(c.static_force), "dynamic_force": float(c.dynamic_force),
-                "pivot_finished": int(c.pivot_finished),
-                "pivot_end": int(getattr(c.pivot_end, "value", c.pivot_end)),
-            }))
-        arr.status.append(top)
-        for k, o in enumerate(out.fingers):
+        top = arr.status[0]
+        top.level = DiagnosticStatus.WARN if held else DiagnosticStatus.OK
+        top.message = "held" if held else "ok"
+        values = (repr(float(out.force)), str(int(c.command_issued)),
+                  _MODES[int(getattr(c.mode, "value", c.mode))], repr(float(c.mu_belief)),
+                  str(int(held)), str(int(getattr(out.status, "value", out.status))),
+                  repr(float(c.static_force)), repr(float(c.dynamic_force)),
+                  str(int(c.pivot_finished)), str(int(getattr(c.pivot_end, "value", c.pivot_end))))
+        for kv, v in zip(top.values, values):
+            kv.value = v
+        for status, o in zip(arr.status[1:], out.fingers):
             st = int(getattr(o.status, "value", o.status))
-            arr.status.append(DiagnosticStatus(
-                level=DiagnosticStatus.OK if st == 0 else DiagnosticStatus.WARN,
-                name=f"{self.get_name()}: finger {k}", message=Status(st).name,
-                values=_key_values({"S": float(o.S), "omega_hat": float(o.omega_hat),
-                                    "c_tilde": float(o.c_tilde), "status": st})))
+            status.level = DiagnosticStatus.OK if st == 0 else DiagnosticStatus.WARN
+            status.message = _STATUS_NAMES[st]
+            for kv, v in zip(status.values, (repr(float(o.S)), repr(float(o.omega_hat)),
+                                             repr(float(o.c_tilde)), str(st))):
+                kv.value = v
         self._pubs["status"].publish(arr)
 
     # --- watchdog and /diagnostics ---------------------------------------------------------

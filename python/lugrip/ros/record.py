@@ -33,8 +33,9 @@ def _message_class(type_name: str):
 
 
 class Recorder(Node):
-    """Subscribes to ``topics`` (best effort, so it matches every publisher) as they appear
-    and writes each message as received."""
+    """Subscribes to ``topics`` as their publishers appear (reliable when every publisher
+    offers it, else best effort, as ``ros2 bag record`` does) and writes each message as
+    received."""
 
     def __init__(self, out: str | Path, topics: list[str], name: str = "lugrip_recorder"):
         super().__init__(name)
@@ -50,8 +51,6 @@ class Recorder(Node):
         self.wanted = [t if t.startswith("/") else "/" + t for t in topics]
         self.connections: dict[str, object] = {}
         self.counts: dict[str, int] = {}
-        self.qos = QoSProfile(reliability=ReliabilityPolicy.BEST_EFFORT,
-                              history=HistoryPolicy.KEEP_LAST, depth=1000)
         self.create_timer(0.2, self._discover)
         self._discover()
 
@@ -65,12 +64,21 @@ class Recorder(Node):
                 self.get_logger().warn(f"{topic}: type {type_name} unknown to rosbags; skipped")
                 self.connections[topic] = None
                 continue
+            infos = self.get_publishers_info_by_topic(topic)
+            if not infos:
+                continue  # the topic is known but its publisher not yet: next round
             conn = self.writer.add_connection(topic, type_name, typestore=self.typestore)
             self.connections[topic] = conn
             self.counts[topic] = 0
+            # as ros2 bag does: reliable when every publisher offers it, else best effort
+            reliable = all(i.qos_profile.reliability == ReliabilityPolicy.RELIABLE
+                           for i in infos)
+            qos = QoSProfile(reliability=ReliabilityPolicy.RELIABLE if reliable
+                             else ReliabilityPolicy.BEST_EFFORT,
+                             history=HistoryPolicy.KEEP_LAST, depth=1000)
             self.create_subscription(_message_class(type_name), topic,
                                      lambda raw, c=conn, t=topic: self._write(c, t, raw),
-                                     self.qos, raw=True)
+                                     qos, raw=True)
 
     def _write(self, conn, topic: str, raw: bytes) -> None:
         self.writer.write(conn, self.get_clock().now().nanoseconds, raw)

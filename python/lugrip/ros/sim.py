@@ -87,8 +87,10 @@ class GripperSimNode(Node):
                  frame_ids=("fingertip_0", "fingertip_1")):
         super().__init__(name)
         ns = "/" + controller.strip("/")
-        qos = QoSProfile(reliability=ReliabilityPolicy.BEST_EFFORT,
-                         history=HistoryPolicy.KEEP_LAST, depth=10)
+        # reliable (a test rig: recordings get every sample); best-effort subscribers such
+        # as the controller node's still match
+        qos = QoSProfile(reliability=ReliabilityPolicy.RELIABLE,
+                         history=HistoryPolicy.KEEP_LAST, depth=1000)
         self.frame_ids = list(frame_ids)
         self.wrench = [self.create_publisher(WrenchStamped, t, qos) for t in wrench_topics]
         self.truth = [self.create_publisher(TwistStamped, f"~/omega_true_{k}", qos)
