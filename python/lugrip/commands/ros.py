@@ -58,6 +58,7 @@ def register(subparsers) -> None:
                    help="write the metrics and criteria here")
     s.add_argument("--csv", type=Path, default=None, metavar="FILE",
                    help="write the run's columns here")
+    s.add_argument("--force", action="store_true", help="overwrite --json / --csv")
     c = sub.add_parser("record", help="topics to an MCAP file lugrip identify/replay read")
     c.add_argument("out", type=Path, metavar="OUT",
                    help="new rosbag2 directory; the file to read is OUT/OUT.mcap")
@@ -148,7 +149,11 @@ def _run_sim(args) -> int:
     import rclpy
 
     from ..ros.sim import RosTimeout, run_ros_scenario
+    from ._output import atomic_write, atomic_write_text, check_file
 
+    for what, path in (("--json", args.json), ("--csv", args.csv)):
+        if path is not None:  # the output policy, before the run
+            check_file(path, what, force=args.force)
     rclpy.init(args=_init_args(args))
     try:
         result = run_ros_scenario(args.scenario, controller=args.controller,
@@ -174,14 +179,17 @@ def _run_sim(args) -> int:
 
         doc = {"scenario": result["scenario"].name, "criteria": crit,
                "metrics": result["metrics"], "timeouts": result["timeouts"]}
-        args.json.write_text(json.dumps(_jsonable(doc), indent=1))
+        atomic_write_text(args.json, json.dumps(_jsonable(doc), indent=1), "--json",
+                          force=args.force)
     if args.csv is not None:
         import numpy as np
 
         run = result["run"]
         names = list(run)
-        np.savetxt(args.csv, np.column_stack([np.asarray(run[n], dtype=float) for n in names]),
-                   delimiter=",", header=",".join(names), comments="")
+        table = np.column_stack([np.asarray(run[n], dtype=float) for n in names])
+        atomic_write(args.csv, lambda fh: np.savetxt(fh, table, delimiter=",",
+                                                     header=",".join(names), comments=""),
+                     "--csv", force=args.force)
     print(f"{result['scenario'].name} over ROS 2: {'FAIL' if failed else 'pass'}",
           file=sys.stderr if failed else sys.stdout)
     return 1 if failed or result["timeouts"] else 0
