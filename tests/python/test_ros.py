@@ -161,23 +161,49 @@ def test_identified_yaml_gives_the_defaults(tmp_path):
     assert specs["observer.bandwidth"] == 1234.0 and specs["observer.torque_noise"] == 2e-5
 
 
-def test_lifecycle_transitions_and_parameter_changes():
+def test_lifecycle_transitions_and_parameter_changes(tmp_path):
     """configure -> activate -> deactivate -> cleanup over the lifecycle services of a node in
-    another process; fixed settings refused while active with the reason, invalid values
-    refused with the core's reason, mu accepted while active. No plant."""
+    another process started with an identified YAML (its mu and observer become the
+    parameters); descriptors carry the unit and whether a setting may change while active;
+    fixed settings refused while active with the reason, invalid values refused with the
+    core's reason, mu accepted while active; the Trigger services (created at configure) refuse unless active. No
+    plant."""
+    from lugrip import ContactParams
+    from rcl_interfaces.srv import DescribeParameters, GetParameters
+    from std_srvs.srv import Trigger
+
+    fit = tmp_path / "fit.yaml"
+    ContactParams.table1().replace(mu=0.31).to_yaml(fit, observer={"bandwidth": 1500.0})
     domain = _DOMAIN_BASE
-    proc = _lugrip("run", "--no-autostart", domain=domain)
+    proc = _lugrip("run", str(fit), "--no-autostart", domain=domain)
     d = _Driver(domain)
     try:
         assert d.state() == "unconfigured"
+        got = d.call(d.node.create_client(GetParameters, "/lugrip/get_parameters"),
+                     GetParameters.Request(names=["contact.mu", "observer.bandwidth"])).values
+        assert [v.double_value for v in got] == [0.31, 1500.0]
+        desc = d.call(d.node.create_client(DescribeParameters, "/lugrip/describe_parameters"),
+                      DescribeParameters.Request(names=["controller.f_max",
+                                                        "controller.k_cd"])).descriptors
+        assert "unit: N;" in desc[0].additional_constraints
+        assert "may change while active" in desc[0].additional_constraints
+        assert "fixed while active" in desc[1].additional_constraints
+        assert desc[0].description == "maximum force [N]"
+
         r = d.set("controller.f_max", 0.05)  # below f_min = 0.1
         assert not r.successful and "f_max" in r.reason
         assert d.transition(Transition.TRANSITION_CONFIGURE) and d.state() == "inactive"
+        pivot = d.node.create_client(Trigger, "/lugrip/pivot")
+        r = d.call(pivot, Trigger.Request())
+        assert not r.success and "not active" in r.message
         assert d.transition(Transition.TRANSITION_ACTIVATE) and d.state() == "active"
         r = d.set("controller.sensor_rate", 1000.0)
         assert not r.successful and "controller.sensor_rate" in r.reason and "active" in r.reason
         assert d.set("contact.mu", 0.4).successful
         assert d.set("controller.k_p", 2.0).successful
+        for name in ("pivot", "slipping_avoidance", "reset"):
+            r = d.call(d.node.create_client(Trigger, f"/lugrip/{name}"), Trigger.Request())
+            assert r.success, (name, r.message)
         r = d.set("contact.mu", -1.0)
         assert not r.successful and "mu" in r.reason
         assert d.transition(Transition.TRANSITION_DEACTIVATE) and d.state() == "inactive"
