@@ -167,22 +167,23 @@ class GripperSimNode(Node):
         self.transition(Transition.TRANSITION_ACTIVATE)
         self.wait_for_controller()
 
+    def _stamped(self, cls, stamp_ns: int, k: int):
+        msg = cls()
+        msg.header.stamp.sec, msg.header.stamp.nanosec = divmod(int(stamp_ns), 1_000_000_000)
+        msg.header.frame_id = self.frame_ids[k]
+        return msg
+
     def publish_truth(self, stamp_ns: int, omegas) -> None:
         """The true slip rate of the object relative to each pad [rad/s] (angular.z)."""
-        sec, nsec = divmod(stamp_ns, 1_000_000_000)
         for k, pub in enumerate(self.truth):
-            msg = TwistStamped()
-            msg.header.stamp.sec, msg.header.stamp.nanosec = int(sec), int(nsec)
-            msg.header.frame_id = self.frame_ids[k]
+            msg = self._stamped(TwistStamped, stamp_ns, k)
             msg.twist.angular.z = float(omegas[k])
             pub.publish(msg)
 
     def publish(self, stamp_ns: int, meas) -> None:
-        sec, nsec = divmod(stamp_ns, 1_000_000_000)
+        """One sample's wrenches, rows (f_n, f_x, f_y, tau) per finger, as the sensor reads."""
         for k, pub in enumerate(self.wrench):
-            msg = WrenchStamped()
-            msg.header.stamp.sec, msg.header.stamp.nanosec = int(sec), int(nsec)
-            msg.header.frame_id = self.frame_ids[k]
+            msg = self._stamped(WrenchStamped, stamp_ns, k)
             f_n, f_x, f_y, tau = (float(x) for x in meas[k])
             msg.wrench.force.x, msg.wrench.force.y, msg.wrench.force.z = f_x, f_y, f_n
             msg.wrench.torque.z = tau
