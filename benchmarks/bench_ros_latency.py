@@ -130,6 +130,7 @@ def main(argv=None) -> int:
         time.sleep(0.5)
         cpu = _cpu_seconds(node.pid) - cpu0
         lat_s = [rx.status[s] - t for s, t in sent.items() if s in rx.status]
+        slow = sum(1 for s, t in sent.items() if s in rx.status and rx.status[s] - t > 1e7)
         lat_c = [rx.command[s] - t for s, t in sent.items() if s in rx.command]
         rows = []
         base = 10**9 + int(args.seconds * 1e9) + 10**9
@@ -153,7 +154,8 @@ def main(argv=None) -> int:
         "",
         f"`python benchmarks/bench_ros_latency.py --seconds {args.seconds:g}`: `lugrip ros run` "
         f"pinned to core {args.core} (taskset), two fingertips' WrenchStamped published at 500 Hz "
-        f"for {args.seconds:g} s by another process on the same machine (ROS 2 Kilted pip wheels, "
+        f"for {args.seconds:g} s by another process on the same machine, both at normal priority "
+        f"(ROS 2 Kilted pip wheels, "
         f"rclpy, Fast DDS; CPython {platform.python_version()}; load average {load0:.1f} before, "
         f"{load1:.1f} after, on a 2-core machine shared with other jobs).",
         "",
@@ -162,7 +164,8 @@ def main(argv=None) -> int:
         f"| `~/joint_command` (command samples, 50 Hz) | {len(lat_c)} | {p_c[0]:.3f} | {p_c[1]:.3f} | {p_c[2]:.3f} |",
         f"| `~/status` (every sample) | {len(lat_s)} | {p_s[0]:.3f} | {p_s[1]:.3f} | {p_s[2]:.3f} |",
         "",
-        f"Samples answered at 500 Hz: {len(lat_s)} of {len(sent)}; node CPU "
+        f"Samples answered at 500 Hz: {len(lat_s)} of {len(sent)}, {slow} of them after more "
+        f"than 10 ms; node CPU "
         f"{cpu / len(sent) * 1e6:.0f} µs per sample ({100 * cpu / args.seconds:.0f} % of its core).",
         "",
         f"| rate pushed [Hz] ({args.burst:g} s each) | samples answered | node CPU per sample [µs] |",
