@@ -240,6 +240,11 @@ class SlipControlNode(LifecycleNode):
         return values * n if len(values) == 1 else values
 
     def on_activate(self, state: LifecycleState) -> TransitionCallbackReturn:
+        try:
+            self._check_io()  # inputs may have changed while inactive
+        except ValueError as err:
+            self.get_logger().error(f"activate failed: {' '.join(str(err).split())}")
+            return TransitionCallbackReturn.FAILURE
         n = self._sc.fingers
         self._frames = [f or None for f in self._per_finger("frame_ids", "")]
         self._flip = [bool(x) for x in self._per_finger("flip_normal", False)]

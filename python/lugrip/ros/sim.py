@@ -66,9 +66,11 @@ def _parse(status) -> dict[str, Any]:
 
 
 def parameter_value(value) -> ParameterValue:
-    """An rcl_interfaces ParameterValue of a bool, int, str or float."""
+    """An rcl_interfaces ParameterValue of a bool, int, str, float or a list of str."""
     v = ParameterValue()
-    if isinstance(value, bool):
+    if isinstance(value, list):
+        v.type, v.string_array_value = ParameterType.PARAMETER_STRING_ARRAY, [str(x) for x in value]
+    elif isinstance(value, bool):
         v.type, v.bool_value = ParameterType.PARAMETER_BOOL, value
     elif isinstance(value, int):
         v.type, v.integer_value = ParameterType.PARAMETER_INTEGER, value
