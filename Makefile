@@ -67,7 +67,7 @@ $(VENV)/.ros: $(VENV)/.installed pyproject.toml
 test-python: install $(VENV)/.ros
 	$(VPY) -m pytest -q tests/python
 
-# `make bench`: every section of BENCHMARKS.md, ~5 minutes; ratios come from one run.
+# `make bench`: every section of BENCHMARKS.md, ~7 minutes; ratios come from one run.
 
 # Debug build of the C++ tests with AddressSanitizer and UBSan.
 sanitize:
@@ -82,7 +82,7 @@ sanitize-campaign:
 	cmake --build build/asan-campaign -j $(JOBS) --target lugrip_fuzz_campaign
 	UBSAN_OPTIONS=halt_on_error=1:print_stacktrace=1 build/asan-campaign/tests/fuzz/lugrip_fuzz_campaign --samples 200000 --seed 3
 
-bench: install
+bench: install $(VENV)/.ros
 	cmake -S . -B $(CPP_BUILD) -DCMAKE_BUILD_TYPE=Release -DLUGRIP_BUILD_TESTS=ON -DLUGRIP_BUILD_BENCHMARKS=ON > /dev/null
 	cmake --build $(CPP_BUILD) -j $(JOBS)
 	$(VPY) benchmarks/run_benchmarks.py --cpp-dir $(CPP_BUILD)/benchmarks --out BENCHMARKS.md
@@ -91,6 +91,7 @@ bench: install
 	$(VPY) benchmarks/bench_slip_control.py --out BENCHMARKS.md
 	$(VPY) benchmarks/bench_rigs.py --out BENCHMARKS.md
 	$(VPY) benchmarks/bench_mujoco_rig.py --out BENCHMARKS.md
+	$(VPY) benchmarks/bench_ros_latency.py --out BENCHMARKS.md
 	$(CPP_BUILD)/benchmarks/bench_closed_loop --markdown > build/issue5.md
 	$(VPY) benchmarks/sections.py BENCHMARKS.md issue5 build/issue5.md
 
