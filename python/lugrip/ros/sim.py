@@ -232,6 +232,8 @@ class RemoteSlipControl:
         self.count = 0
         self.force = float(ctrl.f_min)
         self.timeouts = 0
+        self._last_status = None
+        self._mu = float(_as_params(params).mu)
         self.latencies: list[float] = []
         self._next_wall = None
 
@@ -283,10 +285,12 @@ class RemoteSlipControl:
                 self.timeouts += 1
             elif status["controller"]["command_issued"]:
                 self.latencies.append(time.perf_counter() - sent)
-        else:
+        else:  # the newest status received so far (the node answers a sample or more later)
             rclpy.spin_once(node, timeout_sec=0.0)
-            status = node.statuses.pop(max(node.statuses), None) if node.statuses else None
-            node.statuses.clear()
+            if node.statuses:
+                self._last_status = node.statuses[max(node.statuses)]
+                node.statuses.clear()
+            status = self._last_status
         if node.commands:
             self.force = node.commands.pop(stamp, node.last_command)
             node.commands.clear()
@@ -297,7 +301,7 @@ class RemoteSlipControl:
             finger = SimpleNamespace(omega_hat=0.0, S=0.0, c_tilde=0.0, status=4)
             ctrl = SimpleNamespace(command_issued=0, pivot_finished=0, pivot_end=0,
                                    static_force=self.force, dynamic_force=0.0,
-                                   mu_belief=float("nan"), mode=0)
+                                   mu_belief=self._mu, mode=0)
             return SimpleNamespace(force=self.force, status=4, controller=ctrl,
                                    fingers=[finger, finger])
         c = status["controller"]
