@@ -56,10 +56,18 @@ test-cpp: deps-cpp
 	cmake --build $(CPP_BUILD) -j $(JOBS)
 	cd $(CPP_BUILD) && ctest --output-on-failure -j $(JOBS)
 
-test-python: install
+# the [ros] extra's wheels (ROS 2 Kilted: rclpy, Fast DDS, messages) for tests/python/test_ros.py,
+# read from pyproject.toml and installed beside lugrip without rebuilding it
+$(VENV)/.ros: $(VENV)/.installed pyproject.toml
+# (the wheels are for Python 3.11: older Pythons, without tomllib, skip them and the test)
+	$(VPY) -c "import tomllib; print('\n'.join(tomllib.load(open('pyproject.toml', 'rb'))['project']['optional-dependencies']['ros']))" 2> /dev/null \
+	  | xargs -r $(VPY) -m pip install -q
+	@touch $@
+
+test-python: install $(VENV)/.ros
 	$(VPY) -m pytest -q tests/python
 
-# `make bench`: every section of BENCHMARKS.md, ~5 minutes; ratios come from one run.
+# `make bench`: every section of BENCHMARKS.md, ~7 minutes; ratios come from one run.
 
 # Debug build of the C++ tests with AddressSanitizer and UBSan.
 sanitize:
@@ -74,7 +82,7 @@ sanitize-campaign:
 	cmake --build build/asan-campaign -j $(JOBS) --target lugrip_fuzz_campaign
 	UBSAN_OPTIONS=halt_on_error=1:print_stacktrace=1 build/asan-campaign/tests/fuzz/lugrip_fuzz_campaign --samples 200000 --seed 3
 
-bench: install
+bench: install $(VENV)/.ros
 	cmake -S . -B $(CPP_BUILD) -DCMAKE_BUILD_TYPE=Release -DLUGRIP_BUILD_TESTS=ON -DLUGRIP_BUILD_BENCHMARKS=ON > /dev/null
 	cmake --build $(CPP_BUILD) -j $(JOBS)
 	$(VPY) benchmarks/run_benchmarks.py --cpp-dir $(CPP_BUILD)/benchmarks --out BENCHMARKS.md
@@ -83,6 +91,7 @@ bench: install
 	$(VPY) benchmarks/bench_slip_control.py --out BENCHMARKS.md
 	$(VPY) benchmarks/bench_rigs.py --out BENCHMARKS.md
 	$(VPY) benchmarks/bench_mujoco_rig.py --out BENCHMARKS.md
+	$(VPY) benchmarks/bench_ros_latency.py --out BENCHMARKS.md
 	$(CPP_BUILD)/benchmarks/bench_closed_loop --markdown > build/issue5.md
 	$(VPY) benchmarks/sections.py BENCHMARKS.md issue5 build/issue5.md
 

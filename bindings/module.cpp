@@ -14,6 +14,7 @@ void bind_slip_control(nb::module_& m);
 void bind_plant(nb::module_& m);
 void bind_closed_loop(nb::module_& m);
 void bind_identification(nb::module_& m);
+void bind_frame(nb::module_& m);
 }  // namespace lugrip_bind
 
 NB_MODULE(_core, m) {
@@ -27,4 +28,5 @@ NB_MODULE(_core, m) {
   lugrip_bind::bind_plant(m);
   lugrip_bind::bind_closed_loop(m);
   lugrip_bind::bind_identification(m);
+  lugrip_bind::bind_frame(m);
 }

@@ -9,6 +9,7 @@
 #include "lugrip/limit_surface.hpp"
 #include "lugrip/observer.hpp"
 #include "lugrip/params.hpp"
+#include "lugrip/sensor_frame.hpp"
 #include "lugrip/slider_model.hpp"
 #include "lugrip/slip_control.hpp"
 #include "lugrip/status.hpp"

@@ -173,7 +173,9 @@ class SlipControl(NoCopy):
 
         Args:
             wrenches: (fingers, 4) values (f_n, f_x, f_y, tau) per finger, a float64 array for
-                the fast path (any array-like is converted). One finger also takes (4,).
+                the fast path (any array-like is converted). One finger also takes (4,), and
+                a (2, 4) array's first row; any other shape (a transposed (4, 2), a flat (8,))
+                raises ValueError.
             dt: [s] time since the previous cycle; 0 means the nominal period.
             command: when this cycle computes a command: ``"clock"`` (the first cycle after
                 reset and every ``command_ratio``-th after it), ``"now"`` (from the samples up
@@ -191,6 +193,15 @@ class SlipControl(NoCopy):
         code = _COMMAND_CODES.get(command)
         if code is None:
             raise ValueError(f"command {command!r}: expected one of {list(_COMMAND_CODES)}")
+        if not isinstance(wrenches, np.ndarray):
+            wrenches = np.ascontiguousarray(wrenches, dtype=np.float64)
+        shape = wrenches.shape
+        n = self._sc.fingers
+        if shape != (n, 4) and not (n == 1 and shape in ((4,), (2, 4))):
+            # a transposed (4, 2) or a flat (8,) array would otherwise be read row by row
+            one = ", or (4,)" if n == 1 else ""
+            raise ValueError(f"wrenches of shape {shape}: expected 4 values (f_n, f_x, f_y, "
+                             f"tau) per finger, a ({n}, 4) array{one}")
         try:
             return self._sc.step(wrenches, dt, code)
         except TypeError:

@@ -41,6 +41,7 @@ COMMANDS: list[str] = [
     "simulate",
     "demo",
     "campaign",
+    "ros",
 ]
 """Module names (in this package) of the subcommands, in --help order."""
 

@@ -78,7 +78,7 @@ def add_log_options(parser: argparse.ArgumentParser, *, wrench_topic: bool = Tru
     if omega_topic:
         r.add_argument("--omega-topic", metavar="TOPIC",
                        help="ground-truth angular velocity topic (Twist[Stamped] angular.z, "
-                            "Vector3[Stamped] z, Float64)")
+                            "Vector3[Stamped] z, Float64, or a PoseStamped differentiated)")
     if maneuvers:
         r.add_argument("--maneuver-topic", metavar="TOPIC",
                        help="std_msgs integer topic of maneuver ids (MCAP, bags)")

@@ -81,11 +81,15 @@ def load_maneuvers(
     for j, log in enumerate(_as_logs(logs)):
         name = log.source or f"log{j}"
         if require_omega and (log.omega is None or not np.any(np.isfinite(log.omega))):
+            ros = ("; in a ROS bag or MCAP the ground truth is a topic of its own: name it "
+                   "with --omega-topic TOPIC (Python: omega_topic=), a TwistStamped, "
+                   "Vector3Stamped, Float64 or a PoseStamped to differentiate"
+                   if "wrench_topic" in log.meta and "omega_topic" not in log.meta else "")
             raise IdentificationError(
                 f"{name}: no ground-truth 'omega' column (sliding velocity [rad/s]): "
                 "identification minimises the observer's velocity error and needs it "
                 "(eq. 32); record the slider's angular velocity, e.g. from the robot's "
-                "encoders"
+                "encoders" + ros
             )
         dropped_invalid += int(np.count_nonzero(~log.valid))
         segs = log.segments(max_gap)

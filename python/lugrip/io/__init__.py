@@ -53,6 +53,7 @@ from ._log import (
     SlidingLog,
     _validate,
 )
+from ._ros import contact_wrench
 from ._units import _expand_units, _unit_factor
 
 __all__ = [
@@ -65,6 +66,7 @@ __all__ = [
     "LogWarning",
     "MissingExtraError",
     "SlidingLog",
+    "contact_wrench",
     "find_maneuvers",
     "maneuvers_from_windows",
     "read_grasp_log",
@@ -199,9 +201,12 @@ def read_log(path: str | os.PathLike, *, format: str | None = None,
         wrench_topic: ROS sources: the ``geometry_msgs/WrenchStamped`` (or ``Wrench``) topic;
             default: the only wrench topic, or the one a lugrip-written MCAP names.
         omega_topic: ROS sources: ground-truth angular velocity about the sensor's z axis,
-            ``TwistStamped``/``Twist`` (angular.z), ``Vector3[Stamped]`` (z) or
-            ``Float64``/``Float32``; linearly resampled onto the wrench times (NaN outside its
-            time span and across gaps longer than 10 of its median periods).
+            ``TwistStamped``/``Twist`` (angular.z), ``Vector3[Stamped]`` (z),
+            ``Float64``/``Float32``, or a ``PoseStamped`` of the object in the fingertip's frame
+            (motion capture), differentiated: the rate of its twist angle about z,
+            2 atan2(q_z, q_w) unwrapped, by central differences on the stamps; linearly
+            resampled onto the wrench times (NaN outside its time span and across gaps longer
+            than 10 of its median periods).
         maneuver_topic: ROS sources: a ``std_msgs`` integer (or float holding integers) topic
             whose latest message at or before each wrench sample is that sample's maneuver id
             (header stamps against header stamps when both have them, else log times;

@@ -15,6 +15,7 @@ from typing import Any
 
 import numpy as np
 
+from .. import _core
 from ._log import LogError, LogWarning, _Locator
 
 _DEFAULT_WRENCH_TOPIC = "/lugrip/wrench"
@@ -33,11 +34,17 @@ _TYPES: dict[str, tuple[bool, tuple[str, ...]]] = {
     "geometry_msgs/Twist": (False, ("angular.z",)),
     "geometry_msgs/Vector3Stamped": (True, ("vector.z",)),
     "geometry_msgs/Vector3": (False, ("z",)),
+    "geometry_msgs/PoseStamped": (True, tuple(f"pose.orientation.{a}" for a in "xyzw")),
     **{t: (False, ("data",)) for t in _FLOAT_TYPES + _INT_TYPES},
 }
 WRENCH_TYPES = ("geometry_msgs/WrenchStamped", "geometry_msgs/Wrench")
 OMEGA_TYPES = ("geometry_msgs/TwistStamped", "geometry_msgs/Twist",
-               "geometry_msgs/Vector3Stamped", "geometry_msgs/Vector3") + _FLOAT_TYPES
+               "geometry_msgs/Vector3Stamped", "geometry_msgs/Vector3",
+               "geometry_msgs/PoseStamped") + _FLOAT_TYPES
+#: Ground truth given as a pose (motion capture): differentiated by :func:`pose_rate`.
+POSE_TYPES = ("geometry_msgs/PoseStamped",)
+POSE_METHOD = ("d/dt of the twist angle about z, 2 atan2(q_z, q_w) (swing-twist "
+               "decomposition) unwrapped, by second-order central differences on the stamps")
 ID_TYPES = _INT_TYPES + _FLOAT_TYPES  # maneuver ids (floats must hold integers)
 SCALAR_TYPES = _FLOAT_TYPES + _INT_TYPES  # recorded commands and similar scalars
 #: Most messages read from one topic (about 330 bytes each in memory: 2e6 = 66 min at 500 Hz).
@@ -256,25 +263,60 @@ def hold_last(ns_src: np.ndarray, y_src: np.ndarray, ns_dst: np.ndarray,
     return np.where(k >= 0, y_src[np.maximum(k, 0)], before)
 
 
-def to_contact(f: np.ndarray, m: np.ndarray, offset: float) -> tuple[np.ndarray, np.ndarray]:
-    """Torsional moment about the contact normal at the centre of pressure, from the wrench
-    (f, m) [N], [N m] of shape (n, 3) measured at a sensor origin ``offset`` [m] behind the
-    pad surface along the normal (the frame has f_n = f[:, 2] > 0 in contact; the surface is
-    the plane z = -offset). Returns (tau [N m], centre of pressure (n, 2) [m]); samples
-    without a usable normal force keep m_z and get a NaN centre (docs/sliding_log.md,
-    "Wrench at the sensor origin")."""
-    fx, fy, fz = f[:, 0], f[:, 1], f[:, 2]
-    mx, my, mz = m[:, 0], m[:, 1], m[:, 2]
+def pose_rate(t: np.ndarray, quaternions: np.ndarray) -> np.ndarray:
+    """Angular velocity [rad/s] about z of a pose (object relative to the fingertip, z along
+    the contact normal; e.g. motion capture of both expressed in the fingertip's frame) from its
+    orientation quaternions (n, 4) as (x, y, z, w) at times t [s]: :data:`POSE_METHOD`. The
+    twist about z is the part of the rotation that slides the contact; the swing (tilt of the
+    normal) is left out."""
+    q = np.asarray(quaternions, dtype=np.float64)
+    angle = np.unwrap(2.0 * np.arctan2(q[:, 2], q[:, 3]))
+    if len(t) < 2:
+        return np.full(len(t), np.nan)
+    return np.gradient(angle, t)
+
+
+def contact_floor(f_n: np.ndarray) -> float:
+    """The normal force [N] below which a batch's centre of pressure is not located: 5 % of
+    the median pressing force, at least 1 mN (inf without a pressing sample)."""
+    fz = np.asarray(f_n, dtype=np.float64)
     pressed = fz[np.isfinite(fz) & (fz > 0)]
-    floor = max(1e-3, 0.05 * float(np.median(pressed))) if pressed.size else np.inf
-    ok = np.isfinite(fz) & (fz > floor)
-    x = np.full(len(fz), np.nan)
-    y = np.full(len(fz), np.nan)
-    x[ok] = -(my[ok] + offset * fx[ok]) / fz[ok]
-    y[ok] = (mx[ok] - offset * fy[ok]) / fz[ok]
-    tau = mz.copy()
-    tau[ok] = mz[ok] - x[ok] * fy[ok] + y[ok] * fx[ok]
-    return tau, np.c_[x, y]
+    return max(1e-3, 0.05 * float(np.median(pressed))) if pressed.size else np.inf
+
+
+def contact_wrench(force, moment, *, flip_normal: bool = False,
+                   contact_offset: float | None = None,
+                   floor: float | None = None) -> np.ndarray:
+    """A fingertip sensor's wrench in lugrip's contact frame: rows (f_n, f_x, f_y, tau), the
+    layout :meth:`lugrip.SlipControl.step` takes, from force and moment [N], [N m] of shape
+    (3,) or (n, 3) in the sensor's frame (a ``geometry_msgs/Wrench``). The C++ core's
+    ``lugrip::contact_wrench`` (include/lugrip/sensor_frame.hpp), shared by the log readers
+    (:func:`lugrip.io.read_log`), the ROS node (:mod:`lugrip.ros`) and C++ robot loops:
+
+    * ``flip_normal``: the sensor's z axis points toward the object, so its force z is
+      negative while pressed: the frame is rotated by pi about x (y and z of force and
+      moment change sign) so that f_n > 0 in contact;
+    * ``contact_offset`` [m] (None: the wrench is already at the contact): the sensor origin
+      lies this far behind the pad surface along the normal; the torsional moment is moved
+      to the centre of pressure, x = -(m_y + d f_x) / f_z, y = (m_x - d f_y) / f_z,
+      tau = m_z - x f_y + y f_x (docs/sliding_log.md, "Wrench at the sensor origin"), where
+      f_z > ``floor`` [N]; below it tau = m_z. ``floor`` None: :func:`contact_floor` of the
+      batch (one wrench: 1 mN).
+
+    Returns shape (4,) for one wrench, (n, 4) for n."""
+    offset = -1.0 if contact_offset is None else float(contact_offset)
+    f = np.asarray(force, dtype=np.float64)
+    m = np.asarray(moment, dtype=np.float64)
+    if f.shape == (3,) and m.shape == (3,):
+        return np.array(_core.contact_wrench(f.tolist(), m.tolist(), bool(flip_normal), offset,
+                                             1e-3 if floor is None else float(floor)))
+    if f.ndim != 2 or f.shape != m.shape or f.shape[1] != 3:
+        raise ValueError(f"force and moment: expected shape (3,) or (n, 3) each, got "
+                         f"{np.shape(force)} and {np.shape(moment)}")
+    if floor is None:
+        floor = contact_floor(f[:, 2] * (-1.0 if flip_normal else 1.0))
+    return _core.contact_wrenches(np.ascontiguousarray(f), np.ascontiguousarray(m),
+                                  bool(flip_normal), offset, float(floor))
 
 
 def _metadata_t0(src: RosSource) -> int:
@@ -320,14 +362,10 @@ def read_ros(src: RosSource, *, wrench_topic: str | None, omega_topic: str | Non
     t0 = _metadata_t0(src) if "t0_ns" in src.metadata else int(stamps[0])
     t = (stamps - t0) / 1e9
     v = np.asarray(wrench.values, dtype=np.float64)[keep]
-    sign = -1.0 if flip_normal else 1.0  # rotation by pi about x: y and z components flip
-    force = v[:, 0:3] * [1.0, sign, sign]
-    moment = v[:, 3:6] * [1.0, sign, sign]
-    if contact_offset is None:
-        tau = moment[:, 2]
-    else:
-        tau, _cop = to_contact(force, moment, float(contact_offset))
-    cols = {"t": t, "f_x": force[:, 0], "f_y": force[:, 1], "f_n": force[:, 2], "tau": tau}
+    sign = -1.0 if flip_normal else 1.0  # omega below: the same rotation by pi about x
+    w = contact_wrench(v[:, 0:3], v[:, 3:6], flip_normal=flip_normal,
+                       contact_offset=contact_offset)
+    cols = {"t": t, "f_x": w[:, 1], "f_y": w[:, 2], "f_n": w[:, 0], "tau": w[:, 3]}
     if src.metadata.get("force_vector") == "false":
         cols["f_t"] = np.hypot(cols.pop("f_x"), cols.pop("f_y"))
     prefix = "wrench." if _TYPES[wrench.type][0] else ""
@@ -349,11 +387,17 @@ def read_ros(src: RosSource, *, wrench_topic: str | None, omega_topic: str | Non
         o_ns, o_source = om.times(time_source)
         pick = ordered(file, om, o_ns, "omega", stacklevel + 1, o_source)
         o_t = (o_ns[pick] - t0) / 1e9
-        y = sign * np.asarray(om.values, dtype=np.float64)[pick, 0]
+        values = np.asarray(om.values, dtype=np.float64)[pick]
+        if om.type in POSE_TYPES:
+            y = sign * pose_rate(o_t, values)
+            fields["omega"] = f"pose of '{omega_topic}' differentiated: {POSE_METHOD}; resampled"
+            meta["omega_method"] = POSE_METHOD
+        else:
+            y = sign * values[:, 0]
+            fields["omega"] = f"{_TYPES[om.type][1][0]} of '{omega_topic}' resampled"
         step = np.diff(o_t)
         max_gap = 10.0 * float(np.median(step)) if step.size else 0.0
         cols["omega"] = resample(o_t, y, t, max_gap)
-        fields["omega"] = f"{_TYPES[om.type][1][0]} of '{omega_topic}' resampled"
         meta.update(omega_topic=omega_topic, omega_type=om.type, omega_time_source=o_source)
 
     if maneuver_topic is not None:

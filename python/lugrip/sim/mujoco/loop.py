@@ -150,6 +150,7 @@ def run_mujoco_loop(
     faults=None,
     stuck_samples: int | None = None,
     healthy_finger_fallback: bool = False,
+    controller_factory: Callable[..., Any] | None = None,
 ) -> MujocoRun:
     """Simulate the scenario's grasp on MuJoCo in closed loop for `duration` seconds.
 
@@ -168,6 +169,12 @@ def run_mujoco_loop(
             policy, as
             :func:`lugrip.sim.run_closed_loop` (the same C++ FaultInjector: sensor faults change
             the wrenches SlipControl receives, actuator faults the command the gripper gets).
+        controller_factory: called with SlipControl's arguments instead of
+            :class:`lugrip.SlipControl` (an object with its ``step``, ``reset``, ``settings``,
+            ``request_*`` and ``set_dynamic_enabled``): ``lugrip ros sim`` puts the controller
+            on the other side of the ROS 2 middleware this way. An object with a
+            ``ground_truth(omegas)`` method gets each sample's ``omega_true_0/1`` after its
+            step (published for recordings).
 
     Returns:
         :class:`MujocoRun`, one row per sensor sample.
@@ -192,7 +199,7 @@ def run_mujoco_loop(
     obs_kw = {"torque_noise": float(plant.sensor.torque_noise), "dt": T_s}
     obs_kw.update(dict(observer_settings or {}))
     # the baselines command by their own law; SlipControl's observers still run for the log
-    ctrl = SlipControl(est, fingers=2, observer=obs_kw, stuck_samples=stuck_samples,
+    ctrl = (controller_factory or SlipControl)(est, fingers=2, observer=obs_kw, stuck_samples=stuck_samples,
         healthy_finger_fallback=healthy_finger_fallback, **ctrl_s)
     injector = _core.FaultInjector(fault_specs(faults), T_s) if faults else None
     limits = {
@@ -496,6 +503,8 @@ def run_mujoco_loop(
             cols[f"pad_deflection_{k}"][i] = math.hypot(d.qpos[q[f"p{k}x"]], d.qpos[q[f"p{k}y"]])
             cols[f"pad_twist_{k}"][i] = twist[k]
             cols[f"contact_{k}"][i] = int(in_contact[k])
+        if started and hasattr(ctrl, "ground_truth"):  # a remote controller's recording
+            ctrl.ground_truth([cols[f"omega_true_{k}"][i] for k in (0, 1)])
         row_ok = math.isfinite(command) and all(
             math.isfinite(cols[c][i]) for c in ("slip", "theta")
         )
