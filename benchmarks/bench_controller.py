@@ -37,6 +37,8 @@ from sections import markers, write_section  # noqa: E402
 SINGLE_OFF = {
     "no_slope_gain": {"gain_force": 0.0},
     "no_feedforward": {"feedforward": False},
+    "no_slip_reflex": {"slip_reflex": False},
+    "no_lag_overshoot": {"reaction_lag": 0.0},
     "no_ceiling": {"ceiling_factor": 0.0},
     # the standing reserve the unseen scenes derive from their pulses (the paper's scenes have none)
     "no_reserve": {"reserve_force": 0.0, "reserve_torque": 0.0},

@@ -27,7 +27,7 @@ void bind_controller(nb::module_& m) {
   settings.def(nb::init<>()).def("__repr__", [](const GraspControllerSettings& s) { return to_string(s); });
   def_fields_rw(settings);
   m.def("paper_settings", &paper_settings,
-        "The paper's law (eqs. 34-37): constant PI gains, no floor, reserve, ceiling or learning.");
+        "The paper's law (eqs. 34-37): constant PI gains, no floor, reflex, lag overshoot, reserve, ceiling or learning.");
   m.def("validate_controller_settings", &validation_message<GraspControllerSettings>,
         "Empty string when valid, else one line per bad field.");
 

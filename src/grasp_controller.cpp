@@ -30,8 +30,11 @@ constexpr double kFeedforwardSlippage = 0.9;  // S the feed-forward and the rese
 constexpr double kFeedforwardHorizon = 0.03;  // [s] the trend's extrapolation ahead of the command
 constexpr double kFeedforwardTrend = 0.5;     // the trend is used when it asks this much more
 constexpr double kSlidingSlippage = 0.93;     // S at or above: the period's contact counts as sliding
+constexpr double kReflexSlippage = 0.93;      // the slip reflex's threshold on S (below the 0.95 of a slide at the CoR clip)
+constexpr int kReflexSamples = 3;             // ... on this many samples of the period
+constexpr double kReflexFactor = 1.25;        // ... raises the static part by this factor
 constexpr double kOmegaDeadband = 1.0;        // C_d's dead band in the observer's speed resolutions
-constexpr double kDynamicCap = 0.25;          // with the ceiling, C_d adds at most this x f_ns
+constexpr double kDynamicCap = kReflexFactor - 1.0;  // with the ceiling, C_d adds at most one reflex step
 constexpr double kPivotFloorFactor = 1.1;     // pivoting floor factor x max_i |f_t,i| / mu
 constexpr int kPivotEndSamples = 3;           // consecutive samples of the pivot's end test
 constexpr double kPivotEndFilter = 0.2;       // [s] low-pass on mean |c~| of that test
@@ -103,6 +106,8 @@ bool validate(const GraspControllerSettings& s, std::string* message) {
     bad("f_max", s.f_max, "must be finite, > f_min and <= 1e+06 [N]");
   positive_or_inf("max_rate_up", s.max_rate_up);
   positive_or_inf("max_rate_down", s.max_rate_down);
+  if (!(std::isfinite(s.reaction_lag) && s.reaction_lag >= 0.0 && s.reaction_lag <= 1.0e3))
+    bad("reaction_lag", s.reaction_lag, "must be finite, >= 0 and <= 1000 [s]");
   if (!(s.s_ref >= kSlippageMin && s.s_ref < 1.0)) bad("s_ref", s.s_ref, "must satisfy 1e-03 <= s_ref < 1");
   within("k_p", s.k_p, 0.0, true, kGainMax, " [N]");
   within("k_i", s.k_i, 0.0, true, kGainMax, " [N/s]");
@@ -135,10 +140,10 @@ std::string to_string(const GraspControllerSettings& s) {
   return "GraspControllerSettings(sensor_rate=" + num(s.sensor_rate) +
          ", command_ratio=" + std::to_string(s.command_ratio) + ", f_min=" + num(s.f_min) +
          ", f_max=" + num(s.f_max) + ", max_rate_up=" + num(s.max_rate_up) +
-         ", max_rate_down=" + num(s.max_rate_down) + ", s_ref=" + num(s.s_ref) + ", k_p=" + num(s.k_p) +
+         ", max_rate_down=" + num(s.max_rate_down) + ", reaction_lag=" + num(s.reaction_lag) + ", s_ref=" + num(s.s_ref) + ", k_p=" + num(s.k_p) +
          ", k_i=" + num(s.k_i) + ", gain_force=" + num(s.gain_force) +
          ", dynamic_enabled=" + flag(s.dynamic_enabled) + ", k_cd=" + num(s.k_cd) + ", p_cd=" + num(s.p_cd) +
-         ", z_cd=" + num(s.z_cd) + ", feedforward=" + flag(s.feedforward) +
+         ", z_cd=" + num(s.z_cd) + ", feedforward=" + flag(s.feedforward) + ", slip_reflex=" + flag(s.slip_reflex) +
          ", reserve_force=" + num(s.reserve_force) + ", reserve_torque=" + num(s.reserve_torque) +
          ", ceiling_factor=" + num(s.ceiling_factor) + ", mu_probe=" + num(s.mu_probe) +
          ", s_pivot=" + num(s.s_pivot) + ", tau_pivot=" + num(s.tau_pivot) + ", k_f=" + num(s.k_f) +
@@ -150,6 +155,8 @@ GraspControllerSettings paper_settings() noexcept {
   s.k_i = 10.0;
   s.gain_force = 0.0;
   s.feedforward = false;
+  s.slip_reflex = false;
+  s.reaction_lag = 0.0;
   s.ceiling_factor = 0.0;
   s.mu_probe = 0.0;
   return s;
@@ -217,7 +224,9 @@ void GraspController::reset(double current_force) noexcept {
   last_f_t_ = 0.0;
   last_kp_ = last_e_ = 0.0;
   clear_period();
+  f_est_ = command_;
   trend_lift_ = trend_force_ = 0.0;
+  reflex_armed_ = false;
   reset_probe();
   mu_ = mu0_;
   solver_.set_mu(mu_);
@@ -381,6 +390,8 @@ Status GraspController::step(const GraspControllerInput& in, GraspControllerOutp
     peak_s_ = std::max(peak_s_, slip);
     sum_s_ += slip;
     ++n_s_;
+    if (slip >= kReflexSlippage) ++count_s_;
+    if (count_s_ >= kReflexSamples) reflex_armed_ = true;
   }
   out.status = valid ? Status::Ok : worst;
   out.mean_c_tilde = n_valid > 0 ? c_sum / n_valid : 0.0;
@@ -432,6 +443,7 @@ Status GraspController::step(const GraspControllerInput& in, GraspControllerOutp
   out.gain_p = last_.gain_p;
   out.gain_i = last_.gain_i;
   out.feedforward_force = last_.feedforward_force;
+  out.reflex = last_.reflex;
   out.peak_slippage = last_.peak_slippage;
   out.mu_belief = last_.mu_belief;
   out.ceiling = last_.ceiling;
@@ -456,6 +468,8 @@ void GraspController::issue_command(bool valid, double slip) noexcept {
 
   c.feedforward_force = 0.0;
   c.peak_slippage = peak_s_;
+  c.reflex = false;
+  const double lag = s_.reaction_lag > 0.0 ? std::exp(-t_cmd_ / s_.reaction_lag) : 0.0;
 
   if (!valid) {  // safe command: hold (or raise), never below the floor; restart bumplessly
     double f = std::max(command_, floor);
@@ -464,11 +478,12 @@ void GraspController::issue_command(bool valid, double slip) noexcept {
     if (mode_ == ControllerMode::SlippingAvoidance) {
       // Raise-only reactions from the valid fingers' samples of the period.
       double n_slope = 1.0;
-      const double lift = std::min(static_floor(n_slope), s_.f_max);
-      c.feedforward_force = lift;
+      double lift = std::min(reaction_floor(n_slope, c), s_.f_max);
+      if (lift > f_est_ && lag > 0.0) lift += (lift - f_est_) * lag / (1.0 - lag);
       f = std::max(f, std::min(lift, command_ + s_.max_rate_up * t_cmd_));
     }
     command_ = clamp(f, s_.f_min, s_.f_max);
+    f_est_ = command_ + (f_est_ - command_) * lag;
     init_static_ = true;
     peak_ = 0.0;
     clear_period();
@@ -483,14 +498,14 @@ void GraspController::issue_command(bool valid, double slip) noexcept {
   double f_ns, f_nd = 0.0, e;
   double hi = s_.f_max;  // ceiling of the command (ceiling_factor)
   c.ceiling = hi;
+  bool reacting = false;  // the feed-forward or the reflex lifted the static part
   if (mode_ == ControllerMode::SlippingAvoidance) {
-    // Floor of the static part: feed-forward of the measured load (and the task's reserve).
+    // Floor of the static part: feed-forward of the measured load (and the task's reserve), slip reflex.
     // The grip probe's answer first: a slip it finds lowers the belief, which the floors use.
     probe_evaluate(slip);
     double n_slope = 1.0;
-    const double lift = static_floor(n_slope);
-    c.feedforward_force = lift;
-    const bool probe_started = probe_start(slip, lift > std::min(last_.static_force, command_));
+    const double lift = reaction_floor(n_slope, c);
+    const bool probe_started = probe_start(slip, c.reflex || lift > std::min(last_.static_force, command_));
     clear_period();
     // PI on e = S - s_ref: e > 0 (closer to slip than wanted) raises the force (docs/model.md 9.4).
     e = slip - s_.s_ref;
@@ -521,7 +536,7 @@ void GraspController::issue_command(bool valid, double slip) noexcept {
     // The need is also read from S itself (S ~ 1/f_n: the grip at S = 1 is ~ f S), so a load
     // given without its torque, or an S the load does not explain, never lowers the ceiling.
     hi = s_.f_max;
-    const double need = std::max(ceiling_load_, command_ * slip);
+    const double need = std::max(ceiling_load_, f_est_ * slip);
     if (s_.ceiling_factor > 0.0 && need > 0.0)
       hi = clamp(std::max(s_.ceiling_factor * need, command_), s_.f_min, s_.f_max);
     c.ceiling = hi;
@@ -529,6 +544,7 @@ void GraspController::issue_command(bool valid, double slip) noexcept {
     f_ns = clamp(u, lo, hi);
     if (f_ns != u) {
       if (u < lo && lo > s_.f_min) {
+        reacting = true;
         integrator_ = f_ns - k_p * e;  // the floor lifted the PI: restart it there
         // the part the trend added beyond the measured load's floor, checked at the next command
         trend_lift_ = f_ns - clamp(std::max(u, floor_measured_), s_.f_min, f_ns);
@@ -542,6 +558,8 @@ void GraspController::issue_command(bool valid, double slip) noexcept {
     // does not see them (a probe is not the load's demand).
     if (probe_started) probe_base_ = f_ns;
     const bool probing = probe_left_ > 0;
+    // A reaction during the probe (the reflex moved the grip) spoils its answer.
+    if (probing && !probe_started && c.reflex) probe_disturbed_ = true;
     c.probing = probing;
     if (probing) {  // the probe is a measurement: it may exceed the ceiling by its own size
       hi = std::min(std::max(hi, probe_base_ * (1.0 + s_.mu_probe)), s_.f_max);
@@ -581,10 +599,14 @@ void GraspController::issue_command(bool valid, double slip) noexcept {
   peak_ = 0.0;
 
   double target = f_ns + f_nd;
+  // Reaction through the gripper's lag: overshoot so the force reaches the target in one period.
+  if (reacting && lag > 0.0 && target > f_est_)
+    target = std::min(target + (std::min(target, s_.f_max) - f_est_) * lag / (1.0 - lag), hi);
   double f = clamp(target, command_ - s_.max_rate_down * t_cmd_, command_ + s_.max_rate_up * t_cmd_);
   c.rate_limited = f != target;
   f = clamp(std::max(f, floor), s_.f_min, s_.f_max);
   command_ = f;
+  f_est_ = command_ + (f_est_ - command_) * lag;
 
   c.force = f;
   c.mu_belief = mu_;
@@ -611,6 +633,8 @@ void GraspController::clear_period() noexcept {
   n_load_.fill(0);
   peak_s_ = sum_s_ = 0.0;
   n_s_ = 0;
+  count_s_ = 0;
+  reflex_armed_ = false;
 }
 
 GraspController::PeriodLoad GraspController::period_load(int i) const noexcept {
@@ -702,6 +726,7 @@ void GraspController::probe_evaluate(double slip_mean) noexcept {
       solver_.set_mu(mu_);
     }
     probe_slip_ = true;
+    reflex_armed_ = true;  // a confirmed slip: the reflex raises the static part now
     probe_s_ = probe_f_ = 0.0;  // stick is proven again from the start
   } else if (answered) {
     // Stick proven up to the S before the probe, at the grip of then: the next probe waits
@@ -740,6 +765,26 @@ bool GraspController::probe_start(double slip_mean, bool reacting) noexcept {
   probe_disturbed_ = false;
   probe_left_ = 3;
   return true;
+}
+
+double GraspController::reaction_floor(double& slope_exponent, GraspControllerOutput& c) noexcept {
+  double lift = static_floor(slope_exponent);
+  c.feedforward_force = lift;
+  if (s_.slip_reflex && reflex_armed_) {
+    // On the grip the contact slid at: the static part (a transient f_nd would otherwise be
+    // multiplied into f_ns), or the measured f_n when the gripper has not reached it yet (a
+    // raise still on its way is not a grip that failed; compounding the command while the
+    // force lags would overshoot the load several times).
+    double base = std::min(last_.static_force, command_);
+    double fn_meas = 0.0;
+    for (int i = 0; i < kMaxFingers; ++i) fn_meas = std::max(fn_meas, period_load(i).fn);
+    if (fn_meas > 0.0) base = std::min(base, fn_meas);
+    const double reflex = kReflexFactor * base;
+    lift = std::max(lift, reflex);
+    floor_measured_ = std::max(floor_measured_, reflex);
+    c.reflex = true;
+  }
+  return lift;
 }
 
 double GraspController::static_floor(double& slope_exponent) noexcept {

@@ -32,6 +32,12 @@ struct GraspControllerSettings {
   double f_max = 20.0;  //!< [N] maximum force (gripper limit), > f_min
   double max_rate_up = 200.0;    //!< (*) [N/s] limit on command increase, > 0 (inf: off)
   double max_rate_down = 200.0;  //!< (*) [N/s] limit on command decrease, > 0 (inf: off)
+  //! (*) [s] default 0.03; 0 = off (paper). The gripper's force time constant: when the
+  //! feed-forward or the reflex lifts the static part above the force the gripper is estimated to
+  //! apply (f_est: the commands through this first-order lag), the command overshoots the target
+  //! by the lag's shortfall over one command period, (target - f_est) a / (1 - a),
+  //! a = exp(-T / reaction_lag), so the force reaches the target within one period. >= 0, finite.
+  double reaction_lag = 0.03;
 
   // --- regulator: static part in slipping avoidance, PI on e = S - s_ref (docs/model.md 9.4) --
   double s_ref = 0.8;  //!< (*) reference of the slippage indicator S-bar_a, in (0, 1)
@@ -58,6 +64,12 @@ struct GraspControllerSettings {
   //! extrapolated 30 ms ahead along its trend when that asks 50 % more (a load still rising at
   //! the command); the integrator restarts there. Not applied while pivoting.
   bool feedforward = true;
+  //! (*) default true; false = paper. Slip reflex: when S = max_i S_i is at or above 0.93 on 3
+  //! valid samples of one command period (anywhere in it: a chattering slide alternates S around
+  //! the bound), the next command raises the static part to at least 1.25 x the grip the contact
+  //! slid at (the last static part, or the measured f_n while the force lags). It acts whether
+  //! or not the slip speed is observable (with Coulomb-like pads C_d adds nothing).
+  bool slip_reflex = true;
   //! (*) [N] default 0 = off. The task's envelope of pushes per finger: the static part is
   //! floored at the static grasp force at S = 1 of the measured load with reserve_force added
   //! to |f_t| and reserve_torque to |tau| (such a push then keeps the contact at its limit while
@@ -92,7 +104,7 @@ struct GraspControllerSettings {
 };
 
 //! The paper's law (eqs. 34-37): constant PI gains k_p = 4 N, k_i = 10 N/s, C_d as above, no
-//! floor, reserve, ceiling or learning. Three implementation choices of lugrip that have no
+//! floor, reflex, lag overshoot, reserve, ceiling or learning. Three implementation choices of lugrip that have no
 //! setting apply to it too: the PI's S is the mean over the command period, C_d's input has a
 //! dead band of the observer's speed resolution, and the pivot's end test is lugrip's
 //! (docs/controller.md §1).
@@ -172,6 +184,7 @@ struct GraspControllerOutput {
   double gain_p = 0.0;         //!< k_p used at the last command [N]
   double gain_i = 0.0;         //!< k_i used at the last command [N/s]
   double feedforward_force = 0.0;  //!< feed-forward force at the last command [N] (0: none)
+  bool reflex = false;         //!< last command: the slip reflex raised the static part
   double peak_slippage = 0.0;  //!< peak of max_i S_i over the period before the last command [-]
   double mu_belief = 0.0;      //!< friction coefficient the controller believes now [-]
   double ceiling = 0.0;        //!< ceiling of the last command (ceiling_factor; f_max when off) [N]
@@ -331,6 +344,8 @@ class GraspController {
   void reset_dynamic() noexcept;
   void issue_command(bool valid, double slip) noexcept;
   double static_floor(double& slope_exponent) noexcept;
+  // static_floor() raised by the armed slip reflex; records both in c (feedforward_force, reflex)
+  double reaction_floor(double& slope_exponent, GraspControllerOutput& c) noexcept;
   void clear_period() noexcept;
   // The grip probe (mu_probe): probe_evaluate() counts a running probe down and, at its end,
   // compares the period's load with the reference period's (slip lowers mu_); probe_start()
@@ -377,13 +392,16 @@ class GraspController {
   std::array<double, kMaxFingers> sum_kf_{}, sum_kt_{};  // sums of k f_t, k tau (k: sample index in the period)
   std::array<double, kMaxFingers> sum_k_{}, sum_kk_{};   // sums of k, k^2 over those samples
   std::array<int, kMaxFingers> k_load_{};                // sample index in the period
-  double floor_measured_ = 0.0;  // floor of the period's mean load, without the trend [N]
+  double f_est_ = 0.0;        // gripper force estimated through reaction_lag [N]
+  double floor_measured_ = 0.0;  // reaction floor without the trend (mean load, reflex) [N]
   double ceiling_load_ = 0.0;    // grip the period's load needs at S = 1 (ceiling_factor) [N]
   double trend_lift_ = 0.0;      // part of the last restart of the integrator due to the trend [N]
   double trend_force_ = 0.0;     // static part the trend lifted to at the last command [N]
   double peak_s_ = 0.0;       // peak of max_i S_i since the last command
   double sum_s_ = 0.0;        // sum of max_i S_i over the valid samples since the last command
   int n_s_ = 0;
+  int count_s_ = 0;            // valid samples with S >= 0.93 since the last command
+  bool reflex_armed_ = false;  // such samples reached 3 since the last command
   // grip probe (mu_probe)
   std::array<double, kMaxFingers> sum_f_n_{};  // sum of f_n over the load samples of the period
   std::array<bool, kMaxFingers> fn_ok_{{true, true}};  // every load sample of the period had f_n

@@ -42,7 +42,7 @@ _BOOL_FIELDS = tuple(name for name, kind, _doc in _core.GraspControllerSettings.
 
 
 #: The paper's law (eqs. 34-37) as settings, from the C++ preset ``paper_settings()``: constant
-#: PI gains (k_p = 4 N, k_i = 10 N/s), no feed-forward, reserve, ceiling or learned mu. Pass them
+#: PI gains (k_p = 4 N, k_i = 10 N/s), no feed-forward, reflex, lag overshoot, reserve, ceiling or learned mu. Pass them
 #: to compare with lugrip's defaults: ``GraspController(params, **PAPER_SETTINGS)``. Three
 #: implementation choices without a setting apply to it too (docs/controller.md §1): the PI's S
 #: is the mean over the command period, C_d's input has a dead band of the observer's speed

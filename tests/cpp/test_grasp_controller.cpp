@@ -751,7 +751,7 @@ TEST(ControllerClosedLoop, LowForcesNeedTheSlopeGain) {
   EXPECT_NEAR(0.5 * (full.first + full.second), 4.7495, 0.05);
 }
 
-// --- beyond the paper: slope gain, feed-forward (docs/controller.md) ----------------
+// --- beyond the paper: slope gain, feed-forward, slip reflex (docs/controller.md) ----------------
 // Consistency tests: the plant below is lugrip's own static map S_static(f_n) (StaticForceSolver)
 // behind a first-order force lag; they check the law, not the contact physics (the closed loops
 // on the patch and MuJoCo plants are in tests/python/test_controller.py).
@@ -918,3 +918,81 @@ TEST(ControllerFeedForward, RangeAndRateLimitsStillBound) {
   EXPECT_LT(out.force, before);
 }
 
+TEST(ControllerReflex, RaisesWithinOneCommandPeriodWhenTheSpeedIsUnobservable) {
+  // omega_hat = 0 throughout (Coulomb-like contact: C_d adds nothing); S at the projection bound
+  // on three consecutive samples inside a period.
+  GraspControllerSettings s;
+  s.feedforward = false;
+  s.ceiling_factor = 0.0;  // the inputs' S is not their load's (the ceiling: ClosedLoop.Ceiling*)
+  s.s_ref = 0.8;          // the set point of the inputs below
+  s.reaction_lag = 0.0;   // the raise itself (the lag compensation: ControllerReaction.*)
+  s.max_rate_up = s.max_rate_down = kInf;
+  GraspController c(can(), s);
+  c.reset(2.0);
+  GraspControllerOutput out = run(c, one(0.8), 11);  // two commands at the set point
+  const double f0 = out.force;
+  EXPECT_NEAR(f0, 2.0, 1e-12);
+  for (int k = 0; k < 9; ++k) {
+    c.step(one(k >= 4 && k < 7 ? 1.0 : 0.8), out);
+    EXPECT_FALSE(out.command_issued);
+  }
+  c.step(one(0.8), out);
+  ASSERT_TRUE(out.command_issued);
+  EXPECT_TRUE(out.reflex);
+  EXPECT_GE(out.force, 1.25 * f0 - 1e-12);
+  // Isolated samples above the threshold (noise: two per period, fewer than three) do
+  // not trigger it.
+  GraspController d(can(), s);
+  d.reset(2.0);
+  out = run(d, one(0.8), 11);
+  for (int k = 0; k < 50; ++k) {
+    d.step(one(k % 5 == 2 ? 1.0 : 0.8), out);
+    EXPECT_FALSE(out.reflex);
+  }
+  // Every other sample at the bound (a chattering slide: five per period, never three in a row)
+  // triggers it: the samples may lie anywhere in the period.
+  {
+    GraspController g(can(), s);
+    g.reset(2.0);
+    out = run(g, one(0.8), 11);
+    bool fired = false;
+    for (int k = 0; k < 20; ++k) {
+      g.step(one(k % 2 ? 1.0 : 0.8), out);
+      fired = fired || out.reflex;
+    }
+    EXPECT_TRUE(fired);
+  }
+  // Without the reflex only the PI moves (one command: + k_p e at most).
+  GraspControllerSettings off = s;
+  off.slip_reflex = false;
+  GraspController e(can(), off);
+  e.reset(2.0);
+  out = run(e, one(0.8), 11);
+  for (int k = 0; k < 9; ++k) e.step(one(k >= 4 && k < 7 ? 1.0 : 0.8), out);
+  e.step(one(0.8), out);
+  EXPECT_FALSE(out.reflex);
+  EXPECT_LT(out.force, 1.1 * f0);
+}
+
+TEST(ControllerReflex, RepeatsWhileSlidingAndStopsAtTheCeiling) {
+  GraspControllerSettings s;
+  s.feedforward = false;
+  s.ceiling_factor = 0.0;  // f_max is the ceiling here
+  s.max_rate_up = s.max_rate_down = kInf;
+  GraspController c(can(), s);
+  c.reset(1.0);
+  GraspControllerOutput out;
+  double last = 1.0;
+  int raises = 0;
+  for (int k = 0; k < 500; ++k) {
+    c.step(one(1.0), out);
+    if (out.command_issued && k > 0) {
+      EXPECT_GE(out.force, std::min(1.25 * last, s.f_max) - 1e-9) << k;
+      EXPECT_LE(out.force, s.f_max);
+      raises += out.reflex;
+      last = out.force;
+    }
+  }
+  EXPECT_EQ(out.force, s.f_max);
+  EXPECT_GT(raises, 10);
+}

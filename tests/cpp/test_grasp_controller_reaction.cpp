@@ -1,9 +1,12 @@
 // Reaction of the grasp-force controller to loads that change faster than one command period:
 // the feed-forward of the load's trend (extrapolated 30 ms ahead, used when it asks 50 % more
-// than the mean load; constants of the law, docs/controller.md).
+// than the mean load; constants of the law, docs/controller.md), the command overshoot that
+// compensates the gripper's lag (reaction_lag) and the raise-only reactions on a command sample
+// with an invalid finger.
 //
-// Consistency tests of the law: the inputs are synthetic observer values. Closed loops on
-// MuJoCo: tests/python/test_controller_reaction.py.
+// Consistency tests of the law: the inputs are synthetic observer values; the gripper of
+// LagCompensation.* is an independent first-order lag integrated here at 1 kHz (not the
+// controller's own estimate). Closed loops on MuJoCo: tests/python/test_controller_reaction.py.
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -46,6 +49,7 @@ GraspControllerInput two(const FingerInput& a, const FingerInput& b) {
 
 GraspControllerSettings fast(GraspControllerSettings s = {}) {
   s.max_rate_up = s.max_rate_down = kInf;
+  s.slip_reflex = false;
   s.dynamic_enabled = false;
   return s;
 }
@@ -162,3 +166,87 @@ TEST(ControllerReaction, TrendLiftTheNextPeriodDoesNotConfirmIsTakenBack) {
   }
 }
 
+TEST(ControllerReaction, LagCompensationReachesTheTargetWithinOneCommand) {
+  // Gripper: tau_g df/dt = u - f, tau_g = 30 ms, integrated at 1 kHz. The load steps at a
+  // command; the next command's feed-forward target is f*; without compensation the gripper
+  // has covered 1 - exp(-20/30) = 49 % of the step one period later, with it >= 97 %.
+  const ContactParams p = box();
+  StaticForceSolver solver(p);
+  const double tau_g = 0.03;
+  double reached[2] = {0.0, 0.0};
+  for (const int comp : {0, 1}) {
+    GraspControllerSettings s = fast();
+    s.reaction_lag = comp ? tau_g : 0.0;
+    GraspController c(p, s);
+    const double f0 = solver.solve(2.2, 0.0, s.s_ref).force;
+    c.reset(f0);
+    GraspControllerOutput out;
+    double f = f0, target = 0.0;
+    int t_issue = -1;
+    for (int k = 0; k < 60; ++k) {  // 120 ms
+      const double ft = k <= 10 ? 2.2 : 3.7;  // load step right after the command at 20 ms
+      c.step(two(finger(0.7, ft), finger(0.7, ft)), out);
+      if (out.command_issued && k >= 20 && t_issue < 0) {
+        t_issue = k;
+        target = out.static_force;
+      }
+      for (int j = 0; j < 2; ++j) f += (out.force - f) * (1.0 - std::exp(-0.001 / tau_g));
+      if (t_issue >= 0 && k == t_issue + 9) reached[comp] = (f - f0) / (target - f0);
+    }
+    ASSERT_GT(target, f0 * 1.25);
+    EXPECT_LE(out.force, s.f_max);
+  }
+  EXPECT_NEAR(reached[0], 1.0 - std::exp(-0.02 / tau_g), 0.03);
+  EXPECT_GT(reached[1], 0.97);
+  EXPECT_LT(reached[1], 1.03);
+}
+
+TEST(ControllerReaction, ReflexActsOnACommandSampleWithALostPad) {
+  // Finger 0 reads S at the projection bound on three samples (the object slides); at the
+  // command sample finger 1 reports NoContact (its pad left the object). The command is flagged
+  // held and the status is NoContact; it is still raised by the reflex (a reaction computed
+  // from the valid finger's samples). Never lowered.
+  {
+    const bool react = true;
+    GraspControllerSettings s;
+    s.max_rate_up = s.max_rate_down = kInf;
+    s.feedforward = false;
+    s.reaction_lag = 0.0;
+    GraspController c(box(), s);
+    c.reset(4.0);
+    GraspControllerOutput out;
+    c.step(two(finger(0.7, 2.2), finger(0.7, 2.2)), out);
+    const double f0 = out.force;
+    for (int k = 0; k < 9; ++k) {
+      const double S = k >= 5 && k < 8 ? 1.0 : 0.7;
+      c.step(two(finger(S, 2.2), finger(S, 2.2)), out);
+    }
+    c.step(two(finger(0.7, 2.2), finger(0.0, 0.0, 0.0, Status::NoContact)), out);
+    ASSERT_TRUE(out.command_issued);
+    EXPECT_EQ(out.status, Status::NoContact);
+    EXPECT_TRUE(out.held);
+    EXPECT_TRUE(std::isfinite(out.force));
+    if (react) {
+      EXPECT_TRUE(out.reflex);
+      EXPECT_NEAR(out.force, 1.25 * f0, 1e-9 * f0);
+    } else {
+      EXPECT_EQ(out.force, f0);
+    }
+    // The pad stays lost with no slip on the other: the command is held, never lowered.
+    for (int k = 0; k < 50; ++k) c.step(two(finger(0.1, 0.5), finger(0.0, 0.0, 0.0, Status::NoContact)), out);
+    EXPECT_EQ(out.status, Status::NoContact);
+    EXPECT_GE(out.force, react ? 1.25 * f0 - 1e-9 : f0);
+  }
+}
+
+TEST(ControllerReaction, SettingsValidated) {
+  for (auto bad : {+[](GraspControllerSettings& s) { s.reaction_lag = -1e-3; },
+                   +[](GraspControllerSettings& s) { s.reaction_lag = std::nan(""); },
+                   +[](GraspControllerSettings& s) { s.reaction_lag = kInf; }}) {
+    GraspControllerSettings s;
+    bad(s);
+    std::string msg;
+    EXPECT_FALSE(validate(s, &msg));
+    EXPECT_THROW(GraspController(box(), s), std::invalid_argument);
+  }
+}

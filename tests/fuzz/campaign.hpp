@@ -312,7 +312,8 @@ class Campaign {
     using G = GraspControllerSettings;
     ctl_.reals = {LUGRIP_FUZZ_REAL(G, sensor_rate),   LUGRIP_FUZZ_REAL(G, f_min),
                   LUGRIP_FUZZ_REAL(G, f_max),         LUGRIP_FUZZ_REAL(G, max_rate_up),
-                  LUGRIP_FUZZ_REAL(G, max_rate_down), LUGRIP_FUZZ_REAL(G, s_ref),
+                  LUGRIP_FUZZ_REAL(G, max_rate_down), LUGRIP_FUZZ_REAL(G, reaction_lag),
+                  LUGRIP_FUZZ_REAL(G, s_ref),
                   LUGRIP_FUZZ_REAL(G, k_p),           LUGRIP_FUZZ_REAL(G, k_i),
                   LUGRIP_FUZZ_REAL(G, gain_force),    LUGRIP_FUZZ_REAL(G, k_cd),
                   LUGRIP_FUZZ_REAL(G, p_cd),          LUGRIP_FUZZ_REAL(G, z_cd),
@@ -321,7 +322,8 @@ class Campaign {
                   LUGRIP_FUZZ_REAL(G, s_pivot),       LUGRIP_FUZZ_REAL(G, tau_pivot),
                   LUGRIP_FUZZ_REAL(G, k_f),           LUGRIP_FUZZ_REAL(G, pivot_end_c_tilde)};
     ctl_.ints = {LUGRIP_FUZZ_INT(G, command_ratio)};
-    ctl_.bools = {LUGRIP_FUZZ_BOOL(G, dynamic_enabled), LUGRIP_FUZZ_BOOL(G, feedforward)};
+    ctl_.bools = {LUGRIP_FUZZ_BOOL(G, dynamic_enabled), LUGRIP_FUZZ_BOOL(G, feedforward),
+                  LUGRIP_FUZZ_BOOL(G, slip_reflex)};
     ctl_.init([](const G& s) { return validate(s, nullptr); });
   }
 

@@ -13,8 +13,8 @@ from lugrip import ControllerMode, GraspController, PivotEnd, Status
 from scipy import signal
 
 CAN = lugrip.ContactParams.preset("aluminium_can")
-#: The paper's static law (constant gains, no feed-forward); the ceiling keeps its default here.
-PAPER_PI = {k: lugrip.PAPER_SETTINGS[k] for k in ("gain_force", "feedforward", "k_i")}
+#: The paper's static law (constant gains, no feed-forward, no reflex); the ceiling keeps its default here.
+PAPER_PI = {k: lugrip.PAPER_SETTINGS[k] for k in ("gain_force", "feedforward", "slip_reflex", "k_i")}
 T_SENSOR = 1.0 / 500.0
 T_CMD = 10 * T_SENSOR
 
@@ -297,7 +297,7 @@ def test_closed_loop_settles_at_the_static_force(obj, ft, tau):
     assert np.all(np.abs(tail / f_static - 1) < 0.01)
 
 
-# --- beyond the paper: slope gain, feed-forward (docs/controller.md) ----------------
+# --- beyond the paper: slope gain, feed-forward, slip reflex (docs/controller.md) ----------------
 
 def test_feedforward_is_the_static_grasp_force_of_the_measured_load():
     """Consistency: the feed-forward force of a command is static_grasp_force of the mean load of
@@ -317,8 +317,21 @@ def test_feedforward_is_the_static_grasp_force_of_the_measured_load():
     assert r_off.force[10] < 0.2 < expected
 
 
+def test_slip_reflex_reacts_within_one_command_period_without_speed():
+    """S at the projection bound for 3 samples, omega_hat = 0 (no speed information): the next
+    command raises the static part by 1.25."""
+    ctrl = GraspController(CAN, feedforward=False, max_rate_up=math.inf)
+    ctrl.reset(2.0)
+    S = np.r_[np.full(11, 0.8), 0.8, 0.8, 1.0, 1.0, 1.0, np.full(5, 0.8)]
+    run = ctrl.run(np.zeros(S.size), S, 1.5, 1.0)
+    cmd = np.flatnonzero(run.command_issued)
+    assert cmd[-1] == 20 and run.reflex[20]
+    assert run.force[20] >= 1.25 * run.force[10] - 1e-12
+
+
 @given(
-    name=st.sampled_from(["gain_force", "ceiling_factor", "mu_probe", "reserve_force"]),
+    name=st.sampled_from(["gain_force", "ceiling_factor", "mu_probe", "reserve_force",
+                          "reaction_lag"]),
     value=st.one_of(st.floats(max_value=0.0), st.just(math.nan), st.just(math.inf),
                     st.floats(min_value=1e-9, max_value=2e6),
                     st.sampled_from([1e-6, 9.99e-7, 0.5, 0.51, 1.0, 0.999, 1e3, 1000.5, 1e6, 1.01e6])),
@@ -332,6 +345,7 @@ def test_settings_beyond_the_paper_are_validated(name, value):
         "ceiling_factor": lambda v: v == 0 or 1 <= v <= 1e3,
         "mu_probe": lambda v: 0 <= v <= 0.5,
         "reserve_force": lambda v: 0 <= v <= 1e6,
+        "reaction_lag": lambda v: 0 <= v <= 1e3,
     }[name]
     if valid(value):
         GraspController(CAN, **{name: value})
@@ -345,7 +359,7 @@ def test_removed_settings_are_refused_by_name():
     error that names it (no silent acceptance of a setting that does nothing)."""
     for name in ("gain_schedule_force", "static_equivalent_slippage", "reflex_in_period",
                  "feedforward_trend_grasp", "feedforward_trend_check", "react_when_invalid",
-                 "slip_reflex", "reflex_factor", "reaction_lag", "omega_deadband", "slope_gain",
+                 "reflex_factor", "reflex_slippage", "omega_deadband", "slope_gain",
                  "loop_gain_p", "average_slippage", "anti_windup", "invalid_raise_step",
                  "feedforward_horizon", "pivot_timeout", "pivot_end_filter"):
         with pytest.raises(ValueError, match=name):
