@@ -139,13 +139,25 @@ struct ObserverInput {
 //!   v_slip = |omega_object| a_u rho = |omega_hat| rho (a^2 + 1/2) / (a + 1/(2 a_u)).
 //! Without the clip (a_u = a) these are omega_hat and |omega_hat c|; a pure translation
 //! (a_u -> inf) gives omega_object -> 0 and a finite v_slip.
+//! Friction ratios (ContactParams::static_ratio r_s, kinetic_ratio r_k, not both 1; docs/model.md
+//! 7.5): the observer starts in stick, where the update and S use the static capacity r_s g; once
+//! the friction torque about the CoR reaches kBreakawayLevel r_k g (the level at which a slip,
+//! once under way, does not stop) the update uses g and S is judged against r_k g (clipped at 1),
+//! until the friction falls below kStickRelease r_k g (stuck again). With r_s = r_k = 1 this is
+//! the paper's S.
+constexpr double kBreakawayLevel = 0.995;
+constexpr double kStickRelease = 0.8;
+
 struct ObserverOutput {
-  double omega_hat = 0.0;   //!< estimated slip velocity about the clipped CoR c [rad/s] (object vs fingertip); drives C_d
+  //! estimated slip velocity about the clipped CoR c [rad/s] (object vs fingertip); drives C_d.
+  //! Reported as 0 where speed_observable is false (the speed is not in the data: 0 is never
+  //! worse than a number drawn from noise and model error); omega_state is the observer's state.
+  double omega_hat = 0.0;
   double z_hat = 0.0;       //!< estimated bristle state [rad], |sigma0 z_hat| <= g
-  double S = 0.0;           //!< slippage indicator sigma0 |z_hat| / g in [0, 1] (eq. 37)
+  double S = 0.0;           //!< slippage indicator sigma0 |z_hat| / g in [0, 1] (eq. 37); / (kinetic_ratio g) when kinetic
   double c_tilde = 0.0;     //!< normalized CoR [-] (sensor frame), |c~| <= c_max
   double c = 0.0;           //!< CoR position [m]
-  double g = 0.0;           //!< dry torque capacity about the CoR [N m] (eq. 18, floored)
+  double g = 0.0;           //!< dry torque capacity about the CoR used by the update [N m] (eq. 18, floored); times static_ratio in stick
   double sigma_1 = 0.0;     //!< viscous coefficient about the CoR [N m s/rad] (eq. 17)
   double y = 0.0;           //!< measured friction torque about the CoR, tau - c f_t [N m] (eq. 20), raw torque
   double tau_cor = 0.0;     //!< filtered torque (with sign hysteresis) used for the CoR [N m]
@@ -165,8 +177,12 @@ struct ObserverOutput {
   int cor_iterations = 0;   //!< root-finding iterations of the CoR estimate
   Status status = Status::NoContact;
   double c_tilde_unclipped = 0.0;  //!< normalized CoR before the clip [-], signed like c_tilde, |c~u| >= |c~|
-  double omega_object = 0.0;  //!< slip velocity about the unclipped CoR [rad/s] (= omega_hat where c~u = c~)
-  double v_slip = 0.0;        //!< slip speed of the patch centre [m/s], >= 0
+  double omega_object = 0.0;  //!< slip velocity about the unclipped CoR [rad/s] (= omega_hat where c~u = c~); 0 where !speed_observable
+  double v_slip = 0.0;        //!< slip speed of the patch centre [m/s], >= 0; 0 where !speed_observable
+  double omega_state = 0.0;   //!< the observer's slip-velocity state (omega_hat before the observability gate) [rad/s]
+  //! sliding has started: g is the fitted capacity and S = sigma0 |z_hat| / (kinetic_ratio g);
+  //! false in stick and always false when ContactParams::static_ratio == kinetic_ratio == 1
+  bool kinetic = false;
 };
 
 //! Nonlinear sliding-velocity observer of the paper (eqs. 21-23, docs/model.md 7), per fingertip:
@@ -225,6 +241,7 @@ class Observer {
   double alpha_dt_ = 1.0;   // low-pass coefficient of the CoR inputs at the nominal period
   int invalid_run_ = 0;
   bool need_init_ = true;
+  bool kinetic_ = false;  // Stribeck term: the capacity is the kinetic one (sliding has started)
   ObserverOutput last_;
 };
 
