@@ -200,7 +200,7 @@ template <>
 struct Table<ObserverOutput> {
   using S = ObserverOutput;
   static constexpr auto fields = std::make_tuple(
-      field("omega_hat", &S::omega_hat, "estimated slip velocity about the clipped CoR [rad/s]; 0 where speed_observable is false"),
+      field("omega_hat", &S::omega_hat, "estimated slip velocity about the clipped CoR [rad/s]; 0 where omega_resolution > 1.5 resolution_max"),
       field("z_hat", &S::z_hat, "estimated bristle state [rad]"),
       field("S", &S::S, "slippage indicator sigma0 |z_hat| / g [-] (eq. 37)"),
       field("c_tilde", &S::c_tilde, "normalized CoR [-]"),
@@ -223,9 +223,9 @@ struct Table<ObserverOutput> {
       field("cor_iterations", &S::cor_iterations, "root-finding iterations of the CoR"),
       field("status", &S::status, "Status"),
       field("c_tilde_unclipped", &S::c_tilde_unclipped, "normalized CoR before the clip [-]"),
-      field("omega_object", &S::omega_object, "slip velocity about the unclipped CoR [rad/s]; 0 where speed_observable is false"),
-      field("v_slip", &S::v_slip, "slip speed of the patch centre [m/s]; 0 where speed_observable is false"),
-      field("omega_state", &S::omega_state, "the observer's slip-velocity state (omega_hat before the observability gate) [rad/s]"),
+      field("omega_object", &S::omega_object, "slip velocity about the unclipped CoR [rad/s]; 0 where omega_hat is"),
+      field("v_slip", &S::v_slip, "slip speed of the patch centre [m/s]; 0 where omega_hat is"),
+      field("omega_state", &S::omega_state, "the observer's slip-velocity state (omega_hat before the resolution gate) [rad/s]"),
       field("kinetic", &S::kinetic, "sliding has started: S judged against kinetic_ratio g (friction ratios not 1)"));
 };
 

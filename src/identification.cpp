@@ -192,7 +192,7 @@ void run_segment(Observer& obs, const SegmentWork& w, int64_t begin, int64_t end
 
   for (int64_t i = begin; i < end; ++i) {
     const double dt_in = i == begin ? 0.0 : d.dt[i];
-    const double z_before = obs.z_hat(), w_before = obs.omega_hat();
+    const double z_before = obs.z_hat(), w_before = obs.omega_state();
     const Status st = obs.step(ObserverInput{d.f_n[i], d.f_t[i], d.tau[i], dt_in}, o);
     if (w.omega_hat) w.omega_hat[i] = o.omega_state;
     if (st == Status::Reinitialized) ++out.reinitialized;

@@ -299,6 +299,8 @@ Status Observer::step(const ObserverInput& in, ObserverOutput& out) noexcept {
       co.sigma_1 > 0.0 ? std::min(s_.torque_noise / co.sigma_1, std::numeric_limits<double>::max())
                        : (s_.torque_noise > 0.0 ? std::numeric_limits<double>::max() : 0.0);
   const bool observable = omega_resolution <= s_.resolution_max;
+  // omega_hat is reported up to kOmegaReportFactor x resolution_max, 0 beyond (header)
+  const bool report = omega_resolution <= kOmegaReportFactor * s_.resolution_max;
   double omega_object = 0.0, v_slip = 0.0;
   unclipped_slip(w, std::fabs(co.c_tilde), std::fabs(co.c_tilde_unclipped), co.rho, omega_object, v_slip);
   if (!(std::isfinite(z) && std::isfinite(S) && std::isfinite(rc.drive) && std::isfinite(bound) &&
@@ -319,7 +321,7 @@ Status Observer::step(const ObserverInput& in, ObserverOutput& out) noexcept {
   // Written field by field to last_ and out (no zero-initialised temporary, no struct copy
   // through the stack).
   auto fill = [&](ObserverOutput& r) {
-    r.omega_hat = observable ? omega_ : 0.0;
+    r.omega_hat = report ? omega_ : 0.0;
     r.omega_state = omega_;
     r.kinetic = kinetic_;
     r.z_hat = z_;
@@ -344,8 +346,8 @@ Status Observer::step(const ObserverInput& in, ObserverOutput& out) noexcept {
     r.cor_iterations = co.iterations;
     r.status = status;
     r.c_tilde_unclipped = co.c_tilde_unclipped;
-    r.omega_object = observable ? omega_object : 0.0;
-    r.v_slip = observable ? v_slip : 0.0;
+    r.omega_object = report ? omega_object : 0.0;
+    r.v_slip = report ? v_slip : 0.0;
   };
   fill(last_);
   fill(out);

@@ -295,7 +295,13 @@ class Observer(NoCopy):
 
     @property
     def omega_hat(self) -> float:
+        """The last reported omega_hat [rad/s] (0 where the speed is not in the data)."""
         return self._obs.omega_hat
+
+    @property
+    def omega_state(self) -> float:
+        """The observer's slip-velocity state [rad/s] (omega_hat before the resolution gate)."""
+        return self._obs.omega_state
 
     @property
     def z_hat(self) -> float:

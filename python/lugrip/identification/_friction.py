@@ -34,7 +34,7 @@ class FrictionLevels:
         static_ratio: break-away level over the fitted surface (ContactParams.static_ratio).
         kinetic_ratio: sliding level over the fitted surface (ContactParams.kinetic_ratio).
         stribeck: the break-away level exceeds the sliding level significantly.
-        t: t statistic of the slope of the runs' log sliding level on their log speed.
+        t: t statistic of the slope of the runs' log dry sliding level on their log speed.
         median_ratio: the break-away level (quantile of the peaks) over the sliding level.
         runs: maneuvers with a break-away used for the test.
         line: the report line.
@@ -61,9 +61,12 @@ def friction_levels(
 ) -> FrictionLevels:
     """The load ratio |y| / g (friction torque about the estimated CoR over the capacity of the
     fitted surface, from the online observer's CoR; eqs. 16, 18) on every sample; the sliding
-    level is its ``SLIDING_QUANTILE`` over the gross-sliding samples, the break-away level of a
-    run its peak (20 ms average) up to shortly after gross sliding begins. A Stribeck term is
-    kept when the runs' median sliding level falls with their sliding speed (slope of the logs,
+    level is its ``SLIDING_QUANTILE`` over the gross-sliding samples. Its dry part (the
+    viscous torque sigma_1 |omega| at the true speed taken off) gives each run's median dry
+    sliding level and its break-away, the peak (20 ms average) up to shortly after gross
+    sliding begins, on the samples whose CoR is not clipped (sigma_1 is about the clipped CoR). A Stribeck term is
+    kept when the runs' median dry sliding level falls with their sliding speed (the RMS speed
+    over the patch, |omega| rho sqrt(c~^2 + 1/2) with the estimated CoR; slope of the logs,
     t <= -3) and the ``BREAKAWAY_QUANTILE`` of the peaks exceeds the sliding level by at least
     3 %; that quantile is then static_ratio. Without it both capacities are the sliding level
     (one capacity, as in the paper), and 1 where that level is within 3 % of the surface."""
@@ -73,21 +76,36 @@ def friction_levels(
     peaks, levels, speeds = [], [], []
     for m, ph in zip(mans, phases):
         q = np.full(m.n, np.nan)
+        qd = np.full(m.n, np.nan)
+        vel = np.full(m.n, np.nan)
         for a, b in zip(m.starts[:-1], m.starts[1:]):
             run = obs.run({"f_n": m.f_n[a:b], "f_t": m.f_t[a:b], "tau": m.tau[a:b], "t": m.t[a:b]})
             g = np.asarray(run.g)
             with np.errstate(invalid="ignore", divide="ignore"):
                 q[a:b] = _smooth(np.abs(np.asarray(run.y)) / g, _SMOOTH)
+                # the dry part: the viscous torque at the true speed taken off
+                visc = np.asarray(run.sigma_1) * np.abs(m.omega[a:b])
+                qd[a:b] = _smooth((np.abs(np.asarray(run.y)) - visc) / g, _SMOOTH)
+                # RMS sliding speed over the patch, |omega| rho sqrt(c~u^2 + 1/2) [m/s]
+                rho = p.delta * np.asarray(m.f_n[a:b]) ** p.gamma
+                cu = np.asarray(run.c_tilde_unclipped)
+                vel[a:b] = np.abs(m.omega[a:b]) * rho * np.sqrt(cu * cu + 0.5)
+                # sigma_1 is about the clipped CoR: the dry part only where the CoR is not clipped
+                qd[a:b][np.asarray(run.saturated, bool)] = np.nan
         slide = (np.asarray(ph) == SLIDING) & np.isfinite(q)
         if not slide.any():
             continue
         sliding_q.append(q[slide])
         first = int(np.flatnonzero(slide)[0])
-        window = q[: min(m.n, first + _AFTER)]
+        window = qd[: min(m.n, first + _AFTER)]
         window = window[np.isfinite(window)]
-        level = float(np.median(q[slide]))
-        speed = float(np.median(np.abs(m.omega[slide])))
-        if window.size and level > 0.0 and speed > 0.0:
+        dry = qd[slide]
+        dry = dry[np.isfinite(dry)]
+        if dry.size == 0:
+            continue
+        level = float(np.median(dry))
+        speed = float(np.nanmedian(vel[slide]))
+        if window.size and level > 0.0 and speed > 0.0 and math.isfinite(speed):
             peaks.append(float(window.max()))
             levels.append(level)
             speeds.append(speed)
@@ -117,7 +135,7 @@ def friction_levels(
             static = float(np.clip(static_q, kinetic, 3.0))
     line = (
         f"(d) friction levels from {q_all.size} gross-sliding samples of {n} runs (load |y|/g "
-        f"on the fitted surface): sliding level {kinetic:.3g} ({100 * SLIDING_QUANTILE:g} % "
+        f"on the fitted surface; dry part without sigma_1 |omega| for the runs): sliding level {kinetic:.3g} ({100 * SLIDING_QUANTILE:g} % "
         "quantile" + (", within 3 % of the surface: 1" if kinetic == 1.0 else "")
         + f"); slope of the runs' sliding level on their speed t = {t:.3g}, break-away "
         f"({100 * BREAKAWAY_QUANTILE:g} % quantile of the peaks) over sliding level {med:.3g}: "
