@@ -88,6 +88,7 @@ void bind_observer(nb::module_& m) {
         o.reset();
       })
       .def_prop_ro("omega_hat", [](const Obs& o) { return o.omega_hat(); })
+      .def_prop_ro("omega_state", [](const Obs& o) { return o.omega_state(); })
       .def_prop_ro("z_hat", [](const Obs& o) { return o.z_hat(); })
       .def("step", [](Obs& o, double f_n, double f_t, double tau, double dt) {
         o.guard.check("Observer");

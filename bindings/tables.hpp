@@ -27,14 +27,16 @@ template <>
 struct Table<ContactParams> {
   using S = ContactParams;
   static constexpr auto fields = std::make_tuple(
-      field("mu", &S::mu, "Coulomb friction coefficient [-]"),
+      field("mu", &S::mu, "friction coefficient of the limit surface [-]"),
       field("beta_a", &S::beta_a, "viscous friction per unit area and speed [N s/m^3]"),
       field("sigma0", &S::sigma0, "bristle stiffness [N m/rad]"),
       field("sigma_z", &S::sigma_z, "bristle damping [N m s/rad]"),
       field("delta", &S::delta, "contact-radius law rho = delta f_n^gamma [m/N^gamma]"),
       field("gamma", &S::gamma, "contact-radius exponent [-]"),
       field("k", &S::k, "pressure exponent [-]; 0 selects the elliptic limit surface"),
-      field("c_max", &S::c_max, "saturation of the normalized CoR |c~| [-]"));
+      field("c_max", &S::c_max, "saturation of the normalized CoR |c~| [-]"),
+      field("static_ratio", &S::static_ratio, "break-away friction over mu, mu_s / mu [-] (S's capacity in stick)"),
+      field("kinetic_ratio", &S::kinetic_ratio, "sliding friction level over mu, mu_k / mu [-] (S's capacity once sliding)"));
 };
 
 template <>
@@ -148,7 +150,7 @@ struct Table<CorOutput> {
       field("tau_tilde", &S::tau_tilde, "tau / tau_max [-]"),
       field("sigma", &S::sigma, "eq. 14 ratio [-]"),
       field("rho", &S::rho, "contact radius [m]"),
-      field("g", &S::g, "dry torque capacity about the CoR [N m]"),
+      field("g", &S::g, "dry torque capacity about the CoR used by the update [N m]; times static_ratio in stick"),
       field("sigma_1", &S::sigma_1, "viscous coefficient about the CoR [N m s/rad]"),
       field("y", &S::y, "friction torque about the CoR [N m]"),
       field("inside", &S::inside, "wrench strictly inside the limit surface"),
@@ -179,12 +181,12 @@ template <>
 struct Table<ObserverOutput> {
   using S = ObserverOutput;
   static constexpr auto fields = std::make_tuple(
-      field("omega_hat", &S::omega_hat, "estimated slip velocity about the clipped CoR [rad/s]"),
+      field("omega_hat", &S::omega_hat, "estimated slip velocity about the clipped CoR [rad/s]; 0 where omega_resolution > 1.5 resolution_max"),
       field("z_hat", &S::z_hat, "estimated bristle state [rad]"),
       field("S", &S::S, "slippage indicator sigma0 |z_hat| / g [-] (eq. 37)"),
       field("c_tilde", &S::c_tilde, "normalized CoR [-]"),
       field("c", &S::c, "CoR position [m]"),
-      field("g", &S::g, "dry torque capacity about the CoR [N m]"),
+      field("g", &S::g, "dry torque capacity about the CoR used by the update [N m]; times static_ratio in stick"),
       field("sigma_1", &S::sigma_1, "viscous coefficient about the CoR [N m s/rad]"),
       field("y", &S::y, "measured friction torque about the CoR, tau - c f_t [N m]"),
       field("tau_cor", &S::tau_cor, "filtered torque used for the CoR [N m]"),
@@ -202,8 +204,10 @@ struct Table<ObserverOutput> {
       field("cor_iterations", &S::cor_iterations, "root-finding iterations of the CoR"),
       field("status", &S::status, "Status"),
       field("c_tilde_unclipped", &S::c_tilde_unclipped, "normalized CoR before the clip [-]"),
-      field("omega_object", &S::omega_object, "slip velocity about the unclipped CoR [rad/s]"),
-      field("v_slip", &S::v_slip, "slip speed of the patch centre [m/s]"));
+      field("omega_object", &S::omega_object, "slip velocity about the unclipped CoR [rad/s]; 0 where omega_hat is"),
+      field("v_slip", &S::v_slip, "slip speed of the patch centre [m/s]; 0 where omega_hat is"),
+      field("omega_state", &S::omega_state, "the observer's slip-velocity state (omega_hat before the resolution gate) [rad/s]"),
+      field("kinetic", &S::kinetic, "sliding has started: S judged against kinetic_ratio g (friction ratios not 1)"));
 };
 
 template <>

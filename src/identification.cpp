@@ -192,9 +192,9 @@ void run_segment(Observer& obs, const SegmentWork& w, int64_t begin, int64_t end
 
   for (int64_t i = begin; i < end; ++i) {
     const double dt_in = i == begin ? 0.0 : d.dt[i];
-    const double z_before = obs.z_hat(), w_before = obs.omega_hat();
+    const double z_before = obs.z_hat(), w_before = obs.omega_state();
     const Status st = obs.step(ObserverInput{d.f_n[i], d.f_t[i], d.tau[i], dt_in}, o);
-    if (w.omega_hat) w.omega_hat[i] = o.omega_hat;
+    if (w.omega_hat) w.omega_hat[i] = o.omega_state;
     if (st == Status::Reinitialized) ++out.reinitialized;
     if (o.diverged) ++out.diverged;
 
@@ -256,10 +256,13 @@ void run_segment(Observer& obs, const SegmentWork& w, int64_t begin, int64_t end
         c.sigma0 = sigma0;
         c.sigma_z = sigma_z;
         c.g = Dual(o.g);
+        // friction ratios: in stick the observer's update uses static_ratio times the capacity
+        const double stick_factor =
+            ((p.static_ratio != 1.0 || p.kinetic_ratio != 1.0) && !o.kinetic) ? p.static_ratio : 1.0;
         if (p.mu * f_n * rho * G >= os.g_floor) {
-          const double unit = p.mu * f_n;  // g = unit rho G(a)
+          const double unit = stick_factor * p.mu * f_n;  // g = unit rho G(a)
           for (int k = 0; k < N; ++k) c.g.d[k] = unit * (drho[k] * G + rho * dG * da[k]);
-          c.g.d[kMu] += f_n * rho * G;
+          c.g.d[kMu] += stick_factor * f_n * rho * G;
         }
         c.sigma_1 = Dual(o.sigma_1);
         {
@@ -294,12 +297,12 @@ void run_segment(Observer& obs, const SegmentWork& w, int64_t begin, int64_t end
           ww.v = o.cor_side_flipped ? -w_before : w_before;
           advance(zz, ww, h, c, os.integrator, o.substeps);
           const double bound = o.g / p.sigma0;
-          out.replica_error = std::max(out.replica_error, std::fabs(ww.v - o.omega_hat));
+          out.replica_error = std::max(out.replica_error, std::fabs(ww.v - o.omega_state));
           out.replica_error = std::max(out.replica_error, std::fabs(zz.v - o.z_hat) / bound);
           z = zz;
           omega = ww;
           z.v = o.z_hat;
-          omega.v = o.omega_hat;
+          omega.v = o.omega_state;
           // Chattering guard: where the discrete map is locally chaotic (omega_hat crossing zero
           // with a huge gain), the pathwise derivative grows without bound although the cost
           // varies smoothly on any finite scale. Restart the sensitivities there as at an
@@ -326,7 +329,7 @@ void run_segment(Observer& obs, const SegmentWork& w, int64_t begin, int64_t end
     const double target = d.omega[i];
     const double wt = d.weight[i];
     if (!(scored_status(st) && std::isfinite(target) && wt > 0.0)) continue;
-    const double r = o.omega_hat - target;
+    const double r = o.omega_state - target;
     SegmentSums& S = out.sums;
     S.sse += r * r;
     S.weight += wt;

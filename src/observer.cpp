@@ -138,6 +138,7 @@ void Observer::reset() noexcept {
   pending_ = 0.0;
   invalid_run_ = 0;
   need_init_ = true;
+  kinetic_ = false;
   last_ = ObserverOutput();
 }
 
@@ -190,6 +191,8 @@ Status Observer::step(const ObserverInput& in, ObserverOutput& out) noexcept {
     need_init_ = true;
     ObserverOutput r = last_;
     r.omega_hat = 0.0;
+    r.omega_state = 0.0;
+    r.kinetic = false;
     r.z_hat = 0.0;
     r.S = 0.0;
     r.y = 0.0;
@@ -246,6 +249,23 @@ Status Observer::step(const ObserverInput& in, ObserverOutput& out) noexcept {
   rc.sigma_z = p.sigma_z;
   rc.sigma_1 = co.sigma_1;
   rc.g = std::max(co.g, s_.g_floor);
+  // Friction ratios (static_ratio, kinetic_ratio not both 1, docs/model.md 7.5): in stick the
+  // update and S use the static capacity static_ratio g; once the friction about the CoR has
+  // reached kBreakawayLevel of the sliding level kinetic_ratio g (a slip could now be under way
+  // and would not stop), the update uses g and S that sliding level, until the friction falls
+  // below kStickRelease of it. The mode of a sample is decided from the state it
+  // starts from, so one capacity holds over the whole update.
+  const bool ratios = p.static_ratio != 1.0 || p.kinetic_ratio != 1.0;
+  bool kinetic = false;
+  double s_capacity = 1.0;  // S's capacity over the update's g
+  if (ratios) {
+    if (!init) {
+      const double load = p.sigma0 * std::fabs(z0) / rc.g;  // friction about the CoR over g
+      kinetic = load >= (kinetic_ ? kStickRelease : kBreakawayLevel) * p.kinetic_ratio;
+    }
+    if (kinetic) s_capacity = p.kinetic_ratio;
+    else rc.g *= p.static_ratio;
+  }
   rc.drive = in.tau - co.c * in.f_t;
   if (s_.gain_mode == GainMode::Fixed) {
     rc.gain = s_.gain;
@@ -274,10 +294,13 @@ Status Observer::step(const ObserverInput& in, ObserverOutput& out) noexcept {
       status = Status::Reinitialized;
     }
   }
-  const double S = std::min(p.sigma0 * std::fabs(z) / rc.g, 1.0);
+  const double S = std::min(p.sigma0 * std::fabs(z) / (ratios ? s_capacity * rc.g : rc.g), 1.0);
   const double omega_resolution =
       co.sigma_1 > 0.0 ? std::min(s_.torque_noise / co.sigma_1, std::numeric_limits<double>::max())
                        : (s_.torque_noise > 0.0 ? std::numeric_limits<double>::max() : 0.0);
+  const bool observable = omega_resolution <= s_.resolution_max;
+  // omega_hat is reported up to kOmegaReportFactor x resolution_max, 0 beyond (header)
+  const bool report = omega_resolution <= kOmegaReportFactor * s_.resolution_max;
   double omega_object = 0.0, v_slip = 0.0;
   unclipped_slip(w, std::fabs(co.c_tilde), std::fabs(co.c_tilde_unclipped), co.rho, omega_object, v_slip);
   if (!(std::isfinite(z) && std::isfinite(S) && std::isfinite(rc.drive) && std::isfinite(bound) &&
@@ -294,10 +317,13 @@ Status Observer::step(const ObserverInput& in, ObserverOutput& out) noexcept {
   pending_ = 0.0;
   invalid_run_ = 0;
   need_init_ = false;
+  kinetic_ = kinetic && status != Status::Reinitialized;
   // Written field by field to last_ and out (no zero-initialised temporary, no struct copy
   // through the stack).
   auto fill = [&](ObserverOutput& r) {
-    r.omega_hat = omega_;
+    r.omega_hat = report ? omega_ : 0.0;
+    r.omega_state = omega_;
+    r.kinetic = kinetic_;
     r.z_hat = z_;
     r.S = S;
     r.c_tilde = co.c_tilde;
@@ -309,7 +335,7 @@ Status Observer::step(const ObserverInput& in, ObserverOutput& out) noexcept {
     r.ft_cor = ft_cor;
     r.gain = rc.gain;
     r.omega_resolution = omega_resolution;
-    r.speed_observable = omega_resolution <= s_.resolution_max;
+    r.speed_observable = observable;
     r.inside = co.inside;
     r.saturated = co.saturated;
     r.projected = projected;
@@ -320,8 +346,8 @@ Status Observer::step(const ObserverInput& in, ObserverOutput& out) noexcept {
     r.cor_iterations = co.iterations;
     r.status = status;
     r.c_tilde_unclipped = co.c_tilde_unclipped;
-    r.omega_object = omega_object;
-    r.v_slip = v_slip;
+    r.omega_object = report ? omega_object : 0.0;
+    r.v_slip = report ? v_slip : 0.0;
   };
   fill(last_);
   fill(out);

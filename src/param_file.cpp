@@ -73,9 +73,11 @@ ContactParams read_contact(const YAML::Node& block, const std::string& where) {
     else if (key == "gamma") field = &p.gamma;
     else if (key == "k") field = &p.k;
     else if (key == "c_max") field = &p.c_max;
-    else fail(at, "unknown parameter (expected mu, beta_a, sigma0, sigma_z, delta, gamma, k, c_max)");
+    else if (key == "static_ratio") field = &p.static_ratio;
+    else if (key == "kinetic_ratio") field = &p.kinetic_ratio;
+    else fail(at, "unknown parameter (expected mu, beta_a, sigma0, sigma_z, delta, gamma, k, c_max, static_ratio, kinetic_ratio)");
     *field = number(v, at);
-    if (key != "k" && key != "c_max") ++required;
+    if (key != "k" && key != "c_max" && key != "static_ratio" && key != "kinetic_ratio") ++required;
   }
   if (required < 6) fail(where, "needs mu, beta_a, sigma0, sigma_z, delta and gamma");
   std::string msg;

@@ -30,6 +30,12 @@ bool validate(const ContactParams& p, std::string* message) {
   if (!(p.k >= kMinPressureExponent || p.k == kEllipticLimitSurface))
     bad("k", p.k, "must be >= 0.5 (inf for uniform pressure) or 0 (elliptic limit surface)");
   if (!(std::isfinite(p.c_max) && p.c_max > 0.0 && p.c_max <= 1.0e3)) bad("c_max", p.c_max, "must be finite, > 0 and <= 1000");
+  if (!(std::isfinite(p.static_ratio) && p.static_ratio >= kMinFrictionRatio && p.static_ratio <= kMaxFrictionRatio))
+    bad("static_ratio", p.static_ratio, "must be finite, >= 0.5 and <= 3 (mu_s / mu)");
+  if (!(std::isfinite(p.kinetic_ratio) && p.kinetic_ratio >= kMinFrictionRatio && p.kinetic_ratio <= kMaxFrictionRatio))
+    bad("kinetic_ratio", p.kinetic_ratio, "must be finite, >= 0.5 and <= 3 (mu_k / mu)");
+  else if (!(p.static_ratio >= p.kinetic_ratio))
+    bad("static_ratio", p.static_ratio, "must be >= kinetic_ratio (static friction is not below kinetic)");
   if (message) *message = msg;
   return msg.empty();
 }
@@ -67,7 +73,8 @@ ContactParams object_params(const std::string& name) {
 std::string to_string(const ContactParams& p) {
   return "ContactParams(mu=" + fmt(p.mu) + ", beta_a=" + fmt(p.beta_a) + ", sigma0=" + fmt(p.sigma0) +
          ", sigma_z=" + fmt(p.sigma_z) + ", delta=" + fmt(p.delta) + ", gamma=" + fmt(p.gamma) +
-         ", k=" + (std::isinf(p.k) ? std::string("float('inf')") : fmt(p.k)) + ", c_max=" + fmt(p.c_max) + ")";
+         ", k=" + (std::isinf(p.k) ? std::string("float('inf')") : fmt(p.k)) + ", c_max=" + fmt(p.c_max) +
+         ", static_ratio=" + fmt(p.static_ratio) + ", kinetic_ratio=" + fmt(p.kinetic_ratio) + ")";
 }
 
 const char* to_string(Status s) noexcept {

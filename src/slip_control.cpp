@@ -73,7 +73,9 @@ Status SlipControl::observe(const SlipControlInput& in, SlipControlOutput& out) 
       if (repeats_[i] >= s_.stuck_samples && is_valid(o.status)) o.status = Status::SensorFault;
     }
     FingerInput& f = cin_.fingers[i];
-    f.omega_hat = o.omega_hat;
+    // the controller's C_d takes the observer's state, as before the observer gated its reported
+    // omega_hat where the speed is not in the data (the controller has the resolution beside it)
+    f.omega_hat = o.omega_state;
     f.omega_resolution = o.omega_resolution;
     f.slippage = o.S;
     f.c_tilde = o.c_tilde;

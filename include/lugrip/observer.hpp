@@ -121,10 +121,28 @@ struct ObserverInput {
   }
 };
 
+//! Friction ratios (ContactParams::static_ratio r_s, kinetic_ratio r_k, not both 1; docs/model.md
+//! 7.5): the observer starts in stick, where the update and S use the static capacity r_s g; once
+//! the friction torque about the CoR reaches kBreakawayLevel r_k g (the level at which a slip,
+//! once under way, does not stop) the update uses g and S is judged against r_k g (clipped at 1),
+//! until the friction falls below kStickRelease r_k g (stuck again). With r_s = r_k = 1 this is
+//! the paper's S.
+constexpr double kBreakawayLevel = 0.995;
+constexpr double kStickRelease = 0.8;
+
+//! omega_hat, omega_object and v_slip are reported where omega_resolution <= this factor times
+//! ObserverSettings::resolution_max and 0 beyond, where the speed is not in the data (noise and
+//! model error would set the number). Above 1, so the estimates just past the speed_observable
+//! flag, still good to a few resolutions, are kept; below 2, the margin identification gives data
+//! without a measurable viscous term (beta_A set so that the resolution is at least twice
+//! resolution_max everywhere, docs/model.md 8.3), so those report 0 throughout.
+constexpr double kOmegaReportFactor = 1.5;
+
 //! Result for one sample. Always finite. On InvalidSample / SensorFault the previous output is
 //! held (with the new status); on NoContact omega_hat = z_hat = S = y = 0 (state reset).
 //!
-//! Two angular velocities. omega_hat is the observer's state, the slip about the CoR the
+//! Two angular velocities. omega_hat is the observer's state (reported up to kOmegaReportFactor
+//! resolution_max, else 0; the state itself is omega_state), the slip about the CoR the
 //! dynamics use, i.e. with |c~| clipped at c_max (paper; docs/model.md §5.6); it is what the grasp
 //! controller's dynamic part C_d filters (GraspController, FingerInput::omega_hat). On a
 //! translation-dominated slide the true CoR lies far beyond the clip, the object turns slowly
@@ -140,12 +158,16 @@ struct ObserverInput {
 //! Without the clip (a_u = a) these are omega_hat and |omega_hat c|; a pure translation
 //! (a_u -> inf) gives omega_object -> 0 and a finite v_slip.
 struct ObserverOutput {
-  double omega_hat = 0.0;   //!< estimated slip velocity about the clipped CoR c [rad/s] (object vs fingertip); drives C_d
+  //! estimated slip velocity about the clipped CoR c [rad/s] (object vs fingertip); drives C_d.
+  //! Reported as 0 where omega_resolution > kOmegaReportFactor resolution_max (the speed is not in
+  //! the data: 0 is never worse than a number drawn from noise and model error); omega_state is
+  //! the observer's state.
+  double omega_hat = 0.0;
   double z_hat = 0.0;       //!< estimated bristle state [rad], |sigma0 z_hat| <= g
-  double S = 0.0;           //!< slippage indicator sigma0 |z_hat| / g in [0, 1] (eq. 37)
+  double S = 0.0;           //!< slippage indicator sigma0 |z_hat| / g in [0, 1] (eq. 37); / (kinetic_ratio g) when kinetic
   double c_tilde = 0.0;     //!< normalized CoR [-] (sensor frame), |c~| <= c_max
   double c = 0.0;           //!< CoR position [m]
-  double g = 0.0;           //!< dry torque capacity about the CoR [N m] (eq. 18, floored)
+  double g = 0.0;           //!< dry torque capacity about the CoR used by the update [N m] (eq. 18, floored); times static_ratio in stick
   double sigma_1 = 0.0;     //!< viscous coefficient about the CoR [N m s/rad] (eq. 17)
   double y = 0.0;           //!< measured friction torque about the CoR, tau - c f_t [N m] (eq. 20), raw torque
   double tau_cor = 0.0;     //!< filtered torque (with sign hysteresis) used for the CoR [N m]
@@ -165,8 +187,12 @@ struct ObserverOutput {
   int cor_iterations = 0;   //!< root-finding iterations of the CoR estimate
   Status status = Status::NoContact;
   double c_tilde_unclipped = 0.0;  //!< normalized CoR before the clip [-], signed like c_tilde, |c~u| >= |c~|
-  double omega_object = 0.0;  //!< slip velocity about the unclipped CoR [rad/s] (= omega_hat where c~u = c~)
-  double v_slip = 0.0;        //!< slip speed of the patch centre [m/s], >= 0
+  double omega_object = 0.0;  //!< slip velocity about the unclipped CoR [rad/s] (= omega_hat where c~u = c~); 0 where omega_hat is
+  double v_slip = 0.0;        //!< slip speed of the patch centre [m/s], >= 0; 0 where omega_hat is
+  double omega_state = 0.0;   //!< the observer's slip-velocity state (omega_hat before the resolution gate) [rad/s]
+  //! sliding has started: g is the fitted capacity and S = sigma0 |z_hat| / (kinetic_ratio g);
+  //! false in stick and always false when ContactParams::static_ratio == kinetic_ratio == 1
+  bool kinetic = false;
 };
 
 //! Nonlinear sliding-velocity observer of the paper (eqs. 21-23, docs/model.md 7), per fingertip:
@@ -204,7 +230,9 @@ class Observer {
   //! restart). False: mu out of range, nothing changed.
   bool set_mu(double mu) noexcept { return cor_.set_mu(mu); }
 
-  double omega_hat() const noexcept { return omega_; }
+  //! The last reported omega_hat (0 where the speed is not in the data) and the state itself.
+  double omega_hat() const noexcept { return last_.omega_hat; }
+  double omega_state() const noexcept { return omega_; }
   double z_hat() const noexcept { return z_; }
   const ContactModel& model() const noexcept { return cor_.model(); }
   const ObserverSettings& settings() const noexcept { return s_; }
@@ -225,6 +253,7 @@ class Observer {
   double alpha_dt_ = 1.0;   // low-pass coefficient of the CoR inputs at the nominal period
   int invalid_run_ = 0;
   bool need_init_ = true;
+  bool kinetic_ = false;  // Stribeck term: the capacity is the kinetic one (sliding has started)
   ObserverOutput last_;
 };
 

@@ -295,7 +295,13 @@ class Observer(NoCopy):
 
     @property
     def omega_hat(self) -> float:
+        """The last reported omega_hat [rad/s] (0 where the speed is not in the data)."""
         return self._obs.omega_hat
+
+    @property
+    def omega_state(self) -> float:
+        """The observer's slip-velocity state [rad/s] (omega_hat before the resolution gate)."""
+        return self._obs.omega_state
 
     @property
     def z_hat(self) -> float:
@@ -589,7 +595,7 @@ def observability(
     Args:
         params: ContactParams (sigma0, sigma_z are used), a preset name or a dict.
         z [rad], omega [rad/s], g [N m], sigma_1 [N m s/rad]: arrays (broadcast). Alternatively
-            pass an :class:`ObserverRun` as `z` (z_hat, omega_hat, g, sigma_1 and the gain used
+            pass an :class:`ObserverRun` as `z` (z_hat, omega_state, g, sigma_1 and the gain used
             are taken from it).
         gain: observer gain l (scalar or array) [1/(kg m^2)].
         rtol: rank tolerance on the ratio of singular values of the row-normalised Theta.
@@ -599,7 +605,7 @@ def observability(
     p = _as_params(params)
     if isinstance(z, ObserverRun):
         run = z
-        z, omega, g, sigma_1, gain = run.z_hat, run.omega_hat, run.g, run.sigma_1, run.gain
+        z, omega, g, sigma_1, gain = run.z_hat, run.omega_state, run.g, run.sigma_1, run.gain
     if omega is None or g is None or sigma_1 is None:
         raise ValueError("give z, omega, g and sigma_1 (or an ObserverRun)")
     (z, w, g, s1, l), shape = _flat(z, omega, g, sigma_1, gain)

@@ -12,7 +12,8 @@ from ._yaml import describe_kind, field_path, load_yaml, to_number
 
 __all__ = ["ContactParams", "PRESETS", "read_observer_settings"]
 
-_FIELDS = ("mu", "beta_a", "sigma0", "sigma_z", "delta", "gamma", "k", "c_max")
+_FIELDS = ("mu", "beta_a", "sigma0", "sigma_z", "delta", "gamma", "k", "c_max", "static_ratio",
+           "kinetic_ratio")
 _UNITS = {
     "mu": "-",
     "beta_a": "N s/m^3",
@@ -22,6 +23,8 @@ _UNITS = {
     "gamma": "-",
     "k": "-",
     "c_max": "-",
+    "static_ratio": "-",
+    "kinetic_ratio": "-",
 }
 
 
@@ -30,7 +33,8 @@ class ContactParams:
     """Physical parameters of one fingertip/object contact, SI units.
 
     Args:
-        mu: Coulomb friction coefficient [-].
+        mu: friction coefficient of the limit surface [-] (identification fits it to the
+            gross-sliding wrenches).
         beta_a: viscous friction per unit contact area and unit sliding speed [N s/m^3]. The
             paper prints "Ns/m"; eq. 7 (f_tv = pi beta_A rho^2 omega c) needs N s/m^3, so the
             printed numbers are used unchanged with the unit corrected (docs/model.md section 11).
@@ -42,6 +46,11 @@ class ContactParams:
             contact on an elliptic friction cone, with xi fixed at its k = 4 value
             (docs/model.md §3.5).
         c_max: saturation of the normalized CoR |c~| (paper: 1.5).
+        static_ratio: break-away friction over mu, mu_s / mu, in [0.5, 3]: the capacity the
+            observer judges S against in stick.
+        kinetic_ratio: sliding friction level over mu, mu_k / mu, in [0.5, 3]: the capacity
+            S is judged against once sliding has started. Both 1 (default, the paper's
+            model): no Stribeck term, S as in the paper (docs/model.md §7.5).
 
     Raises:
         ValueError: naming every invalid field.
@@ -55,6 +64,8 @@ class ContactParams:
     gamma: float
     k: float = 4.0
     c_max: float = 1.5
+    static_ratio: float = 1.0
+    kinetic_ratio: float = 1.0
 
     def __post_init__(self) -> None:
         for name in _FIELDS:
@@ -178,6 +189,7 @@ class ContactParams:
                 name: {"value": getattr(self, name) if math.isfinite(getattr(self, name)) else ".inf",
                        "unit": _UNITS[name]}
                 for name in _FIELDS
+                if name not in ("static_ratio", "kinetic_ratio") or getattr(self, name) != 1.0
             }
         }
         if observer is not None:

@@ -901,3 +901,47 @@ TEST(Observer, RejectedSamplesLeaveTheStateAsItWas) {
   s.cor.f_n_min = 1e-300;
   EXPECT_THROW(Observer(p, s), std::invalid_argument);
 }
+
+// No plant: pure-rotation wrenches (f_t = 0, c~ = 0) at load fractions of tau_max, eqs. 16-18.
+TEST(ObserverFrictionRatios, StaticLevelInStickKineticOnceSlidingAndTheResolutionGate) {
+  ContactParams p = table1_params();
+  p.beta_a = 1.0e4;  // speed not in the data
+  p.sigma_z = 1.0e-3;
+  const double f_n = 4.0;
+  const double tau_max = p.mu * shape_factor(p.k) * p.delta * std::pow(f_n, 1.0 + p.gamma);
+  auto run = [&](const ContactParams& q, const std::vector<double>& loads) {
+    Observer obs(q);
+    std::vector<ObserverOutput> out(loads.size());
+    for (std::size_t i = 0; i < loads.size(); ++i) obs.step(ObserverInput{f_n, 0.0, loads[i] * tau_max, 0.002}, out[i]);
+    return out;
+  };
+  std::vector<double> loads;
+  auto hold = [&](double v, int n) { for (int i = 0; i < n; ++i) loads.push_back(v); };
+  hold(0.6, 300);   // stick
+  hold(0.95, 300);  // the kinetic level (0.9) reached
+  hold(0.8, 300);   // above the release (0.72)
+  hold(0.5, 300);   // stuck again
+  ContactParams r = p;
+  r.static_ratio = 1.3;
+  r.kinetic_ratio = 0.9;
+  const auto a = run(p, loads), b = run(r, loads);
+  for (const auto& o : a) {  // default ratios: the paper's S, never kinetic
+    EXPECT_EQ(o.S, std::min(p.sigma0 * std::fabs(o.z_hat) / o.g, 1.0));
+    EXPECT_FALSE(o.kinetic);
+    EXPECT_FALSE(o.speed_observable);
+    EXPECT_EQ(o.omega_hat, 0.0);  // resolution far beyond 1.5 x resolution_max
+    EXPECT_EQ(o.omega_object, 0.0);
+    EXPECT_EQ(o.v_slip, 0.0);
+  }
+  double moved = 0.0;  // the state moves at the load steps while the reported value stays 0
+  for (const auto& o : a) moved = std::max(moved, std::fabs(o.omega_state));
+  EXPECT_GT(moved, 0.0);
+  EXPECT_FALSE(b[299].kinetic);
+  EXPECT_NEAR(b[299].S, 0.6 / 1.3, 0.01);
+  EXPECT_TRUE(b[599].kinetic);
+  EXPECT_EQ(b[599].S, 1.0);
+  EXPECT_TRUE(b[899].kinetic);
+  EXPECT_NEAR(b[899].S, 0.8 / 0.9, 0.01);
+  EXPECT_FALSE(b[1199].kinetic);
+  EXPECT_NEAR(b[1199].S, 0.5 / 1.3, 0.01);
+}

@@ -102,3 +102,17 @@ TEST(ParamFile, BadFieldsAreNamed) {
   EXPECT_NE(error_of(std::string(2 << 20, ' ')).find("larger than 1 MiB"), std::string::npos);
   EXPECT_THROW(load_parameter_file("/nonexistent/file.yaml"), std::invalid_argument);
 }
+
+TEST(ParamFile, ReadsTheFrictionRatiosAndDefaultsThemToOne) {
+  const std::string base = "contact: {mu: 0.5, beta_a: 1e7, sigma0: 16, sigma_z: 2, delta: 0.0018, gamma: 0.25";
+  const ParameterFile plain = parse_parameter_file(base + "}\n", "f.yaml");
+  EXPECT_EQ(plain.params.static_ratio, 1.0);
+  EXPECT_EQ(plain.params.kinetic_ratio, 1.0);
+  const ParameterFile stribeck = parse_parameter_file(
+      base + ", static_ratio: {value: 1.09, unit: '-'}, kinetic_ratio: 0.9}\n", "f.yaml");
+  EXPECT_EQ(stribeck.params.static_ratio, 1.09);
+  EXPECT_EQ(stribeck.params.kinetic_ratio, 0.9);
+  EXPECT_NE(error_of(base + ", static_ratio: 0.8, kinetic_ratio: 0.9}\n").find("static_ratio = 0.8"),
+            std::string::npos);
+  EXPECT_NE(error_of(base + ", kinetic_ratio: 4}\n").find("kinetic_ratio = 4"), std::string::npos);
+}

@@ -204,7 +204,7 @@ TEST(SlipControl, SameNumbersAsTheHandWiredPathWithStatuses) {
       const FingerWrench& w = in.fingers[i];
       const ObserverInput oin = ObserverInput::from_force_vector(w.f_n, w.f_x, w.f_y, w.tau);
       obs[i].step(oin, o);
-      cin.fingers[i] = FingerInput{o.omega_hat, o.S, o.c_tilde, oin.f_t, o.status, true, o.omega_resolution, oin.tau, oin.f_n};
+      cin.fingers[i] = FingerInput{o.omega_state, o.S, o.c_tilde, oin.f_t, o.status, true, o.omega_resolution, oin.tau, oin.f_n};
     }
     ctrl.step(cin, ref);
     sc.step(in, out);
@@ -336,7 +336,7 @@ TEST(SlipControl, ClosedLoopOnThePatchPlantMatchesTheHandWiredLoop) {
       const ObserverInput oin = ObserverInput::from_force_vector(f.f_n, f.f_x, f.f_y, f.tau);
       ObserverOutput o;
       obs[i].step(oin, o);
-      cin.fingers[i] = FingerInput{o.omega_hat, o.S, o.c_tilde, oin.f_t, o.status, true, o.omega_resolution, oin.tau, oin.f_n};
+      cin.fingers[i] = FingerInput{o.omega_state, o.S, o.c_tilde, oin.f_t, o.status, true, o.omega_resolution, oin.tau, oin.f_n};
     }
     ctrl.step(cin, ref);
     plant.set_command(ref.force);

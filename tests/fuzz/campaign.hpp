@@ -288,7 +288,8 @@ class Campaign {
     params_.reals = {LUGRIP_FUZZ_REAL(ContactParams, mu),    LUGRIP_FUZZ_REAL(ContactParams, beta_a),
                      LUGRIP_FUZZ_REAL(ContactParams, sigma0), LUGRIP_FUZZ_REAL(ContactParams, sigma_z),
                      LUGRIP_FUZZ_REAL(ContactParams, delta),  LUGRIP_FUZZ_REAL(ContactParams, gamma),
-                     LUGRIP_FUZZ_REAL(ContactParams, k),      LUGRIP_FUZZ_REAL(ContactParams, c_max)};
+                     LUGRIP_FUZZ_REAL(ContactParams, k),      LUGRIP_FUZZ_REAL(ContactParams, c_max),
+                     LUGRIP_FUZZ_REAL(ContactParams, static_ratio), LUGRIP_FUZZ_REAL(ContactParams, kinetic_ratio)};
     params_.init([](const ContactParams& p) { return validate(p, nullptr); });
     // CoR estimator settings
     cor_.reals = {LUGRIP_FUZZ_REAL(CorSettings, f_n_min), LUGRIP_FUZZ_REAL(CorSettings, force_limit),

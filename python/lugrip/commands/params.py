@@ -34,15 +34,18 @@ examples:
 """
 
 _UNITS = {"mu": "-", "beta_a": "N s/m^3", "sigma0": "N m/rad", "sigma_z": "N m s/rad",
-          "delta": "m/N^gamma", "gamma": "-", "k": "-", "c_max": "-"}
-_MEANING = {"mu": "Coulomb friction coefficient",
+          "delta": "m/N^gamma", "gamma": "-", "k": "-", "c_max": "-",
+          "static_ratio": "-", "kinetic_ratio": "-"}
+_MEANING = {"mu": "friction coefficient of the limit surface",
             "beta_a": "viscous friction per unit area and speed",
             "sigma0": "micro-asperity stiffness",
             "sigma_z": "micro-asperity damping",
             "delta": "contact radius rho = delta f_n^gamma",
             "gamma": "contact radius exponent",
             "k": "pressure exponent (0: elliptic limit surface)",
-            "c_max": "saturation of |c~|"}
+            "c_max": "saturation of |c~|",
+            "static_ratio": "break-away friction / mu (S's capacity in stick)",
+            "kinetic_ratio": "sliding friction level / mu (S's capacity once sliding)"}
 
 
 def register(subparsers) -> None:

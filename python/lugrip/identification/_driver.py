@@ -28,6 +28,7 @@ from ._guess import _clip
 from ._optimize import _refit, minimise
 from ._result import IdentificationResult, estimates_of, evaluate_split
 from ._setup import _bounds, _parse_free, _split, check_options, read_params0
+from ._friction import friction_levels
 from ._start import staged_estimate
 from ._uncertainty import covariance
 
@@ -401,6 +402,16 @@ def identify(
             IdentificationWarning,
             stacklevel=2,
         )
+    if stage is not None and refine:
+        # (d) the friction levels S is judged against (break-away, sliding), at the result
+        keys = {m.key for m in train_m}
+        pairs = [(m, ph) for m, ph in zip(mans, stage.phases) if m.key in keys]
+        levels = friction_levels(
+            [m for m, _ in pairs], [ph for _, ph in pairs], p_hat, dict(odict)
+        )
+        p_hat = p_hat.replace(static_ratio=levels.static_ratio, kinetic_ratio=levels.kinetic_ratio)
+        stage = dataclasses.replace(stage, report=stage.report + (levels.line,))
+        ident.append(levels.line)
     data_warnings = _data_warnings(split, stage)
     for w in data_warnings:
         warnings.warn(w, IdentificationWarning, stacklevel=2)

@@ -6,8 +6,9 @@ equations (docs/rigs.md):
 * the contact is a disc of radius ``rho = delta f_n**gamma`` fixed in the fingertip, covered
   by an ``n_grid x n_grid`` grid of equal square cells (the cells whose centre lies inside
   the disc);
-* Hertzian pressure ``p(r) ~ sqrt(1 - r^2/rho^2)``, scaled so that the cells carry exactly
-  the normal force: ``p_i A_i = f_n w_i`` with ``sum w_i = 1``;
+* Hertzian pressure ``p(r) ~ sqrt(1 - r^2/rho^2)`` (or, with ``pressure="uniform"``, a
+  constant pressure), scaled so that the cells carry exactly the normal force:
+  ``p_i A_i = f_n w_i`` with ``sum w_i = 1``;
 * each cell has a 2-D bristle ``z_i`` [m] with LuGre dynamics driven by the slider's
   velocity relative to the pad at the cell, ``v_i``::
 
@@ -67,6 +68,7 @@ class GridContactRig:
         sigma2: viscous friction per unit normal load [s/m].
         beta_a: viscous shear per unit area and unit speed, uniform over the patch [N s/m^3].
         substeps: internal integration steps per sensor sample [-].
+        pressure: "hertz" (p ~ sqrt(1 - r^2/rho^2)) or "uniform" (p constant over the disc).
     """
 
     name: str = "grid-stribeck"
@@ -81,8 +83,11 @@ class GridContactRig:
     sigma2: float = 0.0
     beta_a: float = 0.0
     substeps: int = 2
+    pressure: str = "hertz"
 
     def __post_init__(self):
+        if self.pressure not in ("hertz", "uniform"):
+            raise ValueError(f"GridContactRig.pressure = {self.pressure!r}: 'hertz' or 'uniform'")
         if int(self.n_grid) < 3:
             raise ValueError("GridContactRig.n_grid must be >= 3")
         object.__setattr__(self, "n_grid", int(self.n_grid))
@@ -128,7 +133,7 @@ class GridContactRig:
 
     def cells(self) -> tuple[np.ndarray, np.ndarray, float]:
         """Cell centres in unit-disc coordinates (C, 2), their load weights w_i (sum 1,
-        Hertzian) and the cell area in units of rho^2."""
+        Hertzian or uniform) and the cell area in units of rho^2."""
         n = self.n_grid
         h = 2.0 / n
         x = -1.0 + h * (np.arange(n) + 0.5)
@@ -136,13 +141,13 @@ class GridContactRig:
         r2 = X * X + Y * Y
         inside = r2 < 1.0
         u = np.stack([X[inside], Y[inside]], axis=1)
-        w = np.sqrt(1.0 - r2[inside])
+        w = np.sqrt(1.0 - r2[inside]) if self.pressure == "hertz" else np.ones(int(inside.sum()))
         w = w / w.sum()
         return u, w, h * h
 
     def torsion_factor(self) -> float:
         """sum w_i |u_i| of the grid: tau_max = mu f_n rho times this (3 pi / 16 for the
-        continuous Hertzian disc)."""
+        continuous Hertzian disc, 2/3 for the uniform one)."""
         u, w, _ = self.cells()
         return float(np.sum(w * np.hypot(u[:, 0], u[:, 1])))
 
@@ -156,7 +161,7 @@ class GridContactRig:
         return RigTruth(
             name=self.name, mu_static=self.mu_s, mu_kinetic=self.mu_k, mu=self.mu_k,
             beta_a=self.beta_a if self.beta_a > 0.0 else None, viscous=viscous,
-            delta=self.delta, gamma=float(self.gamma), pressure="Hertzian (k = 2)",
+            delta=self.delta, gamma=float(self.gamma), pressure="Hertzian (k = 2)" if self.pressure == "hertz" else "uniform (k = inf)",
             tau_max_points=tuple(zip(f.tolist(), tmax.tolist())), notes=notes)
 
     def settings(self) -> dict:

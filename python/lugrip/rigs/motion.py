@@ -48,6 +48,11 @@ class RubbingDesign:
             speed over the patch, omega rho sqrt(c~^2 + 1/2), does not depend on the CoR
             (a robot rubbing at similar speeds in every direction; translation-dominated
             rubs turn slowly); when False the drawn value is used for every CoR.
+        edge_speed_range: when given, the peak sliding speed at the patch edge,
+            |omega| rho (c~ + 1), drawn log-uniform [m/s]; it replaces omega_range and
+            equal_patch_speed (None: omega_range as described above).
+        hold_slip: with edge_speed_range, each constant-speed leg lasts at least this slip
+            distance at the patch edge [m] (slow rubs reach gross sliding); 0: no minimum.
         v_max: cap on the patch-centre speed |omega| |c| at the peak [m/s]; the peak
             |omega| of a maneuver is lowered to respect it.
         f_n_range: nominal normal force, drawn uniform (stratified) [N].
@@ -73,6 +78,8 @@ class RubbingDesign:
     c_tilde_range: tuple[float, float] = (0.05, 20.0)
     omega_range: tuple[float, float] = (0.2, 2.0)
     equal_patch_speed: bool = True
+    edge_speed_range: tuple[float, float] | None = None
+    hold_slip: float = 0.0
     v_max: float = 0.1
     f_n_range: tuple[float, float] = (1.0, 10.0)
     approach: float = 0.1
@@ -93,7 +100,10 @@ class RubbingDesign:
 
     def __post_init__(self):
         for name in ("c_tilde_range", "omega_range", "f_n_range", "accel_range",
-                     "hold_range", "rest_range", "ripple_freq_range", "nominal_radius"):
+                     "hold_range", "rest_range", "ripple_freq_range", "nominal_radius",
+                     "edge_speed_range"):
+            if name == "edge_speed_range" and self.edge_speed_range is None:
+                continue
             pair = tuple(float(v) for v in getattr(self, name))
             if len(pair) != 2 or not all(math.isfinite(v) and v > 0.0 for v in pair):
                 raise ValueError(f"RubbingDesign.{name} = {getattr(self, name)!r}: "
@@ -106,7 +116,8 @@ class RubbingDesign:
             if not (math.isfinite(v) and v > 0.0):
                 raise ValueError(f"RubbingDesign.{name} = {v!r}: must be finite and > 0")
             object.__setattr__(self, name, v)
-        for name in ("noise_force", "noise_torque", "offset_force", "offset_torque", "ripple"):
+        for name in ("noise_force", "noise_torque", "offset_force", "offset_torque", "ripple",
+                     "hold_slip"):
             v = float(getattr(self, name))
             if not (math.isfinite(v) and v >= 0.0):
                 raise ValueError(f"RubbingDesign.{name} = {v!r}: must be finite and >= 0")
@@ -296,7 +307,8 @@ def plan_maneuvers(design: RubbingDesign, n: int, seed: int = 0, *,
     c_tilde = np.exp(lo + (hi - lo) * _stratified(rng, n))
     f_lo, f_hi = design.f_n_range
     f_nom = f_lo + (f_hi - f_lo) * _stratified(rng, n)
-    w_lo, w_hi = np.log(design.omega_range)
+    w_lo, w_hi = np.log(design.omega_range if design.edge_speed_range is None
+                        else design.edge_speed_range)
     w_peak = np.exp(w_lo + (w_hi - w_lo) * _stratified(rng, n))
     phi = rng.uniform(0.0, 2.0 * np.pi, n)
     sign = rng.choice((-1.0, 1.0), n)
@@ -314,12 +326,16 @@ def plan_maneuvers(design: RubbingDesign, n: int, seed: int = 0, *,
                              f"{f_nom[i]:.3g} N")
         c = float(c_tilde[i]) * rho
         peak = float(w_peak[i])
-        if design.equal_patch_speed:
+        if design.edge_speed_range is not None:  # drawn as the speed at the patch edge
+            peak /= rho * (float(c_tilde[i]) + 1.0)
+        elif design.equal_patch_speed:
             peak /= math.sqrt(1.0 + 2.0 * float(c_tilde[i]) ** 2)
         peak = min(peak, design.v_max / c)
         accel = float(np.exp(r.uniform(a_lo, a_hi)))
         legs = int(n_rev[i]) + 1
         holds = r.uniform(*design.hold_range, legs)
+        if design.edge_speed_range is not None and design.hold_slip > 0.0:
+            holds = np.maximum(holds, design.hold_slip / float(w_peak[i]))
         rest = float(r.uniform(*design.rest_range))
         kt = [0.0, design.approach]
         kw = [0.0, 0.0]
