@@ -192,7 +192,7 @@ class GripperSimNode(Node):
             pub.publish(msg)
 
 
-def controller_parameters(params, *, fingers=2, observer=None, stuck_samples=0,
+def controller_parameters(params, *, fingers=2, observer=None, stuck_samples=None,
                           healthy_finger_fallback=False, **controller) -> dict[str, Any]:
     """The node's settings parameters for SlipControl's arguments (as the MuJoCo loop builds
     its controller): the contact model, the effective observer (a file's block merged), the
@@ -205,6 +205,8 @@ def controller_parameters(params, *, fingers=2, observer=None, stuck_samples=0,
         if k != "dt":
             out[f"observer.cor.{k}" if k in cor else f"observer.{k}"] = v
     out.update({f"controller.{k}": v for k, v in controller.items()})
+    if stuck_samples is None:  # SlipControl's own default (the frozen-sensor check)
+        stuck_samples = _core.SlipControlSettings().stuck_samples
     out.update(fingers=int(fingers), stuck_samples=int(stuck_samples),
                healthy_finger_fallback=bool(healthy_finger_fallback))
     kinds = {spec.name: spec.kind for spec in settings_parameters()}
@@ -217,7 +219,7 @@ class RemoteSlipControl:
     by the controller node over ROS 2 (see the module docstring)."""
 
     def __init__(self, node: GripperSimNode, params, *, fingers=2, observer=None,
-                 stuck_samples=0, healthy_finger_fallback=False, lockstep: bool = True,
+                 stuck_samples=None, healthy_finger_fallback=False, lockstep: bool = True,
                  timeout: float = 5.0, **controller):
         ctrl = _core_settings(controller)
         self.settings = SimpleNamespace(controller=ctrl)
