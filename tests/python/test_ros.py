@@ -289,12 +289,19 @@ def _identify_recording_like_csv(tmp_path, rec_log: str) -> None:
                    omega_topic="/lugrip_gripper_sim/omega_true_0")
     run = np.genfromtxt(tmp_path / "run.csv", delimiter=",", names=True)
     started = np.flatnonzero(run["status"] != 3)[0]  # the controller's start: first published
-    cols = {c: run[f"{c}_meas_0"][started:] for c in ("f_n", "f_t", "tau")}
-    assert len(rec) == len(cols["f_n"]), (len(rec), len(cols["f_n"]))  # reliable: all
+    # Reliable QoS loses nothing once the recorder has matched the publisher; discovery may
+    # match it a few samples after the sim's first one (seen: 48 of 9990 on a loaded machine).
+    # The recording is then the run's last samples, none missing in between.
+    total = len(run["t"]) - started
+    k = len(rec)
+    assert total - 0.02 * total <= k <= total, (k, total)
+    first = len(run["t"]) - k
+    cols = {c: run[f"{c}_meas_0"][first:] for c in ("f_n", "f_t", "tau")}
+    np.testing.assert_allclose(np.asarray(rec.f_n), cols["f_n"], rtol=1e-9, atol=1e-12)
     n = len(cols["f_n"])
     csv_path = tmp_path / "run_finger0.csv"
-    write_log(SlidingLog.from_arrays(run["t"][started:], cols["f_n"], cols["tau"],
-                                     f_t=cols["f_t"], omega=run["omega_true_0"][started:]),
+    write_log(SlidingLog.from_arrays(run["t"][first:], cols["f_n"], cols["tau"],
+                                     f_t=cols["f_t"], omega=run["omega_true_0"][first:]),
               csv_path)
     from_csv = read_log(csv_path)
     assert n == len(from_csv)
