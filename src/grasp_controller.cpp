@@ -502,7 +502,7 @@ void GraspController::issue_command(bool valid, double slip) noexcept {
   if (mode_ == ControllerMode::SlippingAvoidance) {
     // Floor of the static part: feed-forward of the measured load (and the task's reserve), slip reflex.
     // The grip probe's answer first: a slip it finds lowers the belief, which the floors use.
-    probe_evaluate(slip);
+    probe_evaluate();
     double n_slope = 1.0;
     const double lift = reaction_floor(n_slope, c);
     const bool probe_started = probe_start(slip, c.reflex || lift > std::min(last_.static_force, command_));
@@ -659,7 +659,7 @@ GraspController::PeriodLoad GraspController::period_load(int i) const noexcept {
   return l;
 }
 
-void GraspController::probe_evaluate(double slip_mean) noexcept {
+void GraspController::probe_evaluate() noexcept {
   if (probe_left_ <= 0) return;
   --probe_left_;
   if (probe_left_ == 1) {  // the probe's second period: kept for the answer

@@ -350,7 +350,7 @@ class GraspController {
   // The grip probe (mu_probe): probe_evaluate() counts a running probe down and, at its end,
   // compares the period's load with the reference period's (slip lowers mu_); probe_start()
   // takes this period as the reference of a new probe when one is due (true: started).
-  void probe_evaluate(double slip_mean) noexcept;
+  void probe_evaluate() noexcept;
   bool probe_start(double slip_mean, bool reacting) noexcept;
   void reset_probe() noexcept;
   static constexpr int kProbeGapMin = 3;  // [commands] at least between two probes

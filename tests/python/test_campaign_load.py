@@ -37,12 +37,10 @@ def _write(tmp_path, doc, name="c.yaml") -> Path:
 
 
 def _exit_2(capsys, *argv) -> str:
-    t0 = time.perf_counter()
     rc = cli.main([str(a) for a in argv])
     err = capsys.readouterr().err.strip()
     assert rc == 2, err
     assert len(err.splitlines()) == 1 and "Traceback" not in err, err
-    assert time.perf_counter() - t0 < 5.0
     return err
 
 
@@ -86,9 +84,7 @@ def test_shipped_campaigns_pass_the_load_checks():
     from lugrip.campaign.validate import validate_campaign
 
     for name in ("patch_blocks", "mujoco_blocks"):
-        t0 = time.perf_counter()
         validate_campaign(load_campaign(ROOT / "campaigns" / f"{name}.yaml"))
-        assert time.perf_counter() - t0 < 5.0
 
 
 def _child_peak_mb() -> float:
@@ -104,7 +100,8 @@ _BOMB = "".join(
 @pytest.mark.parametrize("kind", ["campaign", "settings"])
 def test_alias_bombs_are_refused_quickly_in_a_small_memory(tmp_path, kind):
     """A 2.6 KB campaign file cost 768 MB and a 405 B settings file 810 MB: both now go
-    through lugrip._yaml.load_yaml (exit 2 in < 5 s, < 500 MB)."""
+    through lugrip._yaml.load_yaml (exit 2, < 500 MB; the time each refusal takes is measured by
+    benchmarks/reliability_cases.py, not here)."""
     bomb = tmp_path / f"{kind}.yaml"
     if kind == "campaign":
         bomb.write_text(SHIPPED.read_text() + _BOMB)
@@ -118,15 +115,12 @@ def test_alias_bombs_are_refused_quickly_in_a_small_memory(tmp_path, kind):
                 str(tmp_path / "r.csv")]
     code = ("import sys, resource; from lugrip.cli import main; rc = main(sys.argv[1:]); "
             "print(resource.getrusage(resource.RUSAGE_SELF).ru_maxrss); sys.exit(rc)")
-    t0 = time.perf_counter()
     proc = subprocess.run([sys.executable, "-c", code, *argv], capture_output=True, text=True,
                           check=False,
                           timeout=60)
-    elapsed = time.perf_counter() - t0
     assert proc.returncode == 2, proc.stderr
     assert "aliases" in proc.stderr and str(bomb) in proc.stderr
     assert len(proc.stderr.strip().splitlines()) == 1
-    assert elapsed < 5.0
     assert int(proc.stdout.strip()) / 1024.0 < 500.0  # peak [MB] of the refusing process
 
 

@@ -12,7 +12,6 @@ import signal
 import stat
 import subprocess
 import sys
-import time
 from pathlib import Path
 
 import pytest
@@ -203,9 +202,8 @@ def test_writability_is_checked_before_the_work(exit_2, tmp_path):
     """An output below a regular file (cannot exist): exit 2 at once, before the fit."""
     log = _log(tmp_path / "x.csv")
     (tmp_path / "file").write_text("x")
-    t0 = time.perf_counter()
     err = exit_2(["identify", log, "--out", tmp_path / "file" / "p.yaml"])
-    assert "--out" in err and time.perf_counter() - t0 < 5.0
+    assert "--out" in err
 
 
 def _make_unwritable(folder: Path):
@@ -232,10 +230,8 @@ def test_an_unwritable_folder_is_refused_before_the_work(exit_2, tmp_path):
     try:
         with pytest.raises(OSError):  # the folder really is unwritable for this process
             (ro / "probe").write_text("x")
-        t0 = time.perf_counter()
         err = exit_2(["identify", log, "--out", ro / "p.yaml", "--quiet"])
         assert "--out: cannot write in" in err and str(ro) in err
-        assert time.perf_counter() - t0 < 5.0
     finally:
         undo()
     assert list(ro.iterdir()) == []
@@ -251,10 +247,8 @@ def test_simulate_refuses_a_folder_with_earlier_results(exit_2, tmp_path):
     (out / "metrics.json").write_text('{"mine": 1}\n')
     (out / "experiments.md").write_text("# my notes\n")
     sums = {p.name: _sha(p) for p in out.iterdir()}
-    t0 = time.perf_counter()
     err = exit_2(["simulate", "exp1_big_resin_block", "--out", out])
     assert "experiments.md" in err and "metrics.json" in err and "--force" in err
-    assert time.perf_counter() - t0 < 5.0
     assert {p.name: _sha(p) for p in out.iterdir()} == sums
     # a result name that is a directory is refused even with --force
     (out / "mujoco.md").mkdir()
@@ -297,9 +291,8 @@ def test_campaign_refuses_report_files_of_another_folder(exit_2, tmp_path):
 @pytest.mark.parametrize("runs", ["1e9", "1000000000", "99999999999999999999999"])
 def test_campaign_run_count_is_refused_before_any_list(exit_2, tmp_path, runs):
     src = CAMPAIGN
-    t0 = time.perf_counter()
     err = exit_2(["campaign", src, "--runs", runs, "--out", tmp_path / "o"])
-    assert "--runs" in err and time.perf_counter() - t0 < 5.0
+    assert "--runs" in err
     assert not (tmp_path / "o").exists()
 
 
