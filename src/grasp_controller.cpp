@@ -25,12 +25,13 @@ constexpr double kProbeStepDown = 0.7;    // the belief falls by at most 30 % pe
 constexpr double kMuFloor = 0.5;          // ... and never below half the told mu
 constexpr double kProbeRise = 0.05;       // a new probe once S exceeds the highest stick answer by this
 // Constants of the law that were settings until a randomized campaign showed that changing them
-// did not pay (docs/controller.md §1).
-constexpr double kFeedforwardSlippage = 0.9;  // S the feed-forward and the reserve are solved for
+// did not pay (docs/controller.md §0).
+constexpr double kFeedforwardSlippage = 0.9;  // S the feed-forward is solved for (the reserve: S = 1)
 constexpr double kFeedforwardHorizon = 0.03;  // [s] the trend's extrapolation ahead of the command
 constexpr double kFeedforwardTrend = 0.5;     // the trend is used when it asks this much more
-constexpr double kSlidingSlippage = 0.93;     // S at or above: the period's contact counts as sliding
-constexpr double kReflexSlippage = 0.93;      // the slip reflex's threshold on S (below the 0.95 of a slide at the CoR clip)
+// S at or above: the contact slides (below the 0.95 of a translational slide at the CoR clip);
+// the slip reflex's threshold and the bound under which a period's load can refute a trend
+constexpr double kSlidingSlippage = 0.93;
 constexpr int kReflexSamples = 3;             // ... on this many samples of the period
 constexpr double kReflexFactor = 1.25;        // ... raises the static part by this factor
 constexpr double kOmegaDeadband = 1.0;        // C_d's dead band in the observer's speed resolutions
@@ -140,8 +141,9 @@ std::string to_string(const GraspControllerSettings& s) {
   return "GraspControllerSettings(sensor_rate=" + num(s.sensor_rate) +
          ", command_ratio=" + std::to_string(s.command_ratio) + ", f_min=" + num(s.f_min) +
          ", f_max=" + num(s.f_max) + ", max_rate_up=" + num(s.max_rate_up) +
-         ", max_rate_down=" + num(s.max_rate_down) + ", reaction_lag=" + num(s.reaction_lag) + ", s_ref=" + num(s.s_ref) + ", k_p=" + num(s.k_p) +
-         ", k_i=" + num(s.k_i) + ", gain_force=" + num(s.gain_force) +
+         ", max_rate_down=" + num(s.max_rate_down) + ", reaction_lag=" + num(s.reaction_lag) +
+         ", s_ref=" + num(s.s_ref) + ", k_p=" + num(s.k_p) + ", k_i=" + num(s.k_i) +
+         ", gain_force=" + num(s.gain_force) +
          ", dynamic_enabled=" + flag(s.dynamic_enabled) + ", k_cd=" + num(s.k_cd) + ", p_cd=" + num(s.p_cd) +
          ", z_cd=" + num(s.z_cd) + ", feedforward=" + flag(s.feedforward) + ", slip_reflex=" + flag(s.slip_reflex) +
          ", reserve_force=" + num(s.reserve_force) + ", reserve_torque=" + num(s.reserve_torque) +
@@ -390,7 +392,7 @@ Status GraspController::step(const GraspControllerInput& in, GraspControllerOutp
     peak_s_ = std::max(peak_s_, slip);
     sum_s_ += slip;
     ++n_s_;
-    if (slip >= kReflexSlippage) ++count_s_;
+    if (slip >= kSlidingSlippage) ++count_s_;
     if (count_s_ >= kReflexSamples) reflex_armed_ = true;
   }
   out.status = valid ? Status::Ok : worst;
@@ -426,7 +428,7 @@ Status GraspController::step(const GraspControllerInput& in, GraspControllerOutp
   const bool now = in.command == CommandTiming::Now, hold = in.command == CommandTiming::Hold;
   const bool due = now || (!hold && phase_ == 0);
   if (due) {
-    // The PI's S: this sample (paper) or the mean over the command period (anti-aliasing).
+    // The PI's S: the mean over the command period (anti-aliasing; the call's own when none was valid).
     issue_command(valid, n_s_ > 0 ? sum_s_ / n_s_ : slip);
     out.command_issued = true;
     if (now) phase_ = 0;  // the clock restarts at this command

@@ -47,10 +47,11 @@ _BOOL_FIELDS = tuple(name for name, kind, _doc in _core.GraspControllerSettings.
 #: implementation choices without a setting apply to it too (docs/controller.md §1): the PI's S
 #: is the mean over the command period, C_d's input has a dead band of the observer's speed
 #: resolution, and the pivot's end test is lugrip's.
+_PAPER, _DEFAULTS = _core.paper_settings(), _core.GraspControllerSettings()
 PAPER_SETTINGS: dict[str, Any] = {
-    name: getattr(_core.paper_settings(), name)
+    name: getattr(_PAPER, name)
     for name in _SETTINGS_FIELDS
-    if getattr(_core.paper_settings(), name) != getattr(_core.GraspControllerSettings(), name)
+    if getattr(_PAPER, name) != getattr(_DEFAULTS, name)
 }
 
 
