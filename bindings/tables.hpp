@@ -224,6 +224,8 @@ struct Table<GraspControllerOutput> {
       field("gain_p", &S::gain_p, "k_p used at the last command [N]"),
       field("gain_i", &S::gain_i, "k_i used at the last command [N/s]"),
       field("feedforward_force", &S::feedforward_force, "feed-forward force at the last command [N]"),
+      field("reserve_force", &S::reserve_force, "reserve of the last command: the stated or the learned, the larger, per finger [N]"),
+      field("reserve_torque", &S::reserve_torque, "the same for the twist [N m]"),
       field("reflex", &S::reflex, "the slip reflex raised the last command"),
       field("peak_slippage", &S::peak_slippage, "peak of max_i S_i over the period before the last command [-]"),
       field("mu_belief", &S::mu_belief, "friction coefficient the controller believes now [-]"),

@@ -36,6 +36,13 @@ constexpr int kReflexSamples = 3;             // ... on this many samples of the
 constexpr double kReflexFactor = 1.25;        // ... raises the static part by this factor
 constexpr double kOmegaDeadband = 1.0;        // C_d's dead band in the observer's speed resolutions
 constexpr double kDynamicCap = kReflexFactor - 1.0;  // with the ceiling, C_d adds at most one reflex step
+// Reserve learned from the pushes (docs/controller.md §8): a period-mean load that came and went
+// is a push the task may repeat. Both the peak of each finger's load and the excursion learned
+// from it forget with this time constant, and this share of the excursion is added to the load
+// the floor holds at S = 1 (both chosen on tuning draws, docs/controller.md §8).
+constexpr double kReserveHorizon = 10.0;  // [s]
+constexpr double kReserveShare = 0.6;
+constexpr double kReserveHeld = 0.5;  // learned only while |f_t| is at least this share of its peak
 constexpr double kPivotFloorFactor = 1.1;     // pivoting floor factor x max_i |f_t,i| / mu
 constexpr int kPivotEndSamples = 3;           // consecutive samples of the pivot's end test
 constexpr double kPivotEndFilter = 0.2;       // [s] low-pass on mean |c~| of that test
@@ -206,6 +213,7 @@ GraspController::GraspController(const ContactModel& model, const GraspControlle
   t_cmd_ = s_.command_ratio * dt_;
   pivot_decay_ = std::exp(-t_cmd_ / s_.tau_pivot);
   pivot_c_alpha_ = 1.0 - std::exp(-dt_ / kPivotEndFilter);
+  reserve_decay_ = std::exp(-t_cmd_ / kReserveHorizon);
   for (auto& f : cd_) f = LagFilter(s_.k_cd, s_.z_cd, s_.p_cd, dt_);
   reset(s_.f_min);
 }
@@ -229,6 +237,9 @@ void GraspController::reset(double current_force) noexcept {
   f_est_ = command_;
   trend_lift_ = trend_force_ = 0.0;
   reflex_armed_ = false;
+  learned_ft_.fill(0.0);
+  learned_tau_.fill(0.0);
+  peak_valid_.fill(false);
   reset_probe();
   mu_ = mu0_;
   solver_.set_mu(mu_);
@@ -301,6 +312,7 @@ void GraspController::end_pivot(PivotEnd why, GraspControllerOutput& out) noexce
   init_static_ = true;  // PI integrator = last command - k_p e at the next command
   reset_dynamic();      // C_d restarts from rest
   pivot_count_ = 0;
+  peak_valid_.fill(false);  // the load after the pivot is not a push
   out.pivot_finished = true;
   out.pivot_end = why;
 }
@@ -321,6 +333,7 @@ Status GraspController::step(const GraspControllerInput& in, GraspControllerOutp
     pivot_c_init_ = true;
     peak_ = 0.0;
     probe_left_ = 0;
+    peak_valid_.fill(false);  // the pivot changes the load: no push
   } else if (request_ == Request::Avoid && mode_ == ControllerMode::Pivoting) {
     end_pivot(PivotEnd::Requested, out);
   }
@@ -445,6 +458,8 @@ Status GraspController::step(const GraspControllerInput& in, GraspControllerOutp
   out.gain_p = last_.gain_p;
   out.gain_i = last_.gain_i;
   out.feedforward_force = last_.feedforward_force;
+  out.reserve_force = last_.reserve_force;
+  out.reserve_torque = last_.reserve_torque;
   out.reflex = last_.reflex;
   out.peak_slippage = last_.peak_slippage;
   out.mu_belief = last_.mu_belief;
@@ -772,6 +787,8 @@ bool GraspController::probe_start(double slip_mean, bool reacting) noexcept {
 double GraspController::reaction_floor(double& slope_exponent, GraspControllerOutput& c) noexcept {
   double lift = static_floor(slope_exponent);
   c.feedforward_force = lift;
+  c.reserve_force = reserve_force_;
+  c.reserve_torque = reserve_torque_;
   if (s_.slip_reflex && reflex_armed_) {
     // On the grip the contact slid at: the static part (a transient f_nd would otherwise be
     // multiplied into f_ns), or the measured f_n when the gripper has not reached it yet (a
@@ -805,6 +822,7 @@ double GraspController::static_floor(double& slope_exponent) noexcept {
   }
   floor_measured_ = f_grasp;
   ceiling_load_ = 0.0;
+  reserve_force_ = reserve_torque_ = 0.0;
   for (int i = 0; i < kMaxFingers; ++i) {
     if (n_load_[i] == 0) continue;
     const double n = n_load_[i];
@@ -835,9 +853,31 @@ double GraspController::static_floor(double& slope_exponent) noexcept {
       const double f = solver_.solve(load_ft, load_tau, 1.0).force;
       if (std::isfinite(f)) ceiling_load_ = std::max(ceiling_load_, f);
     }
-    if (s_.reserve_force > 0.0 || s_.reserve_torque > 0.0) {
-      // Standing reserve: the static force of the load plus the disturbance the task expects.
-      const double f = solver_.solve(std::fabs(ft) + s_.reserve_force, std::fabs(tau) + s_.reserve_torque, 1.0).force;
+    if (s_.feedforward) {  // the pushes seen: the part of the load that came and went
+      const double at = std::fabs(tau);
+      if (!peak_valid_[i]) {
+        peak_ft_[i] = ft;
+        peak_tau_[i] = at;
+        peak_valid_[i] = true;
+      }
+      peak_ft_[i] = std::max(peak_ft_[i], ft);
+      peak_tau_[i] = std::max(peak_tau_[i], at);
+      // only while the finger still carries half its peak tangential load: a load that falls to
+      // nothing is a release, not a push
+      const bool held = ft >= kReserveHeld * peak_ft_[i];
+      learned_ft_[i] = std::max(learned_ft_[i] * reserve_decay_, held ? peak_ft_[i] - ft : 0.0);
+      learned_tau_[i] = std::max(learned_tau_[i] * reserve_decay_, held ? peak_tau_[i] - at : 0.0);
+      peak_ft_[i] = ft + (peak_ft_[i] - ft) * reserve_decay_;
+      peak_tau_[i] = at + (peak_tau_[i] - at) * reserve_decay_;
+    }
+    // Reserve: the task's stated envelope or the pushes learned, the larger; the static force of
+    // the load with the reserve added, at S = 1.
+    const double r_f = std::max(s_.reserve_force, kReserveShare * learned_ft_[i]);
+    const double r_t = std::max(s_.reserve_torque, kReserveShare * learned_tau_[i]);
+    reserve_force_ = std::max(reserve_force_, r_f);
+    reserve_torque_ = std::max(reserve_torque_, r_t);
+    if (r_f > 0.0 || r_t > 0.0) {
+      const double f = solver_.solve(std::fabs(ft) + r_f, std::fabs(tau) + r_t, 1.0).force;
       if (std::isfinite(f)) force = std::max(force, f);
       if (std::isfinite(f)) ceiling_load_ = std::max(ceiling_load_, f);
     }

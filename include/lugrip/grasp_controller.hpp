@@ -62,7 +62,10 @@ struct GraspControllerSettings {
   //! static grasp force (StaticForceSolver at S = 0.9) of the load measured over the last
   //! command period (mean f_t and tau of each valid finger, the larger force), or of that load
   //! extrapolated 30 ms ahead along its trend when that asks 50 % more (a load still rising at
-  //! the command); the integrator restarts there. Not applied while pivoting.
+  //! the command); the integrator restarts there. It also learns a reserve from the pushes seen
+  //! (0.6 of the load's excursions below its peak, both forgetting over 10 s; the floor then
+  //! holds the load plus that reserve at S = 1, as reserve_force below). Not applied while
+  //! pivoting.
   bool feedforward = true;
   //! (*) default true; false = paper. Slip reflex: when S = max_i S_i is at or above 0.93 on 3
   //! valid samples of one command period (anywhere in it: a chattering slide alternates S around
@@ -73,7 +76,8 @@ struct GraspControllerSettings {
   //! (*) [N] default 0 = off. The task's envelope of pushes per finger: the static part is
   //! floored at the static grasp force at S = 1 of the measured load with reserve_force added
   //! to |f_t| and reserve_torque to |tau| (such a push then keeps the contact at its limit while
-  //! the reaction is on its way). >= 0, finite.
+  //! the reaction is on its way); where the reserve learned from the pushes (feedforward) is
+  //! larger, that one. >= 0, finite.
   double reserve_force = 0.0;
   double reserve_torque = 0.0;  //!< (*) [N m] default 0 = off; the twist to absorb. >= 0, finite.
   //! (*) [-] default 1.7; 0 = off (paper). In slipping avoidance a raise never takes the command
@@ -184,6 +188,10 @@ struct GraspControllerOutput {
   double gain_p = 0.0;         //!< k_p used at the last command [N]
   double gain_i = 0.0;         //!< k_i used at the last command [N/s]
   double feedforward_force = 0.0;  //!< feed-forward force at the last command [N] (0: none)
+  //! reserve of the last command, per finger, the largest over the fingers: the stated
+  //! reserve_force or the pushes learned, the larger (docs/controller.md §8) [N]
+  double reserve_force = 0.0;
+  double reserve_torque = 0.0;  //!< the same for the twist [N m]
   bool reflex = false;         //!< last command: the slip reflex raised the static part
   double peak_slippage = 0.0;  //!< peak of max_i S_i over the period before the last command [-]
   double mu_belief = 0.0;      //!< friction coefficient the controller believes now [-]
@@ -419,6 +427,12 @@ class GraspController {
   double probe_base_ = 0.0;   // static part when the probe started [N]
   bool probe_slip_ = false;   // the last evaluated probe found slip
 
+  // reserve learned from the pushes (feedforward): per finger, the decaying peak of the
+  // period-mean load (|f_t| [N], |tau| [N m]) and the excursion learned from it
+  std::array<double, kMaxFingers> peak_ft_{}, peak_tau_{}, learned_ft_{}, learned_tau_{};
+  std::array<bool, kMaxFingers> peak_valid_{};
+  double reserve_decay_ = 0.0;  // forgetting factor of both per command
+  double reserve_force_ = 0.0, reserve_torque_ = 0.0;  // reserve of the last floor (output)
   GraspControllerOutput last_{};  // command fields of the last command
 };
 

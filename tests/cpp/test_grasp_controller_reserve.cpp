@@ -116,3 +116,65 @@ TEST(ControllerReserve, ValidationNamesANegativeOrNonFiniteReserve) {
   EXPECT_EQ(s.reserve_torque, 0.0);
   EXPECT_NE(to_string(s).find("reserve_torque=0"), std::string::npos);
 }
+
+// --- the reserve learned from the pushes (no setting; part of the load floors) --------------
+
+TEST(ControllerReserve, APushSeenIsLearnedAsAReserveThatDecaysOverTenSeconds) {
+  // Synthetic observer values (the model's own solver as the reference): a steady 2.2 N load,
+  // a 1 N push for 0.2 s, then the load again. After the push the floor holds the load plus 0.6
+  // of the push at S = 1; the learned excursion forgets with a 10 s time constant (its peak
+  // too), so 10 s later the reserve is e^-1 of it to within the decay of the peak.
+  const ContactParams p = box();
+  GraspController c(p, quiet());
+  c.reset(2.0);
+  settle(c, both(0.3, 2.2, 0.0));
+  GraspControllerOutput out;
+  for (int k = 0; k < 100; ++k) c.step(both(0.3, 3.2, 0.0), out);  // 0.2 s push
+  EXPECT_NEAR(out.reserve_force, 0.0, 1e-12);  // the push itself: nothing came and went yet
+  for (int k = 0; k < 20; ++k) c.step(both(0.3, 2.2, 0.0), out);
+  // the peak decays over 10 s from 3.2 toward 2.2 while the excursion is measured
+  EXPECT_NEAR(out.reserve_force, 0.6 * 1.0, 0.6 * 0.02);
+  // the PI at S = 0.3 unwinds onto the floor: the load plus the reserve at S = 1
+  StaticForceSolver solver(p);
+  for (int k = 0; k < 500; ++k) c.step(both(0.3, 2.2, 0.0), out);  // 1 s
+  EXPECT_NEAR(out.force, solver.solve(2.2 + out.reserve_force, 0.0, 1.0).force, 1e-6 * out.force);
+  EXPECT_GT(out.force, 1.1 * solver.solve(2.2, 0.0, 0.9).force);  // above the feed-forward alone
+  const double r0 = out.reserve_force;
+  for (int k = 0; k < 5000; ++k) c.step(both(0.3, 2.2, 0.0), out);  // 10 s
+  EXPECT_NEAR(out.reserve_force / r0, std::exp(-1.0), 0.02);
+}
+
+TEST(ControllerReserve, ALoadThatFallsToNothingIsAReleaseNotAPush) {
+  // The excursion is learned only while the finger carries half its peak load: a release
+  // (2.2 N to nothing, here within one sample) leaves at most what the one period straddling
+  // the fall shows (its mean 9/10 of the load), far from the 0.6 x 2.2 N a push would leave.
+  const ContactParams p = box();
+  GraspController c(p, quiet());
+  c.reset(2.0);
+  settle(c, both(0.3, 2.2, 0.0));
+  GraspControllerOutput out;
+  for (int k = 0; k < 200; ++k) c.step(both(0.0, 0.0, 0.0), out);
+  EXPECT_LE(out.reserve_force, 0.6 * 0.5 * 2.2);
+  EXPECT_LT(out.reserve_force, 0.2 * 0.6 * 2.2);
+  EXPECT_DOUBLE_EQ(out.reserve_torque, 0.0);
+  // and the paper's law learns nothing
+  GraspController paper(p, paper_settings());
+  paper.reset(2.0);
+  settle(paper, both(0.3, 2.2, 0.0));
+  for (int k = 0; k < 100; ++k) paper.step(both(0.3, 3.2, 0.0), out);
+  for (int k = 0; k < 20; ++k) paper.step(both(0.3, 2.2, 0.0), out);
+  EXPECT_DOUBLE_EQ(out.reserve_force, 0.0);
+}
+
+TEST(ControllerReserve, TheStatedReserveWinsWhereItIsLarger) {
+  const ContactParams p = box();
+  GraspControllerSettings s = quiet();
+  s.reserve_force = 2.0;
+  GraspController c(p, s);
+  c.reset(2.0);
+  settle(c, both(0.3, 2.2, 0.0));
+  GraspControllerOutput out;
+  for (int k = 0; k < 100; ++k) c.step(both(0.3, 3.2, 0.0), out);
+  for (int k = 0; k < 20; ++k) c.step(both(0.3, 2.2, 0.0), out);
+  EXPECT_DOUBLE_EQ(out.reserve_force, 2.0);
+}
