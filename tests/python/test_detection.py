@@ -111,7 +111,7 @@ def test_default_params_yaml_has_no_ratio_fields():
     "mu_s, mu_k, stribeck",
     [(0.63, 0.45, True), (0.5, 0.5, False)],
 )
-def test_identification_and_detection_on_a_stribeck_grid(mu_s, mu_k, stribeck):
+def test_identification_and_detection_on_a_stribeck_grid(mu_s, mu_k, stribeck, tmp_path):
     """Independent plant: grid of LuGre cells (Hertzian pressure, Stribeck speed 1 mm/s), edge
     speeds 0.1-10 mm/s, CoR 0.05-20 rho. identify() finds a Stribeck term exactly when the
     plant has one; with the fitted YAML the observer flags S >= 0.9 on >= 95 % of the held-out
@@ -130,7 +130,12 @@ def test_identification_and_detection_on_a_stribeck_grid(mu_s, mu_k, stribeck):
         r = lugrip.identify(train.log)
     p = r.params
     assert (p.static_ratio > p.kinetic_ratio) == stribeck
-    run = r.make_observer().run(test.log)
+    # the user's path: the YAML `lugrip identify` writes, read back as `lugrip observe` does
+    # (it carries the friction levels: a file without them judged S against one capacity)
+    path = r.save_yaml(tmp_path / "fit.yaml")
+    q = ContactParams.from_yaml(path)
+    assert (q.static_ratio, q.kinetic_ratio) == (p.static_ratio, p.kinetic_ratio)
+    run = Observer(q, **lugrip.read_observer_settings(path)).run(test.log)
     S = np.asarray(run.S)
     om = np.abs(np.asarray(test.log.omega))
     peak = np.zeros(len(om), bool)

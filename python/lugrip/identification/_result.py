@@ -219,6 +219,13 @@ class IdentificationResult:
                 }
                 | ({"note": "0: the elliptic limit surface"} if self.params.k == 0.0 else {}),
                 "c_max": {"value": self.params.c_max, "unit": "-"},
+            }
+            # the friction levels of stage 7 (docs/model.md 7.5), written like
+            # ContactParams.to_yaml does: only when not 1
+            | {
+                name: {"value": getattr(self.params, name), "unit": "-"}
+                for name in ("static_ratio", "kinetic_ratio")
+                if getattr(self.params, name) != 1.0
             },
             # the observer inside the cost: the parameters are identified FOR it (docs/model.md
             # 8.1), so online use must run the same one (lugrip observe --params reads this)
