@@ -86,6 +86,14 @@ def test_replay_reproduces_the_closed_loop_command(tmp_path, capsys, recorded):
     assert (tmp_path / "fig" / "replay_command.png").stat().st_size > 10_000
     assert set(got["status"]) <= {"ok", "no_contact", "invalid_sample", "saturated",
                                   "degenerate", "sensor_fault", "reinitialized"}
+    # the belief and the reserve: mu as told (the probe is off by default), a reserve that is
+    # never negative and below the load the 0.7 kg block puts on a finger (m g / 2 = 3.4 N)
+    mu = _floats(got["mu_belief"])
+    told = yaml.safe_load(recorded["params"].read_text())["contact"]["mu"]["value"]
+    np.testing.assert_allclose(mu, told, rtol=1e-12)
+    r = _floats(got["reserve_force"])
+    assert np.all(r >= 0.0) and np.all(r < 3.4)
+    assert np.all(_floats(got["reserve_torque"]) >= 0.0)
 
 
 def test_replay_reacts_to_the_parameters(tmp_path, capsys, recorded):

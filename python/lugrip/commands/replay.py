@@ -17,12 +17,15 @@ from .simulate_sliding import add_params_arguments, load_params
 __all__ = ["OUTPUT_COLUMNS", "register", "run"]
 
 OUTPUT_COLUMNS = ("t", "command_recorded", "command_replay", "status", "mode", "held",
-                  "S_0", "S_1", "omega_hat_0", "omega_hat_1", "c_tilde_0", "c_tilde_1")
+                  "S_0", "S_1", "omega_hat_0", "omega_hat_1", "c_tilde_0", "c_tilde_1",
+                  "mu_belief", "reserve_force", "reserve_torque")
 """Columns of the replay file: t [s], the recorded command [N] (empty without one), the
 replayed command [N], the cycle's status name, the controller mode, held (1 when the command
-was held because a finger's status was not ok, else 0), and per finger k the
+was held because a finger's status was not ok, else 0), per finger k the
 slippage indicator S_k [-], the estimated sliding velocity omega_hat_k [rad/s] and the
-estimated CoR c_tilde_k [-]."""
+estimated CoR c_tilde_k [-], then the controller's friction belief mu_belief [-] and the
+reserve of its last command per finger (stated or learned from the pushes seen,
+reserve_force [N], reserve_torque [N m])."""
 
 _EPILOG = """\
 examples:
@@ -180,7 +183,9 @@ def _write(path: Path, glog, out, names, force: bool) -> None:
     cols = {"t": glog.t, "command_recorded": rec, "command_replay": out["force"],
             "status": [names["status"].get(int(s), str(int(s))) for s in out["status"]],
             "mode": [names["mode"].get(int(m), str(int(m))) for m in out["mode"]],
-            "held": np.asarray(out["held"], dtype=np.int64)}
+            "held": np.asarray(out["held"], dtype=np.int64),
+            "mu_belief": out["mu_belief"], "reserve_force": out["reserve_force"],
+            "reserve_torque": out["reserve_torque"]}
     for k in range(2):
         for base in ("S", "omega_hat", "c_tilde"):
             key = f"{base}_{k}"
@@ -274,7 +279,8 @@ def run(args) -> int:
         w = np.stack([out[f"omega_hat_{k}"] for k in range(fingers)], axis=1)
         path = write_figure_replay(
             args.plot, glog.t, out["force"], glog.command, S, w, fmt=args.format,
-            held=np.asarray(out["held"], dtype=bool),
+            held=np.asarray(out["held"], dtype=bool), mu_belief=out["mu_belief"],
+            reserve_force=out["reserve_force"],
             title=f"{Path(args.log).name}: SlipControl replay")
         print(f"  wrote {path}")
     return 0

@@ -1,6 +1,7 @@
 """Figure of a grasp replay (``lugrip replay``): the grasp-force command SlipControl would have
-sent beside the one recorded with the log, each finger's slippage indicator S, and each
-finger's estimated sliding velocity omega_hat.
+sent beside the one recorded with the log, each finger's slippage indicator S, each
+finger's estimated sliding velocity omega_hat, and the controller's friction belief and the
+reserve it held.
 
 Drawn with the project style (:mod:`lugrip.plot`): Agg canvas, no pyplot.
 """
@@ -20,14 +21,18 @@ REPLAY_NAME = "replay_command"
 
 
 def figure_replay(t, command_replay, command_recorded=None, S=None, omega_hat=None, *,
-                  held=None, s_threshold: float | None = None, title: str | None = None):
-    """Three panels over time t [s] (n,): (a) the replayed command [N] (n,) and, when given,
+                  held=None, s_threshold: float | None = None, title: str | None = None,
+                  mu_belief=None, reserve_force=None):
+    """Panels over time t [s] (n,): (a) the replayed command [N] (n,) and, when given,
     the recorded one; samples where the replay held its command (a non-ok status) are marked;
     (b) S per finger, shape (n, fingers), with ``s_threshold`` as a line; (c) omega_hat per
-    finger [rad/s], (n, fingers). Panels without data are left out. Returns the Figure."""
+    finger [rad/s], (n, fingers); (d) the controller's friction belief mu_belief [-] (n,) and,
+    on a second axis, the reserve of its last command reserve_force [N] (n,). Panels without
+    data are left out. Returns the Figure."""
     t = np.asarray(t, dtype=float)
     panels = ["command"] + (["S"] if S is not None else []) + \
-        (["omega"] if omega_hat is not None else [])
+        (["omega"] if omega_hat is not None else []) + \
+        (["belief"] if mu_belief is not None else [])
     with plot.style():
         fig, axes = plot.new_figure(len(panels), 1, sharex=True, title=title,
                                     col_width=7.5, squeeze=False)
@@ -61,6 +66,17 @@ def figure_replay(t, command_replay, command_recorded=None, S=None, omega_hat=No
             ax_w.set_ylabel(plot.axis_label("estimated sliding velocity", r"\hat\omega",
                                             "rad/s"))
             ax_w.legend(loc="best")
+            k += 1
+        if mu_belief is not None:
+            ax_b = axes[k]
+            ax_b.plot(t, mu_belief, color=plot.color(0), label="friction belief")
+            ax_b.set_ylabel(plot.axis_label("friction belief", r"\hat\mu", "-"))
+            if reserve_force is not None:
+                ax_r = ax_b.twinx()
+                ax_r.plot(t, reserve_force, color=plot.color(3), label="reserve (per finger)")
+                ax_r.set_ylabel(plot.axis_label("reserve", "r", "N"))
+                ax_r.legend(loc="lower right")
+            ax_b.legend(loc="upper left")
         axes[-1].set_xlabel(plot.axis_label("time", "t", "s"))
         if len(axes) > 1:
             plot.panel_labels(axes)
