@@ -151,12 +151,18 @@ class RosSource:
         return out
 
     def check_topic(self, topic: str, types, what: str) -> None:
+        """``what``: the option naming the topic (``omega_topic``: shown as ``--omega-topic``
+        on the command line) or words for other topics."""
+        option = f"[[opt:{what}]]" if what.endswith("_topic") else what
         if topic not in self.topics:
-            raise LogError(self.file, f"no topic '{topic}' ({what}); topics present: "
-                           f"{self.describe()}")
+            fitting = sorted(n for n, (typ, _, _) in self.topics.items() if typ in types)
+            choose = (f"; of a fitting type: {', '.join(fitting)}" if fitting
+                      else f"; none has a fitting type ({', '.join(types)})")
+            raise LogError(self.file, f"no topic '{topic}' ({option}); topics present: "
+                           f"{self.describe()}{choose}")
         typ = self.topics[topic][0]
         if typ not in types:
-            raise LogError(self.file, f"topic '{topic}' has type {typ}; {what} must be one of "
+            raise LogError(self.file, f"topic '{topic}' has type {typ}; {option} must be one of "
                            f"{', '.join(types)}")
 
     def pick_wrench_topic(self, wrench_topic: str | None) -> str:

@@ -10,7 +10,9 @@ from __future__ import annotations
 
 import dataclasses
 import math
+import os
 from collections.abc import Callable, Mapping, Sequence
+from pathlib import Path
 from typing import Any
 
 import numpy as np
@@ -328,7 +330,10 @@ class PlantConfig:
         if "contact" not in d or "object" not in d:
             raise ValueError("plant config: 'contact' and 'object' are required")
         contact = d.pop("contact")
-        if isinstance(contact, str):
+        if isinstance(contact, (str, os.PathLike)) and \
+                Path(contact).suffix.lower() in (".yaml", ".yml"):
+            contact = ContactParams.from_yaml(contact)  # e.g. written by lugrip identify
+        elif isinstance(contact, str):
             contact = ContactParams.preset(contact)
         elif isinstance(contact, Mapping) and "preset" in contact:
             c = dict(contact)
@@ -336,7 +341,8 @@ class PlantConfig:
         elif isinstance(contact, Mapping):
             contact = ContactParams.from_dict(contact)
         elif not isinstance(contact, ContactParams):
-            raise ValueError("contact: expected a preset name, a mapping or ContactParams")
+            raise ValueError("contact: expected a preset name, a parameter file (.yaml), a "
+                             "mapping or ContactParams")
         moves = [
             _build(GripperMove, m, f"moves[{i}]") for i, m in enumerate(d.pop("moves", None) or [])
         ]
