@@ -20,11 +20,18 @@ $(VPY):
 # CMake build directory (build/<wheel tag>) is reused and rebuilds are incremental.
 $(VENV)/.installed: $(VPY) $(SOURCES)
 	$(VPY) -m pip install -q "scikit-build-core>=0.10" "nanobind>=2.4"
-	$(VPY) -m pip install -q --no-build-isolation ".[test,io]"
+	$(VPY) -m pip install -q --no-build-isolation ".[test,io,docs]"
 	$(VPY) .ci/mujoco_install.py
 	@touch $@
 
 install: $(VENV)/.installed
+
+# The documentation site (mkdocs.yml) into build/site: any warning fails, a broken link or
+# anchor between pages among them (external links are not fetched). The API reference reads the
+# installed package and its stubs, hence `install`. pytest builds it too
+# (tests/python/test_docs_site.py), which is how `make test` and CI check it.
+docs: install
+	NO_MKDOCS_2_WARNING=1 $(VPY) -m mkdocs build --strict
 
 demo: install
 	$(VENV)/bin/lugrip demo --out $(OUT) --force

@@ -108,7 +108,8 @@ class ObjectConfig:
 @dataclasses.dataclass
 class ActuatorConfig:
     """Gripper force actuator: ZOH at command_rate [Hz], first-order lag time_constant [s],
-    saturation [0, f_max] [N], rate limit [N/s]; f_init: force and command at t = 0 [N]."""
+    saturation between 0 and f_max [N], rate limit [N/s]; f_init: force and command at
+    t = 0 [N]."""
 
     f_init: float = 1.0
     f_max: float = 80.0
@@ -268,7 +269,8 @@ class PlantConfig:
     ``PlantConfig.from_dict`` accepts the YAML layout used by the scenarios::
 
         model: patch            # or lumped
-        contact: aluminium_can  # preset name, a ContactParams mapping, or {preset: name, mu: ...}
+        contact: aluminium_can  # preset name, a parameter file (fit.yaml), a ContactParams
+                                # mapping, or {preset: name, mu: ...}
         object: {mass: 0.4, inertia: 4.0e-4, cog: [0.0, -0.03], theta0: 0.0}
         actuator: {f_init: 1.0, time_constant: 0.03}
         sensor: {force_noise: 0.005, torque_noise: 1.0e-5}
