@@ -186,3 +186,22 @@ def test_simulate_help_says_where_scenarios_come_from(capsys):
     text = " ".join(capsys.readouterr().out.split())
     for part in ("$LUGRIP_SCENARIOS", "./scenarios", "installed with lugrip", "--list"):
         assert part in text, part
+
+
+def test_identify_without_omega_topic_names_the_candidates(tmp_path, data, capsys):
+    """A bag whose ground truth is on a topic the reader was not told about: identify's
+    one-line error names --omega-topic and the recording's topics that could be it; observe
+    runs and says the same."""
+    pytest.importorskip("rosbags")
+    from test_io_ros import write_two_finger_bag
+
+    bag = write_two_finger_bag(tmp_path / "bag", data.log, ros1=False, with_maneuvers=False)
+    rc = main(["identify", str(bag), "--wrench-topic", "/finger0/wrench", "--out",
+               str(tmp_path / "fit.yaml")])
+    err = capsys.readouterr().err
+    assert rc == 2 and len(err.strip().splitlines()) == 1, err
+    assert "--omega-topic" in err and "(this recording has: /truth/twist)" in err
+    rc = main(["observe", str(bag), "--wrench-topic", "/finger0/wrench", "--preset", "table1",
+               "--out", str(tmp_path / "e.csv")])
+    out = capsys.readouterr().out
+    assert rc == 0 and "this recording has: /truth/twist" in out

@@ -464,7 +464,9 @@ def run(args) -> int:
         if line:
             print("  " + line)
     else:
-        where = ("name its topic with --omega-topic (a twist, or a pose to differentiate)"
+        candidates = log.meta.get("omega_candidates")
+        where = ("name its topic with --omega-topic (a twist, or a pose to differentiate"
+                 + (f"; this recording has: {', '.join(candidates)})" if candidates else ")")
                  if "wrench_topic" in log.meta else "add an 'omega' column (--columns "
                  "omega=NAME for another name)")
         print(f"  no ground-truth omega in the log: RMSE not computed; {where}")

@@ -405,6 +405,9 @@ def read_ros(src: RosSource, *, wrench_topic: str | None, omega_topic: str | Non
         max_gap = 10.0 * float(np.median(step)) if step.size else 0.0
         cols["omega"] = resample(o_t, y, t, max_gap)
         meta.update(omega_topic=omega_topic, omega_type=om.type, omega_time_source=o_source)
+    else:  # what a --omega-topic could name, for the messages of commands that need omega
+        meta["omega_candidates"] = sorted(n for n, (typ, _, _) in src.topics.items()
+                                          if typ in OMEGA_TYPES)
 
     if maneuver_topic is not None:
         mt = topics[maneuver_topic]
