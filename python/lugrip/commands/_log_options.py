@@ -15,22 +15,30 @@ __all__ = ["add_log_options", "log_kwargs", "parse_columns", "parse_maneuvers", 
 _UNIT_KEYS = ("t", "f_n", "f_x", "f_y", "f_t", "tau", "omega", "force", "command")
 
 
+def _key_values(text: str, keys, what: str, example: str) -> dict[str, str]:
+    """``KEY=VALUE[,KEY=VALUE...]`` with KEY among ``keys``; ``what`` names the two parts
+    (``COLUMN=UNIT``) in the messages, ``example`` shows a valid value."""
+    out: dict[str, str] = {}
+    key_word = what.split("=")[0].lower()
+    for item in text.split(","):
+        key, sep, value = item.partition("=")
+        key, value = key.strip(), value.strip()
+        if not sep or not key or not value:
+            raise argparse.ArgumentTypeError(
+                f"invalid value {item!r}: expected {what}, e.g. {example}")
+        if key not in keys:
+            raise argparse.ArgumentTypeError(
+                f"invalid {key_word} {key!r}: expected one of {', '.join(keys)}")
+        out[key] = value
+    return out
+
+
 def parse_units(text: str) -> dict[str, str]:
     """argparse type for ``--units``: ``COLUMN=UNIT[,COLUMN=UNIT...]``, an underscore standing
     for a space in the unit (``tau=N_mm``); COLUMN 'force' sets every force column, 'command'
     is a two-finger log's recorded command."""
-    out: dict[str, str] = {}
-    for item in text.split(","):
-        key, sep, unit = item.partition("=")
-        key, unit = key.strip(), unit.strip()
-        if not sep or not key or not unit:
-            raise argparse.ArgumentTypeError(
-                f"invalid value {item!r}: expected COLUMN=UNIT, e.g. tau=N_mm")
-        if key not in _UNIT_KEYS:
-            raise argparse.ArgumentTypeError(
-                f"invalid column {key!r}: expected one of {', '.join(_UNIT_KEYS)}")
-        out[key] = unit.replace("_", " ")
-    return out
+    units = _key_values(text, _UNIT_KEYS, "COLUMN=UNIT", "tau=N_mm")
+    return {key: unit.replace("_", " ") for key, unit in units.items()}
 
 
 def parse_columns(text: str) -> dict[str, str]:
@@ -38,18 +46,7 @@ def parse_columns(text: str) -> dict[str, str]:
     format's columns (t, f_n, f_x, f_y, f_t, tau, omega, maneuver), COLUMN the file's header."""
     from ..io._log import COLUMNS
 
-    out: dict[str, str] = {}
-    for item in text.split(","):
-        key, sep, column = item.partition("=")
-        key, column = key.strip(), column.strip()
-        if not sep or not key or not column:
-            raise argparse.ArgumentTypeError(
-                f"invalid value {item!r}: expected NAME=COLUMN, e.g. f_n=Fz,tau=Mz")
-        if key not in COLUMNS:
-            raise argparse.ArgumentTypeError(
-                f"invalid name {key!r}: expected one of {', '.join(COLUMNS)}")
-        out[key] = column
-    return out
+    return _key_values(text, COLUMNS, "NAME=COLUMN", "f_n=Fz,tau=Mz")
 
 
 def parse_maneuvers(text: str):
