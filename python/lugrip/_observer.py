@@ -205,15 +205,15 @@ class Observer(NoCopy):
         gain: fixed observer gain l [1/(kg m^2)] (default 200).
         bandwidth: B = l sigma_1 [1/s] (default 3000; the rate at which omega_hat converges
             in sliding: higher tracks slip ramps with less lag, lower filters torque noise).
-        Other keywords: the fields of the C++ ObserverSettings (gain_min, gain_max, g_floor,
-        torque_cutoff [Hz], filter_force, cor_sign_sigmas, max_invalid, max_dt_gap [s],
-        torque_noise [N m], resolution_max [rad/s], omega_limit [rad/s], substeps,
-        max_substeps) and of CorSettings (f_n_min [N], force_limit [N], torque_limit [N m],
-        zero_force, zero_torque). None means "not given": the file's observer block, else
-        the C++ default. The accepted ranges (the table of include/lugrip/observer.hpp) keep
-        every output finite and bound the work per sample, e.g. dt in [1e-9, 10] s,
-        max_substeps <= 5000, omega_limit <= 1e6 rad/s, f_n_min >= 1e-6 N, force_limit and
-        torque_limit <= 1e9.
+        **settings: the other fields of the C++ ObserverSettings (gain_min, gain_max,
+            g_floor, torque_cutoff [Hz], filter_force, cor_sign_sigmas, max_invalid,
+            max_dt_gap [s], torque_noise [N m], resolution_max [rad/s], omega_limit [rad/s],
+            substeps, max_substeps) and of CorSettings (f_n_min [N], force_limit [N],
+            torque_limit [N m], zero_force, zero_torque). None means "not given": the file's
+            observer block, else the C++ default. The accepted ranges (the table of
+            include/lugrip/observer.hpp) keep every output finite and bound the work per
+            sample, e.g. dt in [1e-9, 10] s, max_substeps <= 5000, omega_limit <= 1e6 rad/s,
+            f_n_min >= 1e-6 N, force_limit and torque_limit <= 1e9.
 
     Raises:
         ValueError: naming every invalid setting (for a file's observer block: the file, the

@@ -50,8 +50,12 @@ class _Parser(argparse.ArgumentParser):
 def build_parser() -> argparse.ArgumentParser:
     """The top-level parser with every subcommand of ``lugrip.commands.COMMANDS``."""
     from . import __version__
+    from ._data import docs_dir
 
-    parser = _Parser(prog="lugrip", description=_DESCRIPTION, epilog=_EPILOG)
+    where = docs_dir()
+    epilog = _EPILOG + (f" The pages cited as docs/*.md are in {where} (the site: 'make docs' "
+                        "in a clone)." if where is not None else "")
+    parser = _Parser(prog="lugrip", description=_DESCRIPTION, epilog=epilog)
     parser.add_argument("--version", action="version", version=f"lugrip {__version__}")
     subparsers = parser.add_subparsers(dest="command", metavar="<command>", required=True,
                                        parser_class=_Parser)

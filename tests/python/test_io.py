@@ -620,7 +620,7 @@ def test_mcap_topic_errors_list_the_topics(tmp_path):
                                        r"WrenchStamped, 20 messages\)") as info:
         read_log(path, wrench_topic="/ft")
     assert str(path) in str(info.value)
-    with pytest.raises(LogError, match=r"no topic '/odom' \(omega_topic\)"):
+    with pytest.raises(LogError, match=r"no topic '/odom' \(omega_topic=\)"):
         read_log(path, omega_topic="/odom")
     with pytest.raises(LogError, match=r"'/lugrip/maneuver' has type std_msgs/Int32"):
         read_log(path, wrench_topic="/lugrip/maneuver")

@@ -135,10 +135,11 @@ def test_bag_gives_the_csv_observe_results(tmp_path, capsys, data, ros1):
 
 
 def test_maneuvers_found_from_the_motion(tmp_path, capsys, data):
-    """Without a maneuver topic the observer never restarts; --maneuvers motion finds one
-    maneuver per simulated maneuver (boundaries inside the unloaded rests) and brings the
-    estimates back to the CSV's: their RMS difference is under a fifth of the no-restart one
-    (measured: 1.5e-5 against 3.6e-4 rad/s)."""
+    """Without a maneuver topic and with --maneuvers file the observer never restarts;
+    --maneuvers motion finds one maneuver per simulated maneuver (boundaries inside the
+    unloaded rests) and brings the estimates back to the CSV's: their RMS difference is under a
+    fifth of the no-restart one (measured: 1.5e-5 against 3.6e-4 rad/s). The default ('auto')
+    is 'motion' for a recording without a maneuver topic: the same estimates."""
     log = data.log
     found = find_maneuvers(log)
     n_true = len(np.unique(log.maneuver))
@@ -153,13 +154,17 @@ def test_maneuvers_found_from_the_motion(tmp_path, capsys, data):
     bag = write_two_finger_bag(tmp_path / "bare", log, ros1=False, with_maneuvers=False)
     _observe(capsys, tmp_path / "run.csv", "--preset", "table1", "--out", tmp_path / "a.csv")
     _observe(capsys, bag, "--preset", "table1", "--out", tmp_path / "none.csv",
-             "--wrench-topic", "/finger0/wrench", "--omega-topic", "/truth/twist")
+             "--wrench-topic", "/finger0/wrench", "--omega-topic", "/truth/twist",
+             "--maneuvers", "file")
     _observe(capsys, bag, "--preset", "table1", "--out", tmp_path / "motion.csv",
              "--wrench-topic", "/finger0/wrench", "--omega-topic", "/truth/twist",
              "--maneuvers", "motion")
+    _observe(capsys, bag, "--preset", "table1", "--out", tmp_path / "auto.csv",
+             "--wrench-topic", "/finger0/wrench", "--omega-topic", "/truth/twist")
     ref = _estimates(tmp_path / "a.csv")["omega_hat"]
     none = _estimates(tmp_path / "none.csv")["omega_hat"]
     motion = _estimates(tmp_path / "motion.csv")["omega_hat"]
+    np.testing.assert_array_equal(_estimates(tmp_path / "auto.csv")["omega_hat"], motion)
     ok = np.isfinite(ref) & np.isfinite(none) & np.isfinite(motion)
     rms_none = float(np.sqrt(np.mean((none[ok] - ref[ok]) ** 2)))
     rms_motion = float(np.sqrt(np.mean((motion[ok] - ref[ok]) ** 2)))

@@ -9,35 +9,52 @@ import argparse
 import math
 from pathlib import Path
 
-__all__ = ["add_log_options", "log_kwargs", "parse_maneuvers", "parse_units",
+__all__ = ["add_log_options", "log_kwargs", "parse_columns", "parse_maneuvers", "parse_units",
            "read_log_from_args"]
 
 _UNIT_KEYS = ("t", "f_n", "f_x", "f_y", "f_t", "tau", "omega", "force", "command")
+
+
+def _key_values(text: str, keys, what: str, example: str) -> dict[str, str]:
+    """``KEY=VALUE[,KEY=VALUE...]`` with KEY among ``keys``; ``what`` names the two parts
+    (``COLUMN=UNIT``) in the messages, ``example`` shows a valid value."""
+    out: dict[str, str] = {}
+    key_word = what.split("=")[0].lower()
+    for item in text.split(","):
+        key, sep, value = item.partition("=")
+        key, value = key.strip(), value.strip()
+        if not sep or not key or not value:
+            raise argparse.ArgumentTypeError(
+                f"invalid value {item!r}: expected {what}, e.g. {example}")
+        if key not in keys:
+            raise argparse.ArgumentTypeError(
+                f"invalid {key_word} {key!r}: expected one of {', '.join(keys)}")
+        out[key] = value
+    return out
 
 
 def parse_units(text: str) -> dict[str, str]:
     """argparse type for ``--units``: ``COLUMN=UNIT[,COLUMN=UNIT...]``, an underscore standing
     for a space in the unit (``tau=N_mm``); COLUMN 'force' sets every force column, 'command'
     is a two-finger log's recorded command."""
-    out: dict[str, str] = {}
-    for item in text.split(","):
-        key, sep, unit = item.partition("=")
-        key, unit = key.strip(), unit.strip()
-        if not sep or not key or not unit:
-            raise argparse.ArgumentTypeError(
-                f"invalid value {item!r}: expected COLUMN=UNIT, e.g. tau=N_mm")
-        if key not in _UNIT_KEYS:
-            raise argparse.ArgumentTypeError(
-                f"invalid column {key!r}: expected one of {', '.join(_UNIT_KEYS)}")
-        out[key] = unit.replace("_", " ")
-    return out
+    units = _key_values(text, _UNIT_KEYS, "COLUMN=UNIT", "tau=N_mm")
+    return {key: unit.replace("_", " ") for key, unit in units.items()}
+
+
+def parse_columns(text: str) -> dict[str, str]:
+    """argparse type for ``--columns``: ``NAME=COLUMN[,NAME=COLUMN...]``, NAME one of the
+    format's columns (t, f_n, f_x, f_y, f_t, tau, omega, maneuver), COLUMN the file's header."""
+    from ..io._log import COLUMNS
+
+    return _key_values(text, COLUMNS, "NAME=COLUMN", "f_n=Fz,tau=Mz")
 
 
 def parse_maneuvers(text: str):
-    """argparse type for ``--maneuvers``: 'file' (the file's own ids), 'motion' (found from
-    the motion) or time windows ``START:END[,START:END...]`` in seconds."""
+    """argparse type for ``--maneuvers``: 'auto' (the file's ids when a column or topic marks
+    them, else found from the motion), 'file' (the file's own ids), 'motion' (found from the
+    motion) or time windows ``START:END[,START:END...]`` in seconds."""
     key = text.strip().lower()
-    if key in ("file", "motion"):
+    if key in ("auto", "file", "motion"):
         return key
     windows = []
     for item in text.split(","):
@@ -46,7 +63,7 @@ def parse_maneuvers(text: str):
             start, end = float(a), float(b)
         except ValueError:
             raise argparse.ArgumentTypeError(
-                f"invalid value {item!r}: expected 'file', 'motion' or START:END windows in "
+                f"invalid value {item!r}: expected 'auto', 'file', 'motion' or START:END windows in "
                 "seconds, e.g. 0:2.5,3:5.5") from None
         if not sep or not (math.isfinite(start) and math.isfinite(end) and end > start):
             raise argparse.ArgumentTypeError(
@@ -66,26 +83,34 @@ def _non_negative(text: str) -> float:
 
 
 def add_log_options(parser: argparse.ArgumentParser, *, wrench_topic: bool = True,
-                    omega_topic: bool = True, maneuvers: bool = True):
+                    omega_topic: bool = True, maneuvers: bool = True, columns: bool = True):
     """Add the log-reading options in their own group; returns the group. ``wrench_topic``,
-    ``omega_topic``, ``maneuvers`` = False leave out ``--wrench-topic`` (for commands that
-    read several wrench topics), ``--omega-topic`` (no ground truth used) and
-    ``--maneuver-topic``/``--maneuvers`` (no observer restarts)."""
+    ``omega_topic``, ``maneuvers``, ``columns`` = False leave out ``--wrench-topic`` (for
+    commands that read several wrench topics), ``--omega-topic`` (no ground truth used),
+    ``--maneuver-topic``/``--maneuvers`` (no observer restarts) and ``--columns`` (tables
+    with a fixed layout)."""
     r = parser.add_argument_group("reading the log (ROS recordings, units, maneuvers, damage)")
+    if columns:
+        r.add_argument("--columns", type=parse_columns, action="append", metavar="NAME=COLUMN",
+                       help="CSV/Parquet: the file's names of the columns, e.g. --columns "
+                            "t=time,f_n=Fz,f_x=Fx,f_y=Fy,tau=Mz,omega=wz; repeatable")
     if wrench_topic:
         r.add_argument("--wrench-topic", metavar="TOPIC",
                        help="WrenchStamped topic (MCAP, bags; default: the only one)")
     if omega_topic:
         r.add_argument("--omega-topic", metavar="TOPIC",
-                       help="ground-truth angular velocity topic (Twist[Stamped] angular.z, "
-                            "Vector3[Stamped] z, Float64, or a PoseStamped differentiated)")
+                       help="ground truth: an angular velocity topic (Twist[Stamped] "
+                            "angular.z, Vector3[Stamped] z, Float64) or a pose topic "
+                            "(PoseStamped of the object in the fingertip frame, e.g. motion "
+                            "capture; its twist angle about z differentiated)")
     if maneuvers:
         r.add_argument("--maneuver-topic", metavar="TOPIC",
                        help="std_msgs integer topic of maneuver ids (MCAP, bags)")
-        r.add_argument("--maneuvers", type=parse_maneuvers, default="file", metavar="SPEC",
-                       help="where maneuvers (observer restarts) come from: 'file' (a "
-                            "maneuver column or topic; default), 'motion' (found from unloaded "
-                            "rests), or windows START:END[,START:END...] in seconds")
+        r.add_argument("--maneuvers", type=parse_maneuvers, default="auto", metavar="SPEC",
+                       help="where maneuvers (observer restarts) come from: 'auto' (default: "
+                            "the file's maneuver column or topic, else 'motion'), 'file' (the "
+                            "column or topic; one maneuver without), 'motion' (found from "
+                            "unloaded rests), or windows START:END[,START:END...] in seconds")
     r.add_argument("--flip-normal", action="store_true",
                    help="the sensor's z axis points out of the pad (f_n = -force.z, ...)")
     r.add_argument("--contact-offset", type=_non_negative, metavar="M",
@@ -109,6 +134,9 @@ def log_kwargs(args: argparse.Namespace) -> dict:
     units: dict[str, str] = {}
     for part in getattr(args, "units", None) or []:
         units.update(part)
+    columns: dict[str, str] = {}
+    for part in getattr(args, "columns", None) or []:
+        columns.update(part)
     maneuvers = getattr(args, "maneuvers", "file")
     return {
         "wrench_topic": getattr(args, "wrench_topic", None),
@@ -120,6 +148,7 @@ def log_kwargs(args: argparse.Namespace) -> dict:
         "units": units or None,
         "allow_gaps": bool(getattr(args, "allow_gaps", False)),
         "time_source": getattr(args, "time_source", None) or "header",
+        "columns": columns or None,
     }
 
 

@@ -334,11 +334,13 @@ def _write_pieces(path: Path, pieces, force: bool) -> None:
             for cols in pieces:
                 fh.write(_csv_text(cols))
     elif suffix in (".parquet", ".pq"):
+        from ..io import MissingExtraError, need
+
         try:
-            import pyarrow as pa
-            import pyarrow.parquet as pq
-        except ImportError:
-            raise CliError("writing Parquet needs pyarrow (pip install pyarrow)") from None
+            pa = need("pyarrow", "writing Parquet")
+            pq = need("pyarrow.parquet", "writing Parquet")
+        except MissingExtraError as exc:
+            raise CliError(str(exc)) from None
 
         def body(fh):
             writer = None
@@ -462,7 +464,12 @@ def run(args) -> int:
         if line:
             print("  " + line)
     else:
-        print("  no ground-truth omega in the log: RMSE not computed")
+        candidates = log.meta.get("omega_candidates")
+        where = ("name its topic with --omega-topic (a twist, or a pose to differentiate"
+                 + (f"; this recording has: {', '.join(candidates)})" if candidates else ")")
+                 if "wrench_topic" in log.meta else "add an 'omega' column (--columns "
+                 "omega=NAME for another name)")
+        print(f"  no ground-truth omega in the log: RMSE not computed; {where}")
     if fig_path is not None:
         from ..plot.observer import write_figure5
 

@@ -88,7 +88,7 @@ def register(subparsers) -> None:
                    help="WrenchStamped topic of each finger, finger 0 first (one or two)")
     t.add_argument("--command-topic", metavar="TOPIC",
                    help="std_msgs/Float64 topic of the recorded grasp-force command [N]")
-    add_log_options(p, wrench_topic=False, omega_topic=False, maneuvers=False)
+    add_log_options(p, wrench_topic=False, omega_topic=False, maneuvers=False, columns=False)
     p.add_argument("--force", action="store_true", help="overwrite existing output files")
     p.set_defaults(run=run)
 
@@ -99,7 +99,7 @@ def _read(args):
     if not Path(args.log).exists():
         raise CliError(f"{args.log}: no such file or directory")
     kw = log_kwargs(args)
-    for unused in ("wrench_topic", "omega_topic", "maneuver_topic", "maneuvers"):
+    for unused in ("wrench_topic", "omega_topic", "maneuver_topic", "maneuvers", "columns"):
         kw.pop(unused)
     return read_grasp_log(args.log, finger_topics=args.finger_topics,
                           command_topic=args.command_topic, **kw)

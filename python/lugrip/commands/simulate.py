@@ -8,6 +8,7 @@ Exit code 0 when every scenario passes its criteria, 1 when one fails, 2 on a us
 from __future__ import annotations
 
 import argparse
+import math
 import sys
 from pathlib import Path
 
@@ -16,9 +17,13 @@ from . import CliError
 __all__ = ["register", "run"]
 
 _EPILOG = """\
-scenarios: names in ./scenarios (or $LUGRIP_SCENARIOS) or its unseen/ and faults/ folders, or
-YAML paths; 'all' runs the paper's experiments, 'unseen' the objects the controller was not
-tuned on, 'faults' the injected sensor/actuator faults.
+scenarios: YAML paths, or names looked up in the first scenario directory of: $LUGRIP_SCENARIOS,
+./scenarios (when it holds YAML files), the scenarios installed with lugrip (lugrip/data/
+scenarios; 'lugrip simulate --list' prints the one in use), and in its unseen/ and faults/
+folders; 'all' runs the paper's experiments, 'unseen' the objects the controller was not tuned
+on, 'faults' the injected sensor/actuator faults. A scenario's plant.contact and estimator may
+name a parameter file (fit.yaml from 'lugrip identify'), found next to the scenario file.
+Scenarios without a paper figure get a time-series figure <name>.png.
 examples:
   lugrip simulate all --out out/                        # the four experiments + baselines
   lugrip simulate exp2_small_resin_block --json m.json  # one scenario
@@ -132,7 +137,7 @@ def run(args: argparse.Namespace) -> int:
 
     if args.plant == "mujoco" and (args.video or not args.no_frames):
         report.choose_gl_backend()  # before anything imports MuJoCo
-    from ..sim.scenarios import find_scenario, list_scenarios, load_scenario
+    from ..sim.scenarios import find_scenario, list_scenarios, load_scenario, scenario_dir
 
     if args.list:
         names = list_scenarios()
@@ -143,6 +148,7 @@ def run(args: argparse.Namespace) -> int:
         for name in names + list_scenarios(suite="unseen") + list_scenarios(suite="faults"):
             s = load_scenario(name)
             print(f"{name:32s} {s.suite:7s} {s.title}")
+        print(f"(from {scenario_dir()})", file=sys.stderr)
         return 0
     names = []
     for n in args.scenarios:
@@ -184,25 +190,43 @@ def run(args: argparse.Namespace) -> int:
         written = {"metrics.json": out}
     else:
         _, written = report.write_outputs(results, args.out, json_path=args.json)
+    no_window = []
     for r in results:
         m = r.metrics["lugrip"]
+        steady = m.get("steady_force")
+        if steady is None or not math.isfinite(steady):
+            no_window.append(r.name)
+            steady_text = "steady      —  "  # the scenario measures no steady force
+        else:
+            steady_text = f"steady {steady:6.3f} N"
         print(
-            f"{r.name:32s} {'pass' if r.passed else 'FAIL'}  steady {m.get('steady_force', float('nan')):6.3f} N"
+            f"{r.name:32s} {'pass' if r.passed else 'FAIL'}  {steady_text}"
             f"  hold slip {m['hold_slip_mm']:.3f} mm  hold rot {m['hold_rotation_deg']:.3f} deg"
             f"  dropped {'yes' if m['dropped'] else 'no'}",
             flush=True,
         )
         if "fault_onset" in m:
-            lat = m["fault_status_latency"]
+            lat, slip_force = m["fault_status_latency"], m["fault_min_force"]
+            if lat is not None:
+                latency = f"status latency {lat} samples"
+            elif m.get("fault_expect_status"):
+                latency = f"status latency — (never raised {', '.join(m['fault_expect_status'])})"
+            else:
+                latency = "status latency — (no status reveals this fault)"
+            slip = "—, no load before the onset" if slip_force is None else f"{slip_force:.3f} N"
             print(
-                f"    fault {', '.join(m['fault_kinds'])}: status latency "
-                f"{'-' if lat is None else lat} samples, min command {m['fault_min_command']:.3f} N"
-                f" (slip force {m['fault_min_force'] or float('nan'):.3f} N)",
+                f"    fault {', '.join(m['fault_kinds'])}: {latency}, min command "
+                f"{m['fault_min_command']:.3f} N (slip force {slip})",
                 flush=True,
             )
         for name, c in r.criteria.items():
             if c["pass"] is False:
                 print(f"    failed: {name} (value {c['value']}, limit {c['limit']})")
+    if no_window:
+        which = ("these scenarios have" if len(no_window) == len(results)
+                 else f"{', '.join(no_window)} {'has' if len(no_window) == 1 else 'have'}")
+        print(f"steady —: {which} no steady_window, so no steady force is measured (the hold's "
+              "slip and rotation are)", flush=True)
     for name, path in written.items():
         print(f"wrote {path}", file=sys.stderr)
     return 0 if all(r.passed for r in results) else 1
@@ -223,8 +247,9 @@ def check_outputs(args: argparse.Namespace, scenario_paths: list[str]) -> None:
         if args.json is None:
             check_dir(args.out, "--out", force=args.force, results=("metrics.json",),
                       inputs=scenario_paths)
-    else:
-        check_dir(args.out, "--out", force=args.force, results=RESULT_FILES,
+    else:  # and the time series of the scenarios without a paper figure, <name>.png
+        own = tuple(f"{Path(p).stem}.png" for p in scenario_paths)
+        check_dir(args.out, "--out", force=args.force, results=RESULT_FILES + own,
                   inputs=scenario_paths)
     if args.json is not None:
         check_file(args.json, "--json", force=args.force, inputs=scenario_paths,

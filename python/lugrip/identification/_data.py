@@ -85,6 +85,8 @@ def load_maneuvers(
                    "with --omega-topic TOPIC (Python: omega_topic=), a TwistStamped, "
                    "Vector3Stamped, Float64 or a PoseStamped to differentiate"
                    if "wrench_topic" in log.meta and "omega_topic" not in log.meta else "")
+            if ros and log.meta.get("omega_candidates"):
+                ros += f" (this recording has: {', '.join(log.meta['omega_candidates'])})"
             raise IdentificationError(
                 f"{name}: no ground-truth 'omega' column (sliding velocity [rad/s]): "
                 "identification minimises the observer's velocity error and needs it "

@@ -23,7 +23,6 @@ import functools
 import math
 
 import numpy as np
-from scipy.optimize import least_squares
 
 from .. import _core
 from .._contact import estimate_cor
@@ -234,6 +233,8 @@ def fit_limit_surface(
 ) -> LimitSurfaceFit:
     """Fit stage (a) (and (c) with ``viscous``) to the sliding points. ``gamma`` / ``k`` /
     ``delta`` given: held at that value (k = 0: the elliptic limit surface)."""
+    from scipy.optimize import least_squares  # on first fit: `import lugrip` stays light
+
     if len(pts) < 3:
         raise ValueError("fewer than 3 gross-sliding points")
     elliptic = k is not None and k == ELLIPSE_K
@@ -381,6 +382,8 @@ def fit_presliding(
     """Fit sigma0 and sigma_z on the runs' loading samples (plus ``tail`` sliding samples; at
     most ``max_runs`` runs, evenly spread); None when no run has a loading phase of >= 3
     samples."""
+    from scipy.optimize import least_squares  # on first fit: `import lugrip` stays light
+
     wins = []
     for i, (m, ph) in enumerate(zip(mans, phases)):
         for a, b in runs(m):

@@ -127,7 +127,9 @@ def staged_estimate(
     if counts["maneuvers_sliding"] < 3:
         raise IdentificationError(
             f"gross sliding in only {counts['maneuvers_sliding']} maneuver(s): the limit "
-            "surface needs several CoRs and normal forces; record more maneuvers"
+            "surface needs several CoRs and normal forces; record more maneuvers, or split "
+            "a log that holds several into maneuvers (lugrip identify --maneuvers motion or "
+            "START:END windows; read_log(..., maneuvers='motion'))"
         )
     pts = sliding_points(mans, phases)
     # first pass at k = 4 (or the given k): it only has to find sigma0 for the second pass

@@ -191,7 +191,8 @@ def read_log(path: str | os.PathLike, *, format: str | None = None,
              flip_normal: bool = False, contact_offset: float | None = None,
              units: Mapping[str, str] | None = None, check_units: bool = True,
              max_nan_run: int = 3, allow_gaps: bool = False,
-             time_source: str = "header") -> SlidingLog:
+             time_source: str = "header",
+             columns: Mapping[str, str] | None = None) -> SlidingLog:
     """Read a sliding log.
 
     Args:
@@ -213,9 +214,11 @@ def read_log(path: str | os.PathLike, *, format: str | None = None,
             samples before the first message take its id); default: the one a
             lugrip-written MCAP names.
         maneuvers: replaces the file's maneuver ids: ``"motion"`` finds them from the wrench
-            and omega (:func:`find_maneuvers`), a sequence of ``(t_start, t_end)`` windows [s]
-            numbers them (:func:`maneuvers_from_windows`); None keeps the file's (a column or
-            a topic; all zeros when it has none).
+            and omega (:func:`find_maneuvers`), ``"auto"`` keeps the file's when a column or
+            topic marks them and finds them from the motion otherwise (the command line's
+            default), a sequence of ``(t_start, t_end)`` windows [s] numbers them
+            (:func:`maneuvers_from_windows`); None keeps the file's (all zeros when it has
+            none).
         flip_normal: the sensor's z axis points toward the object (out of the pad), so its
             force z is negative while pressed: rotate the frame by pi about x (y and z of
             force and moment, and omega, change sign) so that f_n > 0 in contact.
@@ -233,6 +236,10 @@ def read_log(path: str | os.PathLike, *, format: str | None = None,
         time_source: ROS sources: ``"header"`` (default) orders the messages by their header
             stamps (the sensor's clock; log times for types without a header), ``"log"`` by
             the recorder's log times (for a sensor whose clock jumped).
+        columns: CSV and Parquet tables whose columns have other names: {format name: the
+            file's column}, e.g. ``{'t': 'time', 'f_n': 'Fz', 'tau': 'Mz'}`` (a header cell
+            matches with or without its ``[unit]``, case-insensitively); a file column named
+            like a mapped format column is then ignored.
 
     ROS header stamps that go backwards are an error (LogError naming the topic and the count
     of backward steps; ``time_source="log"`` reads such a recording by log time). Messages
@@ -253,13 +260,13 @@ def read_log(path: str | os.PathLike, *, format: str | None = None,
                  maneuver_topic=maneuver_topic, maneuvers=maneuvers, flip_normal=flip_normal,
                  contact_offset=contact_offset, units=units, check_units=check_units,
                  max_nan_run=max_nan_run, allow_gaps=allow_gaps, stacklevel=4,
-                 time_source=time_source)[0]
+                 time_source=time_source, columns=columns)[0]
 
 
 def _read(path, *, format, wrench_topic, omega_topic, maneuver_topic, maneuvers, flip_normal,
           contact_offset, units, check_units, max_nan_run, allow_gaps, stacklevel,
           finger: int | None = None, scalar_topics: Mapping[str, str] | None = None,
-          time_source: str = "header"):
+          time_source: str = "header", columns: Mapping[str, str] | None = None):
     """read_log's work; also returns the columns (with a two-finger table's ``command`` when
     ``finger`` is given, or the ``scalar_topics`` {column: topic} of a ROS source)."""
     path = Path(path)
@@ -269,6 +276,10 @@ def _read(path, *, format, wrench_topic, omega_topic, maneuver_topic, maneuvers,
     fmt = _detect_format(path, format, file)
     if fmt in _MODULE_FOR:
         need(_MODULE_FOR[fmt], _EXTRA_FOR[fmt])
+    if columns and fmt not in ("csv", "parquet"):
+        raise LogError(file, f"[[opt:columns]] applies to CSV and Parquet tables, not to a {fmt} "
+                       "recording (choose its topics with [[opt:wrench_topic]], "
+                       "[[opt:omega_topic]], [[opt:maneuver_topic]])")
     ros_only = {"wrench_topic": wrench_topic, "omega_topic": omega_topic,
                 "maneuver_topic": maneuver_topic, "contact_offset": contact_offset,
                 "time_source": None if time_source == "header" else time_source}
@@ -281,11 +292,11 @@ def _read(path, *, format, wrench_topic, omega_topic, maneuver_topic, maneuvers,
                                            and contact_offset >= 0.0):
         raise LogError(file, f"contact_offset = {contact_offset!r} m: must be finite and >= 0")
     if fmt == "csv":
-        cols, header_units, loc, meta = _read_csv(path, file, finger)
+        cols, header_units, loc, meta = _read_csv(path, file, finger, columns)
     elif fmt == "parquet":
         from ._parquet import _read_parquet
 
-        cols, header_units, loc, meta = _read_parquet(path, file, finger)
+        cols, header_units, loc, meta = _read_parquet(path, file, finger, columns)
     else:
         from ._ros import read_ros
 
@@ -304,6 +315,8 @@ def _read(path, *, format, wrench_topic, omega_topic, maneuver_topic, maneuvers,
             stacklevel=stacklevel, time_source=time_source)
         meta["format"] = fmt
 
+    if columns:
+        meta["columns"] = {k: str(v) for k, v in columns.items()}
     given = dict(header_units)
     given.update(_expand_units(units, file))
     converted = {}
@@ -320,9 +333,11 @@ def _read(path, *, format, wrench_topic, omega_topic, maneuver_topic, maneuvers,
             if name in cols:
                 cols[name] = -cols[name]
         meta["flip_normal"] = True
+    if isinstance(maneuvers, str) and maneuvers == "auto":
+        maneuvers = None if "maneuver" in cols else "motion"
     if maneuvers is not None and not (isinstance(maneuvers, str) and maneuvers == "motion"):
         if isinstance(maneuvers, str):
-            raise LogError(file, f"maneuvers={maneuvers!r}: give 'motion' or a list of "
+            raise LogError(file, f"maneuvers={maneuvers!r}: give 'motion', 'auto' or a list of "
                            "(t_start, t_end) windows")
         cols["maneuver"] = maneuvers_from_windows(cols["t"], maneuvers, file).astype(float)
         meta["maneuvers_from"] = "windows"

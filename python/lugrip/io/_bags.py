@@ -8,7 +8,7 @@ from collections.abc import Iterator
 from pathlib import Path
 from typing import Any
 
-from ._extras import exc_text, need
+from ._extras import decode_error_text, exc_text, need
 from ._log import LogError
 from ._ros import _TYPES, RosSource, short_type
 
@@ -97,7 +97,8 @@ class BagSource(RosSource):
                     msg = self._reader.deserialize(data, conn.msgtype)
                 except Exception as exc:  # noqa: BLE001 (decoders raise several types)
                     raise LogError(self.file, f"cannot decode {short_type(conn.msgtype)} "
-                                   f"({exc_text(exc)})", where=f"message {counts[conn.topic]} "
+                                   f"({decode_error_text(exc)})",
+                                   where=f"message {counts[conn.topic]} "
                                    f"on topic '{conn.topic}'", row=counts[conn.topic]) from None
                 yield conn.topic, log_ns, msg
         except LogError:

@@ -52,18 +52,56 @@ def _column_name(raw: str, finger: int | None) -> str | None:
     return None if name in FINGER_COLUMNS else name
 
 
-def _parse_header(names: list[str], file: str, finger: int | None = None
+def _source_names(raw: str) -> tuple[str, ...]:
+    """The names a ``columns=`` mapping may give for a header cell: the whole cell and its name
+    without a ``[unit]`` suffix, lower case."""
+    cell = str(raw).strip().lower()
+    m = _HEADER_RE.match(str(raw))
+    return (cell, m.group(1).lower()) if m else (cell,)
+
+
+def _renames(names: list[str], file: str, columns: Mapping[str, str] | None) -> dict[str, str]:
+    """{source name (lower case): format name} of a ``columns=`` mapping {format name: source
+    column}, checked against the format and the header."""
+    if not columns:
+        return {}
+    rename: dict[str, str] = {}
+    for target, source in columns.items():
+        if target not in UNITS:
+            raise LogError(file, f"[[opt:columns]]: {target!r} is not a column of the format "
+                           f"(expected one of {', '.join(UNITS)})")
+        key = str(source).strip().lower()
+        if key in rename:
+            raise LogError(file, f"[[opt:columns]]: column {source!r} is mapped twice "
+                           f"({rename[key]!r} and {target!r})")
+        rename[key] = target
+    present = {n for raw in names for n in _source_names(raw)}
+    for key, target in rename.items():
+        if key not in present:
+            have = ", ".join(str(n) for n in names) or "(none)"
+            raise LogError(file, f"[[opt:columns]] maps {target!r} to {columns[target]!r}, which "
+                           f"is not a column of the file; the file has: {have}",
+                           where="row 1", row=1)
+    return rename
+
+
+def _parse_header(names: list[str], file: str, finger: int | None = None,
+                  columns: Mapping[str, str] | None = None
                   ) -> tuple[dict[str, int], dict[str, str], list[str]]:
     """Map column name -> position, column -> unit from ``name [unit]``, ignored names
-    (``finger``: see :func:`_column_name`)."""
+    (``finger``: see :func:`_column_name`; ``columns``: {format name: the file's column}, for
+    files whose columns have other names; a file column named like a mapped format column is
+    then ignored)."""
     index: dict[str, int] = {}
     units: dict[str, str] = {}
     ignored: list[str] = []
     known = set(UNITS) | (set(GRASP_COLUMNS) if finger is not None else set())
+    rename = _renames(names, file, columns)
     for pos, raw in enumerate(names):
         m = _HEADER_RE.match(str(raw))
-        name = _column_name(raw, finger)
-        if name not in known:
+        mapped = [rename[n] for n in _source_names(raw) if n in rename]
+        name = mapped[0] if mapped else _column_name(raw, finger)
+        if name not in known or (not mapped and name in rename.values()):
             ignored.append(str(raw))
             continue
         if name in index:
@@ -71,7 +109,7 @@ def _parse_header(names: list[str], file: str, finger: int | None = None
                            f"and {pos + 1})", where=f"row 1, column '{name}'", row=1,
                            column=name)
         index[name] = pos
-        if m.group(2) is not None:
+        if m is not None and m.group(2) is not None:
             units[name] = m.group(2)
     return index, units, ignored
 
@@ -96,8 +134,10 @@ def _check_required(index: Mapping[str, Any], names: list[str], file: str,
                     "(or f_t_k), tau_k; optional omega_k, command, maneuver")
     if missing:
         names_ = ", ".join(f"'{c}'" for c in missing)
+        hint = ("" if finger is not None else "; map the file's own names with [[alt:columns="
+                "{'t': 'time', 'f_n': 'Fz', 'tau': 'Mz', ...}|--columns t=time,f_n=Fz,tau=Mz,...]]")
         raise LogError(file, f"missing required column(s) {names_}; the file has: {have}; "
-                       f"{expected}", where=f"row 1, column '{missing[0]}'", row=1,
+                       f"{expected}{hint}", where=f"row 1, column '{missing[0]}'", row=1,
                        column=missing[0])
 
 
@@ -119,7 +159,8 @@ def _cells_to_float(cells, column: str, loc: _Locator) -> np.ndarray:
     raise loc.error("column is not numeric", None, column)  # pragma: no cover
 
 
-def _read_csv(path: Path, file: str, finger: int | None = None
+def _read_csv(path: Path, file: str, finger: int | None = None,
+              columns: Mapping[str, str] | None = None
               ) -> tuple[dict[str, np.ndarray], dict[str, str], _Locator, dict]:
     size = path.stat().st_size
     if size > MAX_CSV_BYTES:
@@ -131,7 +172,7 @@ def _read_csv(path: Path, file: str, finger: int | None = None
     if head[:2] in (b"\xff\xfe", b"\xfe\xff") or b"\x00" in head:
         raise LogError(file, "not UTF-8 text (UTF-16 or a binary file?); save the table as "
                        "UTF-8 CSV")
-    fast, why = _read_csv_stream(path, file, finger)
+    fast, why = _read_csv_stream(path, file, finger, columns)
     if fast is not None:
         return fast
     if size > MAX_LINE_READER_BYTES:
@@ -176,7 +217,7 @@ def _read_csv(path: Path, file: str, finger: int | None = None
         rows.append(record)
         lines.append(reader.line_num)
     assert header is not None
-    index, units, ignored = _parse_header(header, file, finger)
+    index, units, ignored = _parse_header(header, file, finger, columns)
     if not index and all(_is_number(c) for c in header if c):
         raise LogError(file, f"no header row: row {header_line} holds numbers; the first row "
                        "must name the columns (t, f_n, f_x, f_y or f_t, tau, omega, maneuver)",
@@ -220,7 +261,8 @@ def _count_lines(path: Path) -> int:
     return n if last == b"\n" else n + 1
 
 
-def _read_csv_stream(path: Path, file: str, finger: int | None = None):
+def _read_csv_stream(path: Path, file: str, finger: int | None = None,
+                     columns: Mapping[str, str] | None = None):
     """pyarrow's streaming CSV reader for clean files (one header row, no blank lines, every
     cell of the format's columns a number), block by block into the format's columns; only
     those columns are ever held. Returns (result, None), or (None, reason) to fall back to the
@@ -245,7 +287,7 @@ def _read_csv_stream(path: Path, file: str, finger: int | None = None):
         header = [c.strip() for c in next(csv.reader([line], delimiter=delim))]
     except (csv.Error, StopIteration):  # e.g. quotes the csv module refuses: it names them
         return None, "the header row is not one CSV record"
-    index, units, ignored = _parse_header(header, file, finger)
+    index, units, ignored = _parse_header(header, file, finger, columns)
     if not index:
         return None, "the first row names none of the format's columns"
     _check_required(index, header, file, finger)

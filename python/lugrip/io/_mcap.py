@@ -12,7 +12,7 @@ from typing import Any
 
 import numpy as np
 
-from ._extras import exc_text, need
+from ._extras import decode_error_text, exc_text, need
 from ._log import UNITS, LogError, LogWarning, SlidingLog
 from ._ros import (
     _DEFAULT_MANEUVER_TOPIC,
@@ -210,7 +210,7 @@ class McapSource(RosSource):
                     msg = decode(data)
                 except Exception as exc:  # noqa: BLE001 (decoders raise several types)
                     raise LogError(self.file, f"cannot decode {self.topics[name][0]} "
-                                   f"({exc_text(exc)})", where=f"message {k + 1} on topic "
+                                   f"({decode_error_text(exc)})", where=f"message {k + 1} on topic "
                                    f"'{name}'", row=k + 1) from None
                 yield name, log_ns, msg
 

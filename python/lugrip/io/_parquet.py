@@ -18,7 +18,8 @@ from ._log import UNITS, LogError, SlidingLog, _json_meta, _Locator
 MAX_PARQUET_ROWS = 3_000_000
 
 
-def _read_parquet(path: Path, file: str, finger: int | None = None):
+def _read_parquet(path: Path, file: str, finger: int | None = None,
+                  columns=None):
     pa = need("pyarrow", "reading Parquet")
     pq = need("pyarrow.parquet", "reading Parquet")
     if path.stat().st_size == 0:
@@ -35,7 +36,7 @@ def _read_parquet(path: Path, file: str, finger: int | None = None):
     except Exception as exc:  # noqa: BLE001 (pyarrow raises several types for bad files)
         raise LogError(file, f"not a readable Parquet file ({exc_text(exc)})") from None
     names = list(table.column_names)
-    index, units, ignored = _parse_header(names, file, finger)
+    index, units, ignored = _parse_header(names, file, finger, columns)
     _check_required(index, names, file, finger)
     if table.num_rows == 0:
         raise LogError(file, "no data rows (the table is empty)")

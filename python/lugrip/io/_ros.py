@@ -151,12 +151,18 @@ class RosSource:
         return out
 
     def check_topic(self, topic: str, types, what: str) -> None:
+        """``what``: the option naming the topic (``omega_topic``: shown as ``--omega-topic``
+        on the command line) or words for other topics."""
+        option = f"[[opt:{what}]]" if what.endswith("_topic") else what
         if topic not in self.topics:
-            raise LogError(self.file, f"no topic '{topic}' ({what}); topics present: "
-                           f"{self.describe()}")
+            fitting = sorted(n for n, (typ, _, _) in self.topics.items() if typ in types)
+            choose = (f"; of a fitting type: {', '.join(fitting)}" if fitting
+                      else f"; none has a fitting type ({', '.join(types)})")
+            raise LogError(self.file, f"no topic '{topic}' ({option}); topics present: "
+                           f"{self.describe()}{choose}")
         typ = self.topics[topic][0]
         if typ not in types:
-            raise LogError(self.file, f"topic '{topic}' has type {typ}; {what} must be one of "
+            raise LogError(self.file, f"topic '{topic}' has type {typ}; {option} must be one of "
                            f"{', '.join(types)}")
 
     def pick_wrench_topic(self, wrench_topic: str | None) -> str:
@@ -399,6 +405,9 @@ def read_ros(src: RosSource, *, wrench_topic: str | None, omega_topic: str | Non
         max_gap = 10.0 * float(np.median(step)) if step.size else 0.0
         cols["omega"] = resample(o_t, y, t, max_gap)
         meta.update(omega_topic=omega_topic, omega_type=om.type, omega_time_source=o_source)
+    else:  # what a --omega-topic could name, for the messages of commands that need omega
+        meta["omega_candidates"] = sorted(n for n, (typ, _, _) in src.topics.items()
+                                          if typ in OMEGA_TYPES)
 
     if maneuver_topic is not None:
         mt = topics[maneuver_topic]

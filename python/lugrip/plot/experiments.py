@@ -28,6 +28,7 @@ __all__ = [
     "figure_15",
     "figure_17",
     "figure_baselines",
+    "figure_scenario",
     "write_figures",
 ]
 
@@ -226,6 +227,14 @@ def figure_17(full, empty):
     return fig
 
 
+def figure_scenario(result):
+    """Any scenario without a paper figure (a user's own, unseen objects, faults): lugrip's run
+    as Figure 13 lays it out (grasp force, tangential force and torque; S and c~; omega_hat)."""
+    s = result.scenario
+    return _force_s_omega(result, f"{s.name}: {s.title}", tangential=True, torque=True,
+                          legend_loc="center right")
+
+
 _KIND_STYLE = {
     "lugrip": (BLUE, "-", "lugrip"),
     "lugrip_no_pivot": (CYAN, "-", "lugrip, no pivoting"),
@@ -278,7 +287,8 @@ FIGURES = {
 def write_figures(
     results: Mapping[str, object] | Sequence[object], out_dir: str | Path
 ) -> dict[str, Path]:
-    """Write the paper figures available from `results` (ScenarioResult by name) and one
+    """Write the paper figures available from `results` (ScenarioResult by name), the time
+    series of every other scenario (``<name>.png``, :func:`figure_scenario`) and one
     baseline-comparison figure per result with baselines. Returns {figure name: path}."""
     by_name = results if isinstance(results, Mapping) else {r.name: r for r in results}
     out = Path(out_dir)
@@ -286,12 +296,18 @@ def write_figures(
     for name, (fname, fn) in FIGURES.items():
         if name in by_name:
             paths[fname] = plot.save(fn(by_name[name]), out / fname)
+    covered = set(FIGURES)
     if "exp4_aluminium_can_full" in by_name and "exp4_aluminium_can_empty" in by_name:
+        covered |= {"exp4_aluminium_can_full", "exp4_aluminium_can_empty"}
         fname = "fig17_exp4_aluminium_can.png"
         paths[fname] = plot.save(
             figure_17(by_name["exp4_aluminium_can_full"], by_name["exp4_aluminium_can_empty"]),
             out / fname,
         )
+    for name, r in by_name.items():
+        if name not in covered and "lugrip" in r.runs:
+            fname = f"{name}.png"
+            paths[fname] = plot.save(figure_scenario(r), out / fname)
     for name, r in by_name.items():
         if len(r.runs) > 1:
             fname = f"{name}_baselines.png"

@@ -10,7 +10,9 @@ from __future__ import annotations
 
 import dataclasses
 import math
+import os
 from collections.abc import Callable, Mapping, Sequence
+from pathlib import Path
 from typing import Any
 
 import numpy as np
@@ -106,7 +108,8 @@ class ObjectConfig:
 @dataclasses.dataclass
 class ActuatorConfig:
     """Gripper force actuator: ZOH at command_rate [Hz], first-order lag time_constant [s],
-    saturation [0, f_max] [N], rate limit [N/s]; f_init: force and command at t = 0 [N]."""
+    saturation between 0 and f_max [N], rate limit [N/s]; f_init: force and command at
+    t = 0 [N]."""
 
     f_init: float = 1.0
     f_max: float = 80.0
@@ -266,7 +269,8 @@ class PlantConfig:
     ``PlantConfig.from_dict`` accepts the YAML layout used by the scenarios::
 
         model: patch            # or lumped
-        contact: aluminium_can  # preset name, a ContactParams mapping, or {preset: name, mu: ...}
+        contact: aluminium_can  # preset name, a parameter file (fit.yaml), a ContactParams
+                                # mapping, or {preset: name, mu: ...}
         object: {mass: 0.4, inertia: 4.0e-4, cog: [0.0, -0.03], theta0: 0.0}
         actuator: {f_init: 1.0, time_constant: 0.03}
         sensor: {force_noise: 0.005, torque_noise: 1.0e-5}
@@ -328,7 +332,10 @@ class PlantConfig:
         if "contact" not in d or "object" not in d:
             raise ValueError("plant config: 'contact' and 'object' are required")
         contact = d.pop("contact")
-        if isinstance(contact, str):
+        if isinstance(contact, (str, os.PathLike)) and \
+                Path(contact).suffix.lower() in (".yaml", ".yml"):
+            contact = ContactParams.from_yaml(contact)  # e.g. written by lugrip identify
+        elif isinstance(contact, str):
             contact = ContactParams.preset(contact)
         elif isinstance(contact, Mapping) and "preset" in contact:
             c = dict(contact)
@@ -336,7 +343,8 @@ class PlantConfig:
         elif isinstance(contact, Mapping):
             contact = ContactParams.from_dict(contact)
         elif not isinstance(contact, ContactParams):
-            raise ValueError("contact: expected a preset name, a mapping or ContactParams")
+            raise ValueError("contact: expected a preset name, a parameter file (.yaml), a "
+                             "mapping or ContactParams")
         moves = [
             _build(GripperMove, m, f"moves[{i}]") for i, m in enumerate(d.pop("moves", None) or [])
         ]

@@ -211,6 +211,12 @@ def markdown_section(
         ]
     lines += ["### Pass criteria", "", criteria_table(results), ""]
     lines += ["Criteria: " + "; ".join(f"`{k}`: {v}" for k, v in CRITERIA.items()) + ".", ""]
+    own = [r.name for r in results if f"{r.name}.png" in figures]
+    if own:
+        lines += ["### Other scenarios (lugrip's run: forces, S and c~, omega_hat)", ""]
+        for name in own:
+            lines += [f"![{name}]({Path(figures[f'{name}.png']).relative_to(base).as_posix()})",
+                      ""]
     base_figs = [(k, v) for k, v in figures.items() if k.endswith("_baselines.png")]
     if base_figs:
         lines += ["### Baselines (ground truth: command, slip, rotation)", ""]

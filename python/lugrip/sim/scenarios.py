@@ -10,7 +10,10 @@ A scenario file (``scenarios/<name>.yaml``) holds::
     description: ...                 # what is shown
     choices: {...}                   # documented choice of mass, geometry, loads (free mapping)
     duration: 22.0                   # [s]
-    plant: {...}                     # PlantConfig.from_dict layout (object, lift, disturbances)
+    plant: {...}                     # PlantConfig.from_dict layout (object, lift, disturbances);
+                                     # contact: a preset, a mapping or a parameter file
+                                     # (fit.yaml of lugrip identify; relative: next to the
+                                     # scenario, else the shipped objects/)
     controller: {...}                # GraspController settings
     observer: {...}                  # Observer settings
     estimator: {patch: {...}}        # per plant model: contact parameters of observers + controller
@@ -269,11 +272,18 @@ class Scenario:
         sw = data.get("steady_window")
         if sw is not None and (not isinstance(sw, Sequence) or isinstance(sw, str) or len(sw) != 2):
             raise ValueError(f"{where}: steady_window: expected [start, end] in seconds")
+        plant = dict(plant)
+        contact = plant.get("contact")
+        if isinstance(contact, str) and Path(contact).suffix.lower() in (".yaml", ".yml"):
+            # an identified parameter file: its contact parameters, read now (relative to the
+            # scenario) so the plant block stays self-contained
+            path = _estimator_file(contact, source, f"{where}: plant.contact")
+            plant["contact"] = ContactParams.from_yaml(path).to_dict()
         s = cls(
             name=str(data["name"]),
             title=str(data["title"]),
             duration=to_number(data["duration"], f"{where}: duration"),
-            plant=dict(data["plant"]),
+            plant=plant,
             figure=data.get("figure"),
             group=data.get("group"),
             description=str(data.get("description") or "").strip(),
@@ -420,9 +430,10 @@ class Scenario:
         return self.plant_config().contact
 
 
-def _estimator_file(name: str, source: Path | None) -> Path:
-    """The parameter file `name` of an estimator block: as given when absolute, else next to
-    the scenario file `source`, else in the shipped objects directory."""
+def _estimator_file(name: str, source: Path | None, what: str = "estimator") -> Path:
+    """The parameter file `name` of an estimator block (or, ``what``, of plant.contact): as
+    given when absolute, else next to the scenario file `source`, else in the shipped objects
+    directory."""
     from .._data import data_dir
 
     p = Path(name)
@@ -435,7 +446,7 @@ def _estimator_file(name: str, source: Path | None) -> Path:
         if c.is_file():
             return c
     where = ", ".join(str(c.parent) for c in candidates) or "no scenario or objects directory"
-    raise ValueError(f"estimator parameter file {name!r} not found (looked in {where})")
+    raise ValueError(f"{what} parameter file {name!r} not found (looked in {where})")
 
 
 def _estimator_block(value: Any, where: str) -> dict:
