@@ -19,7 +19,7 @@ $(VPY):
 # Build dependencies are installed into the venv and the build runs without isolation, so the
 # CMake build directory (build/<wheel tag>) is reused and rebuilds are incremental.
 $(VENV)/.installed: $(VPY) $(SOURCES)
-	$(VPY) -m pip install -q "scikit-build-core>=0.10" "nanobind>=2.4"
+	$(VPY) -m pip install -q "scikit-build-core>=0.10" "nanobind>=2.4" "mujoco>=3.2,<4"
 	$(VPY) -m pip install -q --no-build-isolation ".[test,io]"
 	@touch $@
 
