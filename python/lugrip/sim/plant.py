@@ -5,7 +5,12 @@ A plant simulates the gripper, its two fingertip force/torque sensors, the grasp
 robot's moves and disturbances. It knows nothing of lugrip's observers, controller, baselines,
 faults or judging: the closed-loop runner (:mod:`lugrip.sim.runner`) owns those for every
 plant. A plant kind is one module with a class that satisfies :class:`Plant` and one call of
-:func:`register_plant`.
+:func:`register_plant` (a line in the built-in registrations at the end of this module, which
+import the plant's module only when it is used). Every ``--plant`` choice, scenario check and
+campaign asks this registry; nothing else names a plant kind.
+
+The reference implementation is :class:`lugrip.sim.mujoco.plant.MujocoPlant`; the runner is
+:func:`lugrip.sim.runner.run_plant_loop`.
 
 The cycle
 ---------
@@ -18,9 +23,10 @@ The cycle
 
 ``reset(scene, seed=None, *, config=None)``
     ``scene`` is the parsed scenario, a :class:`lugrip.sim.scenarios.Scenario` (already
-    ``scene.for_plant(name)``): the plant reads its own block from it (MuJoCo: ``scene.mujoco``,
-    i.e. ``scene.scene_spec()``; another engine: ``getattr(scene, name)`` or
-    ``scene.plant.get(name)``) and ``scene.duration``. ``config`` is the
+    ``scene.for_plant(name)``): the plant reads its own block from it, ``scene.block(name)``
+    (a dict: the scenario file's top-level key of the plant's name, e.g. ``mujoco:`` -- which
+    ``scene.scene_spec()`` parses for MuJoCo -- or ``drake:``; any registered name is accepted
+    as a key), and may read ``scene.duration`` and ``scene.name``. ``config`` is the
     :class:`lugrip.sim.PlantConfig` of the run (object mass/inertia/CoG [kg, kg m^2, m];
     contact parameters; actuator lag, rate limit, range and ``f_init``; sensor rate, noise and
     bias; gripper moves; disturbances; drop limits; seed). When None it is
@@ -115,8 +121,9 @@ class PlantSamples:
     * ``rotation`` (n,): rotation of the object relative to the fingertips since reset [rad]
       (positive counter-clockwise seen along the closing axis from finger 0).
     * ``theta`` (n,): the object's angle in the world plane [rad] (0 at rest).
-    * ``cog`` (n, 2): the object's centre of gravity relative to the grasp point, world plane
-      axes (horizontal, vertical) [m]; with ``theta``, the object's pose relative to the hand.
+    * ``cog`` (n, 2): the object's centre of gravity relative to the fingertips' midpoint (the
+      grasp point at rest), world plane axes (horizontal, vertical) [m]; with ``theta``, the
+      object's pose relative to the hand.
     * ``omega`` (n, 2): the object's spin relative to fingertip i about the sensor z axis
       [rad/s] (0 without contact).
     * ``v_slip`` (n, 2): the object's in-plane slip speed relative to fingertip i at the sensor

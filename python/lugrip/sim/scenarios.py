@@ -49,6 +49,8 @@ from .._yaml import load_yaml, to_number
 from . import faults as _faults
 from ._closed_loop import ClosedLoopRun, estimator_params, run_closed_loop
 from ._plant import PlantConfig
+from .plant import make_plant, plant_names, registered
+from .runner import run_plant_loop
 
 __all__ = [
     "CRITERIA",
@@ -197,8 +199,9 @@ _KEYS = {
     "faults",
 }
 
-#: Plant models a scenario runs on: the two of lugrip's own simulator and MuJoCo's gripper.
-PLANT_MODELS = ("patch", "lumped", "mujoco")
+#: Plant models a scenario runs on when this module was imported: the two of lugrip's own
+#: simulator and the registered engines (lugrip.sim.plant; the checks below ask the registry).
+PLANT_MODELS = plant_names()
 #: Scenario sets: the paper's experiments (scenarios/*.yaml) and objects the controller was not
 #: tuned on (scenarios/unseen/*.yaml).
 SUITES = ("paper", "unseen", "faults")
@@ -232,13 +235,22 @@ class Scenario:
     source: Path | None = None
     #: the standing reserve's derivation (controller ``reserve: disturbances``), else empty
     reserve: dict = dataclasses.field(default_factory=dict)
+    #: the blocks of registered engines other than MuJoCo, by plant name (see :meth:`block`)
+    engines: dict = dataclasses.field(default_factory=dict)
+
+    def block(self, name: str) -> dict:
+        """The scenario's own block for engine ``name`` (its top-level key of that name; the
+        ``mujoco`` block for MuJoCo), empty when the file has none."""
+        own = getattr(self, name, None) if name not in ("plant", "engines") else None
+        return dict(own) if isinstance(own, dict) else dict(self.engines.get(name) or {})
 
     @classmethod
     def from_dict(cls, data: Mapping[str, Any], source: Path | None = None) -> Scenario:
         where = str(source) if source else "scenario"
         if not isinstance(data, Mapping):
             raise ValueError(f"{where}: expected a mapping at the top level")  # noqa: TRY004 (file content)
-        unknown = sorted(set(data) - _KEYS)
+        # a registered engine's own block (lugrip.sim.plant) is a top-level key of its name
+        unknown = sorted(set(data) - _KEYS - set(plant_names()))
         if unknown:
             raise ValueError(f"{where}: unknown key(s) {', '.join(unknown)}")
         for key in ("name", "title", "duration", "plant"):
@@ -256,16 +268,16 @@ class Scenario:
             unknown = sorted(set(crit) - set(CRITERIA))
             if unknown:
                 raise ValueError(f"{where}: unknown criteria {', '.join(unknown)}")
-        if not set(by_plant) <= set(PLANT_MODELS):
+        if not set(by_plant) <= set(plant_names()):
             raise ValueError(
-                f"{where}: criteria_by_plant: keys must be among {', '.join(PLANT_MODELS)}"
+                f"{where}: criteria_by_plant: keys must be among {', '.join(plant_names())}"
             )
         plant = data["plant"]
         if not isinstance(plant, Mapping):
             raise ValueError(f"{where}: plant: expected a mapping (model: patch | lumped | mujoco, ...)")  # noqa: TRY004 (file content)
         model = plant.get("model", "patch")
-        if not isinstance(model, str) or model not in PLANT_MODELS:
-            raise ValueError(f"{where}: plant.model: must be one of {', '.join(PLANT_MODELS)}")
+        if not isinstance(model, str) or model not in plant_names():
+            raise ValueError(f"{where}: plant.model: must be one of {', '.join(plant_names())}")
         sw = data.get("steady_window")
         if sw is not None and (not isinstance(sw, Sequence) or isinstance(sw, str) or len(sw) != 2):
             raise ValueError(f"{where}: steady_window: expected [start, end] in seconds")
@@ -294,6 +306,8 @@ class Scenario:
             criteria_by_plant={str(k): dict(v) for k, v in by_plant.items()},
             faults=_faults.fault_block(data.get("faults"), where),
             source=source,
+            engines={str(k): dict(v or {}) for k, v in data.items()
+                     if k not in _KEYS and registered(k)},
         )
         if s.suite not in SUITES:
             raise ValueError(f"{where}: suite {s.suite!r}: expected one of {', '.join(SUITES)}")
@@ -332,6 +346,7 @@ class Scenario:
         d = dataclasses.asdict(self)
         d.pop("source")
         d.pop("reserve")
+        d.update(d.pop("engines"))
         if d["steady_window"] is not None:
             d["steady_window"] = list(d["steady_window"])
         return d
@@ -352,8 +367,8 @@ class Scenario:
     def plant_model(self, model: str | None = None) -> str:
         """The plant model a run uses: `model`, else the file's ``plant.model`` (patch)."""
         m = str(model if model is not None else self.plant.get("model", "patch"))
-        if m not in PLANT_MODELS:
-            raise ValueError(f"plant model {m!r}: expected one of {', '.join(PLANT_MODELS)}")
+        if m not in plant_names():
+            raise ValueError(f"plant model {m!r}: expected one of {', '.join(plant_names())}")
         return m
 
     def plant_config(self, model: str | None = None, seed: int | None = None) -> PlantConfig:
@@ -363,7 +378,7 @@ class Scenario:
         d = copy.deepcopy(self.plant)
         if model is not None:
             d["model"] = model
-        if d.get("model") == "mujoco":
+        if registered(d.get("model", "patch")):  # an engine reads the patch plant's block
             d["model"] = "patch"
         if seed is not None:
             d["seed"] = int(seed)
@@ -443,9 +458,9 @@ def _estimator_block(value: Any, where: str) -> dict:
     parameters the estimator side uses with that plant."""
     if value is None:
         return {}
-    if not isinstance(value, Mapping) or not set(value) <= set(PLANT_MODELS):
+    if not isinstance(value, Mapping) or not set(value) <= set(plant_names()):
         raise ValueError(
-            f"{where}: estimator: expected a mapping with keys among {', '.join(PLANT_MODELS)}"
+            f"{where}: estimator: expected a mapping with keys among {', '.join(plant_names())}"
         )
     return {str(k): copy.deepcopy(v) for k, v in value.items()}
 
@@ -793,7 +808,9 @@ def simulate(
     **options,
 ) -> ClosedLoopRun:
     """One closed-loop run of `scenario` on plant `model` (patch, lumped: lugrip's C++ loop;
-    mujoco: :func:`lugrip.sim.mujoco.loop.run_mujoco_loop`) with controller `kind`."""
+    a registered engine such as mujoco: :func:`lugrip.sim.runner.run_plant_loop` on
+    :func:`lugrip.sim.plant.make_plant`'s plant, `frame_callback` among its options) with
+    controller `kind`."""
     est = scenario.estimator_for(model)
     if scenario.faults:
         options = dict(
@@ -802,19 +819,19 @@ def simulate(
             stuck_samples=scenario.faults.get("stuck_samples", 0),
             healthy_finger_fallback=scenario.faults.get("healthy_finger_fallback", False),
         )
-    if model == "mujoco":
-        from .mujoco.loop import run_mujoco_loop
-
-        return run_mujoco_loop(
+    if registered(model):  # an engine behind the Plant interface
+        plant = make_plant(model, **({} if frame_callback is None else
+                                     {"frame_callback": frame_callback}))
+        return run_plant_loop(
+            plant,
+            scenario,
             cfg,
-            scenario.scene_spec(),
             scenario.controller,
             scenario.observer,
             schedule,
             scenario.duration,
             kind=kind,
             estimator=est,
-            frame_callback=frame_callback,
             **options,
         )
     return run_closed_loop(
