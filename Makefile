@@ -8,7 +8,8 @@ OUT    ?= out
 
 SOURCES := $(shell find src include bindings python -type f \( -name '*.cpp' -o -name '*.hpp' -o -name '*.py' \)) pyproject.toml CMakeLists.txt
 
-.PHONY: all install demo test test-cpp test-python test-install deps-cpp validate identify-mujoco bench sanitize sanitize-campaign clean
+PHONY_DEMO := install-demo
+.PHONY: all install $(PHONY_DEMO) demo test test-cpp test-python test-install deps-cpp validate identify-mujoco bench sanitize sanitize-campaign clean
 
 all: install
 
@@ -25,8 +26,19 @@ $(VENV)/.installed: $(VPY) $(SOURCES)
 
 install: $(VENV)/.installed
 
-demo: install
-	$(VENV)/bin/lugrip demo --out $(OUT) --force
+# `make demo` needs lugrip and its runtime dependencies only (no test extras: a smaller .venv);
+# a .venv that `make install`/`make test` set up already serves it as it is.
+$(VENV)/.installed-demo: $(VPY) $(SOURCES)
+	$(VPY) -m pip install -q "scikit-build-core>=0.10" "nanobind>=2.4" "mujoco>=3.2,<4"
+	$(VPY) -m pip install -q --no-build-isolation .
+	@touch $@
+
+install-demo: $(VENV)/.installed-demo
+
+# one noise seed per MuJoCo scene; `lugrip demo --full` (DEMO_FLAGS=--full) runs eight
+DEMO_FLAGS ?=
+demo: $(if $(wildcard $(VENV)/.installed),install,install-demo)
+	$(VENV)/bin/lugrip demo --out $(OUT) --force $(DEMO_FLAGS)
 
 test: test-cpp test-install test-python
 

@@ -76,8 +76,9 @@ __all__ = [
     "PlantClock",
     "PlantSamples",
     "make_plant",
-    "plant_names",
     "plant_description",
+    "plant_names",
+    "plant_renders",
     "register_plant",
     "registered",
 ]
@@ -197,15 +198,20 @@ class Plant(Protocol):
 
 #: name -> (factory or "module:attribute", one line of description)
 _REGISTRY: dict[str, tuple[Callable[..., Plant] | str, str]] = {}
+#: registered plants whose factory takes ``frame_callback`` (MuJoCo's offscreen frames)
+_RENDERS: set[str] = set()
 
 
-def register_plant(name: str, factory: Callable[..., Plant] | str, description: str = "") -> None:
+def register_plant(name: str, factory: Callable[..., Plant] | str, description: str = "", *,
+                   frames: bool = False) -> None:
     """Make plant kind ``name`` available to :func:`make_plant` and ``--plant``.
 
     ``factory`` is a callable returning a :class:`Plant` (called with :func:`make_plant`'s
     keyword options), or a ``"module:attribute"`` string naming one, imported on first use (so
     an engine's package is imported only when its plant is used). Registering a name again
-    replaces it."""
+    replaces it. ``frames``: the factory takes ``frame_callback=f(model, data, t)`` called
+    after every sensor sample with MuJoCo's model and data (``lugrip simulate --video`` and the
+    report's frames)."""
     key = str(name).strip().lower()
     if not key or not key.replace("_", "").replace("-", "").isalnum():
         raise ValueError(f"plant name {name!r}: expected letters, digits, '-' or '_'")
@@ -214,6 +220,14 @@ def register_plant(name: str, factory: Callable[..., Plant] | str, description: 
     if not (callable(factory) or (isinstance(factory, str) and ":" in factory)):
         raise TypeError("factory: expected a callable or a 'module:attribute' string")
     _REGISTRY[key] = (factory, str(description))
+    _RENDERS.discard(key)
+    if frames:
+        _RENDERS.add(key)
+
+
+def plant_renders(name: str) -> bool:
+    """Plant kind ``name`` renders MuJoCo frames (``register_plant(..., frames=True)``)."""
+    return str(name).strip().lower() in _RENDERS
 
 
 def plant_names() -> tuple[str, ...]:
@@ -268,4 +282,5 @@ register_plant(
     "mujoco",
     "lugrip.sim.mujoco.plant:MujocoPlant",
     "MuJoCo gripper with compliant pads and condim-4 contacts (an independent engine)",
+    frames=True,
 )

@@ -22,6 +22,8 @@ A scenario file (``scenarios/<name>.yaml``) holds::
     baselines: {constant_force: true, friction_cone: true}
     short: {...}                     # overrides for --short (top-level keys; plant merged)
     faults: {inject: [...], ...}     # injected sensor/actuator faults (lugrip.sim.faults)
+    known_limits: {mujoco: "why"}    # plant -> why the scenario is known to fail there (demo)
+    <engine>: {...}                  # a registered engine's own block (mujoco: see SceneSpec)
 
 Slip and rotation are measured in the *hold* phases: from ``hold_start`` (by default the start of
 the lift, so the lift-off, where the load arrives, counts) to the end, minus the pivoting
@@ -197,6 +199,7 @@ _KEYS = {
     "mujoco",
     "criteria_by_plant",
     "faults",
+    "known_limits",
 }
 
 #: Plant models a scenario runs on when this module was imported: the two of lugrip's own
@@ -237,6 +240,9 @@ class Scenario:
     reserve: dict = dataclasses.field(default_factory=dict)
     #: the blocks of registered engines other than MuJoCo, by plant name (see :meth:`block`)
     engines: dict = dataclasses.field(default_factory=dict)
+    #: plant name -> why this scenario is known to fail its criteria on that plant (the demo
+    #: reports such a failure as a documented limit, not an error)
+    known_limits: dict = dataclasses.field(default_factory=dict)
 
     def block(self, name: str) -> dict:
         """The scenario's own block for engine ``name`` (its top-level key of that name; the
@@ -308,6 +314,7 @@ class Scenario:
             source=source,
             engines={str(k): dict(v or {}) for k, v in data.items()
                      if k not in _KEYS and registered(k)},
+            known_limits=_known_limits(data.get("known_limits"), where),
         )
         if s.suite not in SUITES:
             raise ValueError(f"{where}: suite {s.suite!r}: expected one of {', '.join(SUITES)}")
@@ -451,6 +458,19 @@ def _estimator_file(name: str, source: Path | None) -> Path:
             return c
     where = ", ".join(str(c.parent) for c in candidates) or "no scenario or objects directory"
     raise ValueError(f"estimator parameter file {name!r} not found (looked in {where})")
+
+
+def _known_limits(value: Any, where: str) -> dict:
+    """The ``known_limits`` block: plant name -> the reason (text) the scenario fails there."""
+    if value is None:
+        return {}
+    if not isinstance(value, Mapping) or not set(value) <= set(plant_names()):
+        raise ValueError(f"{where}: known_limits: expected a mapping with keys among "
+                         f"{', '.join(plant_names())} (plant -> reason)")
+    bad = [k for k, v in value.items() if not isinstance(v, str) or not v.strip()]
+    if bad:
+        raise ValueError(f"{where}: known_limits.{bad[0]}: expected the reason as text")
+    return {str(k): str(v).strip() for k, v in value.items()}
 
 
 def _estimator_block(value: Any, where: str) -> dict:
