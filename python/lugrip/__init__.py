@@ -35,7 +35,8 @@ from ._observer import (
     observability,
     sensor_wrench,
 )
-from ._params import PRESETS, ContactParams, read_observer_settings
+from ._observer import read_observer_settings
+from ._params import PRESETS, ContactParams
 from ._controller import (
     PAPER_SETTINGS,
     ControllerMode,

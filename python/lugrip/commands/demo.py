@@ -55,6 +55,8 @@ class DemoStep:
     function: StepFunction | str
     #: units of progress the step reports (an int, or a function of ``full``)
     units: Union[int, Callable[[bool], int]] = 1
+    #: the step renders MuJoCo frames (the offscreen GL back end is chosen before any step)
+    renders: bool = False
 
     def count(self, full: bool) -> int:
         return max(1, int(self.units(full) if callable(self.units) else self.units))
@@ -72,7 +74,7 @@ STEPS: list[DemoStep] = [
     DemoStep("experiments", "Closed-loop experiments (paper Figures 11, 13, 15, 17) and baselines",
              "lugrip.sim.report:demo_section", lambda full: _count("paper")),
     DemoStep("mujoco", "Closed loop on MuJoCo: the paper's experiments and unseen objects",
-             "lugrip.sim.report:mujoco_demo_section", lambda full: _count("all")),
+             "lugrip.sim.report:mujoco_demo_section", lambda full: _count("all"), renders=True),
 ]
 """Steps of ``lugrip demo`` in report order."""
 
@@ -232,9 +234,10 @@ def run(args: argparse.Namespace) -> int:
     from ._output import check_dir
 
     check_dir(args.out, "--out", force=args.force, results=(REPORT_NAME,))
-    from ..sim import report
+    if any(step.renders for step in steps):
+        from ..sim import report
 
-    report.choose_gl_backend()  # frames of the engine steps: before any step imports MuJoCo
+        report.choose_gl_backend()  # the frames: before any step imports MuJoCo
     path, failed = run_demo(args.out, steps, full=args.full)
     print(f"wrote {path}", file=sys.stderr)
     for line in known_limits:

@@ -6,7 +6,6 @@ from __future__ import annotations
 import argparse
 import math
 import sys
-import time
 from pathlib import Path
 
 from . import CliError, observer_options, positive_float
@@ -425,7 +424,8 @@ def run(args) -> int:
     if args.rubbing:
         if args.params0 is None:
             raise CliError("--rubbing needs --params0 (the fingertip's delta and gamma)")
-        from .._params import ContactParams, read_observer_settings
+        from .._observer import read_observer_settings
+        from .._params import ContactParams
 
         try:
             base = ContactParams.from_yaml(args.params0)
@@ -459,7 +459,7 @@ def run(args) -> int:
 
     block = None
     if args.params0 is not None and args.params0.suffix in (".yaml", ".yml"):
-        from .._params import read_observer_settings
+        from .._observer import read_observer_settings
 
         if not args.params0.exists():
             raise CliError(f"argument --params0: {args.params0}: no such file")

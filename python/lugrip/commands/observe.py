@@ -370,7 +370,7 @@ def write_estimates(path: Path, log, run, *, force: bool = False) -> Path:
 def observer_block(args) -> dict | None:
     """The ``observer:`` block of the --params file (settings the parameters were identified
     with), or None (no --params, or a file without the block such as objects/*.yaml)."""
-    from .._params import read_observer_settings
+    from .._observer import read_observer_settings
 
     if getattr(args, "params", None) is None:
         return None

@@ -22,7 +22,6 @@ from collections.abc import Callable, Mapping, Sequence
 from typing import Any
 
 import mujoco
-import numpy as np
 
 from ..._params import ContactParams
 from .._plant import Disturbance, PlantConfig
