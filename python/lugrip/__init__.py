@@ -48,7 +48,7 @@ from ._controller import (
 )
 from ._slip_control import SlipControl, SlipControlRun
 from .io import LogError, LogWarning, SlidingLog, read_log, write_log
-from .sliding import simulate_sliding
+from .sim.sliding import simulate_sliding
 
 # lugrip.identify is the function; its subpackage is lugrip.identification
 from .identification import (

@@ -399,7 +399,7 @@ def _observer(params, args, dt: float, block: dict | None = None):
 def run(args) -> int:
     import numpy as np
 
-    from ..sliding import score
+    from ..sim.sliding import score
 
     out = Path(args.out)
     if out.suffix.lower() not in (".csv", ".parquet", ".pq"):
@@ -485,7 +485,7 @@ def demo_section(out_dir: Path) -> str:
     the default settings, Figure 5 and the scores (Markdown)."""
     from .. import ContactParams, Observer
     from ..plot.observer import write_figure5
-    from ..sliding import score, simulate_maneuvers
+    from ..sim.sliding import score, simulate_maneuvers
 
     params = ContactParams.table1()
     data = simulate_maneuvers(params, 40, seed=5)
