@@ -24,7 +24,7 @@ Scene faults never raise; they set ``ClosedLoopRun.scene`` (see :data:`SCENE_STA
 from __future__ import annotations
 
 import math
-from collections.abc import Callable, Mapping, Sequence
+from collections.abc import Callable, Mapping
 from typing import Any
 
 import mujoco
@@ -34,8 +34,11 @@ from lugrip import _core
 from lugrip._params import ContactParams
 from lugrip._slip_control import SlipControl
 from lugrip.sim._closed_loop import ClosedLoopRun, _schedule, estimator_params, fault_specs
-from lugrip.sim._plant import Disturbance, PlantConfig
-from lugrip.sim.mujoco.gripper import SceneSpec, build_scene, spin_coefficient
+from lugrip.sim._plant import PlantConfig
+from lugrip.sim.mujoco.gripper import SceneSpec, build_scene
+# unchanged since: the disturbance rule and the friction-cone baseline's law
+from lugrip.sim.mujoco.loop import cone_slip_force, disturbance_wrench  # noqa: F401
+from lugrip.sim.runner import cone_command as _cone_command
 
 __all__ = [
     "SCENE_STATUS",
@@ -67,76 +70,6 @@ class MujocoRun(ClosedLoopRun):
 def _min_jerk(t: float, t0: float, T: float) -> float:
     u = min(max((t - t0) / T, 0.0), 1.0) if T > 0 else float(t >= t0)
     return u**3 * (10.0 - 15.0 * u + 6.0 * u * u)
-
-
-def _pulse(shape: str, u: float) -> float:
-    if shape in ("rectangular", "rect"):
-        return 1.0
-    if shape in ("half_sine", "halfsine"):
-        return math.sin(math.pi * u)
-    if shape == "ramp":
-        return u
-    return 1.0 - abs(2.0 * u - 1.0)  # triangle
-
-
-def disturbance_wrench(
-    disturbances: Sequence[Disturbance], t: float, theta: float
-) -> tuple[float, float, float]:
-    """Sum of the active pulses at t [s] for an object at angle theta [rad]: world force
-    (horizontal, vertical) [N] and the torque about the CoG [N m] (the patch plant's rule)."""
-    fx = fy = tau = 0.0
-    c, s = math.cos(theta), math.sin(theta)
-    for d in disturbances:
-        u = (t - d.t_start) / d.duration
-        if not (0.0 <= u < 1.0):
-            continue
-        a = _pulse(d.shape, u)
-        px = c * d.point[0] - s * d.point[1]
-        py = s * d.point[0] + c * d.point[1]
-        qx, qy = a * d.force[0], a * d.force[1]
-        fx += qx
-        fy += qy
-        tau += a * d.torque + px * qy - py * qx
-    return fx, fy, tau
-
-
-def cone_slip_force(params: ContactParams, f_t: float, tau: float) -> float:
-    """The normal force [N] below which MuJoCo's contact slips under the load (f_t [N], tau
-    [N m]): the root of (f_t / (mu f))^2 + (tau / (mu_spin(f) f))^2 = 1 with the torsional
-    coefficient mu_spin(f) = mu xi rho(f) the scene sets (bisection on log f)."""
-    f_t, tau = abs(float(f_t)), abs(float(tau))
-    if f_t == 0.0 and tau == 0.0:
-        return 0.0
-
-    def load(f: float) -> float:
-        return (f_t / (params.mu * f)) ** 2 + (tau / (spin_coefficient(params, f) * f)) ** 2
-
-    lo, hi = 1e-6, 1.0
-    while load(hi) > 1.0:
-        hi *= 2.0
-    for _ in range(200):
-        mid = math.sqrt(lo * hi)
-        if load(mid) > 1.0:
-            lo = mid
-        else:
-            hi = mid
-        if hi / lo < 1.0 + 1e-9:
-            break
-    return hi
-
-
-def _cone_command(command, fn, ft, mu, margin, release, T, s) -> float:
-    """The friction-cone baseline's command (as the C++ closed loop's): raised to
-    max_i f_t / (mu margin) when the utilisation f_t / (mu f_n) reaches the margin."""
-    u = max((ft[i] / (mu * fn[i]) for i in (0, 1) if fn[i] > 0.0), default=0.0)
-    required = max(ft) / (mu * margin)
-    target = command
-    if u >= margin:
-        target = max(command, required)
-    elif release > 0.0:
-        target = max(required, command - release * T)
-    f = min(max(target, command - s["max_rate_down"] * T), command + s["max_rate_up"] * T)
-    return min(max(f, s["f_min"]), s["f_max"])
 
 
 def run_mujoco_loop(

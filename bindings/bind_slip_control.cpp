@@ -36,6 +36,17 @@ void load(const SC& sc, const double* w, size_t size, SlipControlInput& in) {
   for (size_t i = 0; i < k; ++i) in.fingers[i] = FingerWrench{w[4 * i], w[4 * i + 1], w[4 * i + 2], w[4 * i + 3]};
 }
 
+// Batch row i of (N, k, 4) wrenches into the input, after its request (1 pivoting, 2
+// slipping avoidance; pr may be null).
+void load_row(SC& sc, const double* pw, size_t k, size_t i, const int32_t* pr, SlipControlInput& in) {
+  if (pr && pr[i] == 1) sc.request_pivoting();
+  else if (pr && pr[i] == 2) sc.request_slipping_avoidance();
+  for (size_t j = 0; j < static_cast<size_t>(sc.fingers()); ++j) {
+    const double* x = pw + 4 * (k * i + j);
+    in.fingers[j] = FingerWrench{x[0], x[1], x[2], x[3]};
+  }
+}
+
 }  // namespace
 
 void bind_slip_control(nb::module_& m) {
@@ -97,12 +108,7 @@ void bind_slip_control(nb::module_& m) {
           SlipControlInput in;
           SlipControlOutput o;
           for (size_t i = 0; i < n; ++i) {
-            if (pr && pr[i] == 1) sc.request_pivoting();
-            else if (pr && pr[i] == 2) sc.request_slipping_avoidance();
-            for (size_t j = 0; j < static_cast<size_t>(sc.fingers()); ++j) {
-              const double* x = pw + 4 * (k * i + j);
-              in.fingers[j] = FingerWrench{x[0], x[1], x[2], x[3]};
-            }
+            load_row(sc, pw, k, i, pr, in);
             in.dt = pd ? pd[i] : 0.0;
             in.command = pc ? static_cast<CommandTiming>(pc[i]) : CommandTiming::Clock;
             sc.step(in, o);
@@ -137,12 +143,7 @@ void bind_slip_control(nb::module_& m) {
         SlipControlInput in;
         SlipControlOutput o;
         for (size_t i = 0; i < n; ++i) {
-          if (pr && pr[i] == 1) sc.request_pivoting();
-          else if (pr && pr[i] == 2) sc.request_slipping_avoidance();
-          for (size_t j = 0; j < static_cast<size_t>(sc.fingers()); ++j) {
-            const double* x = pw + 4 * (k * i + j);
-            in.fingers[j] = FingerWrench{x[0], x[1], x[2], x[3]};
-          }
+          load_row(sc, pw, k, i, pr, in);
           sc.step(in, o);
           const GraspControllerOutput& c = o.controller;
           double* r = po + i * kLogColumns;
