@@ -103,6 +103,7 @@ bench: install $(VENV)/.ros
 	$(VPY) benchmarks/bench_slip_control.py --out BENCHMARKS.md
 	$(VPY) benchmarks/bench_rigs.py --out BENCHMARKS.md
 	$(VPY) benchmarks/bench_mujoco_rig.py --out BENCHMARKS.md
+	$(VPY) benchmarks/bench_mujoco_loop.py --out BENCHMARKS.md
 	$(VPY) benchmarks/bench_ros_latency.py --out BENCHMARKS.md
 	$(CPP_BUILD)/benchmarks/bench_closed_loop --markdown > build/issue5.md
 	$(VPY) benchmarks/sections.py BENCHMARKS.md issue5 build/issue5.md

@@ -178,7 +178,7 @@ class MujocoPlant:
 
     @property
     def mj_step_seconds(self) -> float:
-        """Wall time spent inside ``mj_step`` since reset [s]."""
+        """CPU time spent inside ``mj_step`` since reset [s] (the stepping thread's clock)."""
         return float(self._stepper.mj_step_seconds)
 
     def _scene_faults(self, t, contact, fingers) -> None:
