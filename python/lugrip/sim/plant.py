@@ -57,8 +57,9 @@ Frames and signs (all arrays float64 unless said, n = samples of the call, finge
   exerts on the fingertip in its sensor frame [N, N, N, N m], tau about the sensor z axis,
   averaged over the sample period, with the sensor's bias and noise (``config.sensor``).
   ``wrench_true`` (n, 2, 4): the same without bias and noise.
-* the hand frame: the gripper's plane, X along the fingers' closing axis, Y up when the hand is
-  not rolled; the world plane: horizontal, vertical.
+* the hand frame: the plane the object moves in (the finger plane), X horizontal and Y up when
+  the hand is not rolled; Z is the grasp axis, from finger 0 to finger 1. The world plane:
+  horizontal, vertical. Angles are positive about Z (right-hand rule).
 """
 
 from __future__ import annotations
@@ -120,7 +121,7 @@ class PlantSamples:
     * ``slip`` (n, 2): displacement of the object's grasp point relative to the fingertips
       since reset, in the hand frame (X, Y) [m].
     * ``rotation`` (n,): rotation of the object relative to the fingertips since reset [rad]
-      (positive counter-clockwise seen along the closing axis from finger 0).
+      (positive about the grasp axis from finger 0 to finger 1).
     * ``theta`` (n,): the object's angle in the world plane [rad] (0 at rest).
     * ``cog`` (n, 2): the object's centre of gravity relative to the fingertips' midpoint (the
       grasp point at rest), world plane axes (horizontal, vertical) [m]; with ``theta``, the
