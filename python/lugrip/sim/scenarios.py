@@ -45,6 +45,7 @@ from typing import Any
 
 from .. import __version__
 from .._controller import controller_settings
+from .._params import ContactParams  # noqa: F401  (part of this module's namespace before the split)
 from ._closed_loop import ClosedLoopRun, run_closed_loop
 from ._plant import PlantConfig
 from .plant import make_plant, registered
