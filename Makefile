@@ -6,9 +6,12 @@ JOBS   ?= 2
 CPP_BUILD := build/cpp
 OUT    ?= out
 
+# MuJoCo for the build (the C++ stepper lugrip._mjstep compiles against its headers) and the run
+MUJOCO_SPEC ?= mujoco>=3.12
 SOURCES := $(shell find src include bindings python -type f \( -name '*.cpp' -o -name '*.hpp' -o -name '*.py' \)) pyproject.toml CMakeLists.txt
 
-.PHONY: all install demo test test-cpp test-python test-install test-oldest docs deps-cpp validate identify-mujoco bench sanitize sanitize-campaign clean
+PHONY_DEMO := install-demo
+.PHONY: all install $(PHONY_DEMO) demo test test-cpp test-python test-install test-oldest docs deps-cpp validate identify-mujoco bench sanitize sanitize-campaign clean
 
 all: install
 
@@ -19,7 +22,7 @@ $(VPY):
 # Build dependencies are installed into the venv and the build runs without isolation, so the
 # CMake build directory (build/<wheel tag>) is reused and rebuilds are incremental.
 $(VENV)/.installed: $(VPY) $(SOURCES)
-	$(VPY) -m pip install -q "scikit-build-core>=0.10" "nanobind>=2.4"
+	$(VPY) -m pip install -q "scikit-build-core>=0.10" "nanobind>=2.4" "$(MUJOCO_SPEC)"
 	$(VPY) -m pip install -q --no-build-isolation ".[test,io,docs]"
 	$(VPY) .ci/mujoco_install.py
 	@touch $@
@@ -33,8 +36,20 @@ install: $(VENV)/.installed
 docs: install
 	NO_MKDOCS_2_WARNING=1 $(VPY) -m mkdocs build --strict
 
-demo: install
-	$(VENV)/bin/lugrip demo --out $(OUT) --force
+# `make demo` needs lugrip and its runtime dependencies only (no test extras: a smaller .venv);
+# a .venv that `make install`/`make test` set up already serves it as it is.
+$(VENV)/.installed-demo: $(VPY) $(SOURCES)
+	$(VPY) -m pip install -q "scikit-build-core>=0.10" "nanobind>=2.4" "$(MUJOCO_SPEC)"
+	$(VPY) -m pip install -q --no-build-isolation .
+	$(VPY) .ci/mujoco_install.py
+	@touch $@
+
+install-demo: $(VENV)/.installed-demo
+
+# one noise seed per MuJoCo scene; `lugrip demo --full` (DEMO_FLAGS=--full) runs eight
+DEMO_FLAGS ?=
+demo: $(if $(wildcard $(VENV)/.installed),install,install-demo)
+	$(VENV)/bin/lugrip demo --out $(OUT) --force $(DEMO_FLAGS)
 
 test: test-cpp test-install test-python
 
@@ -69,7 +84,7 @@ test-cpp: deps-cpp
 # tests/python/test_packaging.py checks this list against pyproject.toml.
 OLDEST_VENV := $(VENV)-oldest
 OLDEST := numpy==1.24.4 scipy==1.10.1 matplotlib==3.7.0 pyyaml==6.0.1 mujoco==3.12.0 \
-	pyarrow==14.0.0 mcap==1.1.0 rosbags==0.10.10
+	tqdm==4.66.0 pyarrow==14.0.0 mcap==1.1.0 rosbags==0.10.10
 OLDEST_TESTS := tests/python/test_mujoco_ident.py tests/python/test_mujoco_pad.py \
 	tests/python/test_mujoco_scenes.py tests/python/test_mujoco_validation.py \
 	tests/python/test_pivot_mujoco.py tests/python/test_rigs_mujoco.py \
@@ -78,10 +93,12 @@ OLDEST_TESTS := tests/python/test_mujoco_ident.py tests/python/test_mujoco_pad.p
 
 test-oldest: install
 	test -x $(OLDEST_VENV)/bin/python || $(PYTHON) -m venv $(OLDEST_VENV)
-	$(OLDEST_VENV)/bin/python -m pip install -q $(OLDEST) "pytest>=7.4" "hypothesis>=6.90"
-	rm -rf build/wheel
-	$(VPY) -m pip wheel -q --no-build-isolation --no-deps . -w build/wheel
-	$(OLDEST_VENV)/bin/python -m pip install -q --no-deps --force-reinstall build/wheel/lugrip-*.whl
+	$(OLDEST_VENV)/bin/python -m pip install -q $(OLDEST) "pytest>=7.4" "hypothesis>=6.90" \
+	  "scikit-build-core>=0.10" "nanobind>=2.4"
+# built in that venv (its own build folder): lugrip._mjstep compiles against the headers of the
+# MuJoCo it runs with and links that version's libmujoco
+	$(OLDEST_VENV)/bin/python -m pip install -q --no-build-isolation --no-deps --force-reinstall \
+	  -C build-dir=build/oldest .
 	$(OLDEST_VENV)/bin/python -m pytest -q -p no:cacheprovider $(OLDEST_TESTS)
 
 # the [ros] extra's wheels (ROS 2 Kilted: rclpy, Fast DDS, messages) for tests/python/test_ros.py,
@@ -119,6 +136,7 @@ bench: install $(VENV)/.ros
 	$(VPY) benchmarks/bench_slip_control.py --out BENCHMARKS.md
 	$(VPY) benchmarks/bench_rigs.py --out BENCHMARKS.md
 	$(VPY) benchmarks/bench_mujoco_rig.py --out BENCHMARKS.md
+	$(VPY) benchmarks/bench_mujoco_loop.py --out BENCHMARKS.md
 	$(VPY) benchmarks/bench_ros_latency.py --out BENCHMARKS.md
 	$(CPP_BUILD)/benchmarks/bench_closed_loop --markdown > build/issue5.md
 	$(VPY) benchmarks/sections.py BENCHMARKS.md issue5 build/issue5.md

@@ -20,6 +20,13 @@ using Times = nb::ndarray<const double, nb::ndim<1>, nb::c_contig, nb::device::c
 using Requests = nb::ndarray<const int32_t, nb::ndim<1>, nb::c_contig, nb::device::cpu>;
 using SC = Guarded<SlipControl>;
 
+//! Columns of SlipControl.run_log, in order.
+constexpr size_t kLogColumns = 17;
+const char* const kLogNames[kLogColumns] = {
+    "force", "status", "static_force", "dynamic_force", "mu_belief", "mode", "command_issued",
+    "pivot_finished", "pivot_end", "omega_hat_0", "omega_hat_1", "S_0", "S_1", "c_tilde_0",
+    "c_tilde_1", "status_0", "status_1"};
+
 // Copies k x 4 wrench values (k = the object's finger count, or 2) into the input.
 void load(const SC& sc, const double* w, size_t size, SlipControlInput& in) {
   const size_t k = static_cast<size_t>(sc.fingers());
@@ -27,6 +34,17 @@ void load(const SC& sc, const double* w, size_t size, SlipControlInput& in) {
     throw std::invalid_argument("wrenches: expected " + std::to_string(4 * k) +
                                 " values (fingers x (f_n, f_x, f_y, tau)), got " + std::to_string(size));
   for (size_t i = 0; i < k; ++i) in.fingers[i] = FingerWrench{w[4 * i], w[4 * i + 1], w[4 * i + 2], w[4 * i + 3]};
+}
+
+// Batch row i of (N, k, 4) wrenches into the input, after its request (1 pivoting, 2
+// slipping avoidance; pr may be null).
+void load_row(SC& sc, const double* pw, size_t k, size_t i, const int32_t* pr, SlipControlInput& in) {
+  if (pr && pr[i] == 1) sc.request_pivoting();
+  else if (pr && pr[i] == 2) sc.request_slipping_avoidance();
+  for (size_t j = 0; j < static_cast<size_t>(sc.fingers()); ++j) {
+    const double* x = pw + 4 * (k * i + j);
+    in.fingers[j] = FingerWrench{x[0], x[1], x[2], x[3]};
+  }
 }
 
 }  // namespace
@@ -38,6 +56,11 @@ void bind_slip_control(nb::module_& m) {
   m.def("validate_slip_control_settings", &validation_message<SlipControlSettings>,
         "Empty string when valid, else one line per problem.");
 
+  {
+    nb::list names;
+    for (const char* name : kLogNames) names.append(name);
+    m.attr("SLIP_CONTROL_LOG_COLUMNS") = nb::tuple(names);
+  }
   nb::class_<SlipControlOutput> out(m, "SlipControlOutput");
   out.def(nb::init<>());
   def_fields_ro(out);
@@ -85,12 +108,7 @@ void bind_slip_control(nb::module_& m) {
           SlipControlInput in;
           SlipControlOutput o;
           for (size_t i = 0; i < n; ++i) {
-            if (pr && pr[i] == 1) sc.request_pivoting();
-            else if (pr && pr[i] == 2) sc.request_slipping_avoidance();
-            for (size_t j = 0; j < static_cast<size_t>(sc.fingers()); ++j) {
-              const double* x = pw + 4 * (k * i + j);
-              in.fingers[j] = FingerWrench{x[0], x[1], x[2], x[3]};
-            }
+            load_row(sc, pw, k, i, pr, in);
             in.dt = pd ? pd[i] : 0.0;
             in.command = pc ? static_cast<CommandTiming>(pc[i]) : CommandTiming::Clock;
             sc.step(in, o);
@@ -109,6 +127,48 @@ void bind_slip_control(nb::module_& m) {
          "0 none, 1 pivoting, 2 slipping avoidance, or empty; commands: (N,) CommandTiming codes or "
          "empty for the clock). Returns a dict of (N,) arrays: the "
          "GraspControllerOutput fields and each finger's ObserverOutput fields suffixed _0 / _1.")
+      .def("run_log", [](SC& sc, const Batch& w, const Requests& req,
+                         nb::ndarray<double, nb::ndim<2>, nb::c_contig, nb::device::cpu> out) {
+        sc.guard.check("SlipControl");
+        const size_t n = w.shape(0), k = w.shape(1);
+        if (w.shape(2) != 4 || (k != static_cast<size_t>(sc.fingers()) && k != kMaxFingers))
+          throw std::invalid_argument("wrenches: expected shape (N, " + std::to_string(sc.fingers()) + ", 4)");
+        if (req.shape(0) != n && req.shape(0) != 0) throw std::invalid_argument("requests: expected N values or none");
+        if (out.shape(0) != n || out.shape(1) != kLogColumns)
+          throw std::invalid_argument("out: expected shape (N, " + std::to_string(kLogColumns) + ")");
+        const double* pw = w.data();
+        const int32_t* pr = req.shape(0) ? req.data() : nullptr;
+        double* po = out.data();
+        nb::gil_scoped_release release;
+        SlipControlInput in;
+        SlipControlOutput o;
+        for (size_t i = 0; i < n; ++i) {
+          load_row(sc, pw, k, i, pr, in);
+          sc.step(in, o);
+          const GraspControllerOutput& c = o.controller;
+          double* r = po + i * kLogColumns;
+          r[0] = o.force;
+          r[1] = static_cast<double>(static_cast<int>(o.status));
+          r[2] = c.static_force;
+          r[3] = c.dynamic_force;
+          r[4] = c.mu_belief;
+          r[5] = static_cast<double>(static_cast<int>(c.mode));
+          r[6] = c.command_issued ? 1.0 : 0.0;
+          r[7] = c.pivot_finished ? 1.0 : 0.0;
+          r[8] = static_cast<double>(static_cast<int>(c.pivot_end));
+          for (size_t j = 0; j < 2; ++j) {
+            const ObserverOutput& f = o.fingers[j];
+            r[9 + j] = f.omega_hat;
+            r[11 + j] = f.S;
+            r[13 + j] = f.c_tilde;
+            r[15 + j] = static_cast<double>(static_cast<int>(f.status));
+          }
+        }
+      }, "wrenches"_a, "requests"_a, "out"_a,
+         "step() over (N, fingers, 4) wrenches with the clock's commands (requests: (N,) 0 none, 1 "
+         "pivoting, 2 slipping avoidance, or empty), writing the closed-loop log's columns of each "
+         "cycle into out (N, 17) float64, named by lugrip._core.SLIP_CONTROL_LOG_COLUMNS "
+         "(codes as numbers). A batch without one array per output field.")
       .def("reset", [](SC& sc, double force) {
         sc.guard.check("SlipControl");
         sc.reset(force);

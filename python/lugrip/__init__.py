@@ -35,7 +35,8 @@ from ._observer import (
     observability,
     sensor_wrench,
 )
-from ._params import PRESETS, ContactParams, read_observer_settings
+from ._observer import read_observer_settings
+from ._params import PRESETS, ContactParams
 from ._controller import (
     PAPER_SETTINGS,
     ControllerMode,
@@ -47,7 +48,7 @@ from ._controller import (
 )
 from ._slip_control import SlipControl, SlipControlRun
 from .io import LogError, LogWarning, SlidingLog, read_log, write_log
-from .sliding import simulate_sliding
+from .sim.sliding import simulate_sliding
 
 # lugrip.identify is the function; its subpackage is lugrip.identification
 from .identification import (

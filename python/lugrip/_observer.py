@@ -15,13 +15,17 @@ from __future__ import annotations
 import dataclasses
 import math
 from collections.abc import Mapping
+from pathlib import Path
+from typing import Any
 
 import numpy as np
 
 from . import _core
 from ._contact import Status, _as_params, _flat, _model, _params_path, _shaped
 from ._nocopy import NoCopy
-from ._params import read_observer_settings
+from ._observer_fields import _COR_FIELDS, _OBS_FIELDS, _OBS_KINDS, GAIN_MODES, INTEGRATORS
+from ._params import ContactParams, _plain_observer_block
+from ._yaml import load_yaml
 from ._yaml import to_number
 
 __all__ = [
@@ -35,22 +39,10 @@ __all__ = [
     "SliderState",
     "SliderTrajectory",
     "observability",
+    "read_observer_settings",
     "sensor_wrench",
 ]
 
-INTEGRATORS = {
-    "implicit": _core.Integrator.Implicit,
-    "rk4": _core.Integrator.Rk4,
-    "rk4_adaptive": _core.Integrator.Rk4Adaptive,
-    "rosenbrock": _core.Integrator.Rosenbrock,
-}
-GAIN_MODES = {"fixed": _core.GainMode.Fixed, "bandwidth": _core.GainMode.Bandwidth}
-# Settings names and kinds from the C++ field tables (bindings/tables.hpp); defaults stay in C++.
-_COR_FIELDS = tuple(name for name, _kind, _doc in _core.CorSettings.fields)
-_OBS_KINDS = {
-    name: kind for name, kind, _doc in _core.ObserverSettings.fields if kind in ("float", "int", "bool")
-}
-_OBS_FIELDS = tuple(_OBS_KINDS)
 
 
 def _enum(table: dict, name: str, value):
@@ -640,3 +632,39 @@ def observability(
         outside_domain=_shaped(outside, shape),
         degraded=_shaped(degraded, shape),
     )
+
+
+def _check_observer_block(block, where: str) -> dict:
+    """Validates an observer block (keywords of :class:`Observer`) by building the observer;
+    returns it with plain Python values. Errors name ``where`` and the key, never the value."""
+    plain = _plain_observer_block(block, where)
+    try:
+        Observer(ContactParams.table1(), **plain)
+    except (TypeError, ValueError, OverflowError) as err:
+        lines = [ln.strip() for ln in str(err).splitlines() if ln.strip()]
+        if lines and lines[0].startswith("invalid observer settings"):
+            lines = lines[1:]
+        raise ValueError("; ".join(f"{where}.{ln}" for ln in lines) or where) from None
+    return plain
+
+
+def read_observer_settings(path: str | Path) -> dict[str, Any] | None:
+    """The ``observer:`` block of a parameter YAML (written by ``lugrip identify`` /
+    :meth:`lugrip.identification.IdentificationResult.save_yaml`): the settings of the observer the
+    parameters were identified with, as keywords of :class:`lugrip.Observer`, so that the
+    observer used online is the one inside the identification cost (docs/model.md 8.1). None when
+    the file has no such block (e.g. ``objects/*.yaml``, ``lugrip params`` output).
+    ``lugrip.Observer(path)`` starts from this block (its keywords override it), as do
+    ``lugrip observe --params``, ``lugrip identify --params0`` and ``lugrip.identify`` with a
+    YAML ``params0``.
+
+    Raises:
+        ValueError: the file cannot be read within the limits of :func:`lugrip._yaml.load_yaml`,
+            or the block is not a mapping or holds an unknown or invalid setting (message
+            ``<file>: observer.<key>: ...``).
+    """
+    path = Path(path)
+    data = load_yaml(path)
+    if not isinstance(data, dict) or data.get("observer") is None:
+        return None
+    return _check_observer_block(data["observer"], f"{path}: observer")

@@ -8,9 +8,10 @@ from pathlib import Path
 from typing import Any
 
 from . import _core
+from ._observer_fields import _COR_FIELDS, _OBS_KINDS, GAIN_MODES, INTEGRATORS
 from ._yaml import describe_kind, field_path, load_yaml, to_number
 
-__all__ = ["ContactParams", "PRESETS", "read_observer_settings"]
+__all__ = ["PRESETS", "ContactParams"]
 
 _FIELDS = ("mu", "beta_a", "sigma0", "sigma_z", "delta", "gamma", "k", "c_max", "static_ratio",
            "kinetic_ratio")
@@ -193,17 +194,18 @@ class ContactParams:
             }
         }
         if observer is not None:
-            body["observer"] = _check_observer_block(dict(observer), "observer")
+            body["observer"] = _plain_observer_block(dict(observer), "observer")
         text = (f"# {comment}\n" if comment else "") + yaml.safe_dump(body, sort_keys=False)
         if path is not None:
             Path(path).write_text(text)
         return text
 
 
-def _check_observer_block(block: Any, where: str) -> dict[str, Any]:
-    """Validates an observer block (keywords of lugrip.Observer) by building the settings;
-    returns it with plain Python values. Errors name ``where`` and the key, never the value."""
-    from ._observer import _COR_FIELDS, _OBS_KINDS, GAIN_MODES, INTEGRATORS, Observer
+def _plain_observer_block(block: Any, where: str) -> dict[str, Any]:
+    """An observer block (keywords of lugrip.Observer) with plain Python values: its keys, the
+    kind of each value and the enumerations checked (the ranges are checked by
+    :func:`lugrip._observer._check_observer_block`, which builds the observer). Errors name
+    ``where`` and the key, never the value."""
 
     if not isinstance(block, dict):
         raise ValueError(f"{where}: expected a mapping of observer settings, not {describe_kind(block)}")
@@ -238,36 +240,7 @@ def _check_observer_block(block: Any, where: str) -> dict[str, Any]:
             plain[k] = int(x)
         else:
             plain[k] = to_number(v, field)
-    try:
-        Observer(ContactParams.table1(), **plain)
-    except (TypeError, ValueError, OverflowError) as err:
-        lines = [ln.strip() for ln in str(err).splitlines() if ln.strip()]
-        if lines and lines[0].startswith("invalid observer settings"):
-            lines = lines[1:]
-        raise ValueError("; ".join(f"{where}.{ln}" for ln in lines) or where) from None
     return plain
-
-
-def read_observer_settings(path: str | Path) -> dict[str, Any] | None:
-    """The ``observer:`` block of a parameter YAML (written by ``lugrip identify`` /
-    :meth:`lugrip.identification.IdentificationResult.save_yaml`): the settings of the observer the
-    parameters were identified with, as keywords of :class:`lugrip.Observer`, so that the
-    observer used online is the one inside the identification cost (docs/model.md 8.1). None when
-    the file has no such block (e.g. ``objects/*.yaml``, ``lugrip params`` output).
-    ``lugrip.Observer(path)`` starts from this block (its keywords override it), as do
-    ``lugrip observe --params``, ``lugrip identify --params0`` and ``lugrip.identify`` with a
-    YAML ``params0``.
-
-    Raises:
-        ValueError: the file cannot be read within the limits of :func:`lugrip._yaml.load_yaml`,
-            or the block is not a mapping or holds an unknown or invalid setting (message
-            ``<file>: observer.<key>: ...``).
-    """
-    path = Path(path)
-    data = load_yaml(path)
-    if not isinstance(data, dict) or data.get("observer") is None:
-        return None
-    return _check_observer_block(data["observer"], f"{path}: observer")
 
 
 PRESETS = ("table1", "big_resin_block", "small_resin_block", "plastic_bottle", "aluminium_can")

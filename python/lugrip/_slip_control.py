@@ -24,7 +24,8 @@ from ._controller import (
 )
 from ._nocopy import NoCopy
 from ._observer import Observer
-from ._params import ContactParams, read_observer_settings
+from ._observer import read_observer_settings
+from ._params import ContactParams
 
 __all__ = ["SlipControl", "SlipControlRun"]
 

@@ -236,7 +236,8 @@ def test_demo_chooses_the_gl_back_end_before_its_steps(tmp_path, monkeypatch):
     calls = []
     monkeypatch.setattr(report, "choose_gl_backend", lambda: calls.append("gl") or "osmesa")
     fake = [demo.DemoStep("ls", "LS", lambda out_dir: calls.append("ls") or "ok"),
-            demo.DemoStep("mujoco", "MuJoCo", lambda out_dir: calls.append("mujoco") or "ok")]
+            demo.DemoStep("mujoco", "MuJoCo", lambda out_dir: calls.append("mujoco") or "ok",
+                          renders=True)]
     monkeypatch.setattr(demo, "STEPS", fake)
     assert main(["demo", "--out", str(tmp_path / "a")]) == 0
     assert calls == ["gl", "ls", "mujoco"]

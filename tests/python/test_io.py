@@ -532,7 +532,7 @@ def test_never_overwrites_without_permission(tmp_path, suffix):
 
 def test_write_is_atomic(tmp_path, monkeypatch):
     """A failure while writing leaves neither a partial file nor a temporary file."""
-    import lugrip.io as lio
+    import lugrip.io._files as lio  # write_log's module
 
     def half_then_fail(log, fh):
         fh.write(b"t,f_n,f_t,tau\n0,1,")

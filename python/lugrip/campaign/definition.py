@@ -441,11 +441,11 @@ class Campaign:
         seed = data["seed"]
         if isinstance(seed, bool) or not isinstance(seed, int) or seed < 0:
             raise CampaignError(f"seed: {seed!r} must be an integer >= 0")
-        from ..sim.scenarios import PLANT_MODELS
+        from ..sim.plant import plant_names, registered
 
         plant = str(data.get("plant", "patch"))
-        if plant not in PLANT_MODELS:
-            raise CampaignError(f"plant: {plant!r}: expected one of {', '.join(PLANT_MODELS)}")
+        if plant not in plant_names():
+            raise CampaignError(f"plant: {plant!r}: expected one of {', '.join(plant_names())}")
         ctrl = data["controllers"]
         if isinstance(ctrl, (list, tuple)):
             ctrl = {str(c): {} for c in ctrl}
@@ -473,8 +473,8 @@ class Campaign:
             raise CampaignError("parameters: expected a mapping name -> distribution")
         parameters = {str(k): Distribution.from_dict(str(k), v) for k, v in params.items()}
         pads = sorted(k for k in parameters if k.startswith("pad_"))
-        if pads and plant != "mujoco":
-            raise CampaignError(f"parameters.{pads[0]}: only for plant mujoco (MuJoCo's pads)")
+        if pads and not registered(plant):
+            raise CampaignError(f"parameters.{pads[0]}: only for an engine's pads (plant mujoco)")
         crit = dict(_DEFAULT_CRITERIA)
         if "crush_factor" in parameters:
             crit["no_crush"] = True
@@ -496,7 +496,7 @@ class Campaign:
             raise CampaignError(
                 "criteria.no_crush: needs a crush force per run (draw parameters.crush_factor)"
             )
-        if plant == "mujoco":
+        if registered(plant):  # an engine reports its scene status
             crit.setdefault("scene_ok", True)
         eval_seed = data.get("evaluation_seed")
         if eval_seed is not None and (
@@ -830,7 +830,7 @@ class Campaign:
         from ..sim.scenarios import Scenario
 
         tmp = Scenario.from_dict(d | {"estimator": {}}, base.source)
-        plant_contact = tmp.plant_config(self.plant if self.plant != "mujoco" else None).contact
+        plant_contact = tmp.plant_config(self.plant).contact
         est = estimator_params(plant_contact, base.estimator_for(self.plant)) or plant_contact
         if drawn_mu:
             est = est.replace(mu=plant_contact.mu)
@@ -912,3 +912,20 @@ def load_campaign(path: str | Path) -> Campaign:
     except ValueError as err:  # YamlLimitError: names the file and the line
         raise CampaignError(str(err)) from None
     return Campaign.from_dict(data, source=p)
+
+
+def _controller_call(name: str, opts: dict, scenario) -> tuple[str, dict, dict, dict]:
+    """(kind, controller settings, observer settings, options of simulate) of a controller."""
+    from .._controller import PAPER_SETTINGS
+
+    ctrl = dict(scenario.controller)
+    obs = dict(scenario.observer)
+    if name in ("lugrip", "paper"):
+        if name == "paper":
+            ctrl.update(PAPER_SETTINGS)
+        ctrl.update(opts.get("controller") or {})
+        obs.update(opts.get("observer") or {})
+        return "lugrip", ctrl, obs, {}
+    if name == "constant_force":
+        return "constant_force", ctrl, obs, {"constant_force": float(opts["force"])}
+    return "friction_cone", ctrl, obs, dict(opts)

@@ -28,8 +28,8 @@ from typing import Any
 
 import numpy as np
 
-from .._controller import PAPER_SETTINGS, controller_settings
-from .definition import FRONTIER_DEFAULTS, Campaign, CampaignError
+from .._controller import controller_settings
+from .definition import FRONTIER_DEFAULTS, Campaign, CampaignError, _controller_call
 
 __all__ = ["BACKENDS", "ResultStore", "run_campaign", "run_one"]
 
@@ -54,21 +54,6 @@ METRICS = (
     "scene_status",
     "peak_command",
 )
-
-
-def _controller_call(name: str, opts: dict, scenario) -> tuple[str, dict, dict, dict]:
-    """(kind, controller settings, observer settings, options of simulate) of a controller."""
-    ctrl = dict(scenario.controller)
-    obs = dict(scenario.observer)
-    if name in ("lugrip", "paper"):
-        if name == "paper":
-            ctrl.update(PAPER_SETTINGS)
-        ctrl.update(opts.get("controller") or {})
-        obs.update(opts.get("observer") or {})
-        return "lugrip", ctrl, obs, {}
-    if name == "constant_force":
-        return "constant_force", ctrl, obs, {"constant_force": float(opts["force"])}
-    return "friction_cone", ctrl, obs, dict(opts)
 
 
 def _criteria(campaign: Campaign, m: dict) -> dict[str, bool]:
@@ -490,40 +475,32 @@ def campaign_from_doc(doc: dict) -> Campaign:
 
 
 class Progress:
-    """One status line on stderr: runs done, rate, success rate per controller."""
+    """The campaign's progress bar on stderr (tqdm): runs done, rate, ETA and the success rate
+    per controller so far. Redraws in place on a terminal; elsewhere (a log file, CI) tqdm
+    writes a line at most every 30 s."""
 
     def __init__(self, total: int, controllers: Sequence[str], stream=None, enabled=True):
-        self.total, self.done = total, 0
+        from tqdm import tqdm
+
         self.ok = dict.fromkeys(controllers, 0)
         self.n = dict.fromkeys(controllers, 0)
-        self.stream = stream or sys.stderr
-        self.enabled = enabled
-        self.tty = bool(getattr(self.stream, "isatty", lambda: False)())
-        self.t0 = time.perf_counter()
-        self._last = -1.0
+        stream = stream or sys.stderr
+        tty = bool(getattr(stream, "isatty", lambda: False)())
+        self.bar = tqdm(total=total, unit="run", desc="campaign", file=stream,
+                        disable=not enabled, mininterval=0.5 if tty else 30.0,
+                        dynamic_ncols=tty, leave=True)
 
     def update(self, rows: Sequence[dict]) -> None:
-        self.done += 1
         for r in rows:
             self.n[r["controller"]] += 1
             self.ok[r["controller"]] += bool(r["success"])
-        if not self.enabled:
-            return
-        frac = self.done / max(self.total, 1)
-        if not self.tty and self.done < self.total and frac - self._last < 0.1:
-            return
-        self._last = frac
-        dt = time.perf_counter() - self.t0
-        rates = " ".join(
-            f"{c} {100.0 * self.ok[c] / self.n[c]:.0f}%" for c in self.ok if self.n[c]
+        self.bar.set_postfix_str(
+            " ".join(f"{c} {100.0 * self.ok[c] / self.n[c]:.0f}%" for c in self.ok if self.n[c]),
+            refresh=False,
         )
-        width = 20
-        bar = "#" * int(width * frac) + "-" * (width - int(width * frac))
-        line = f"[{bar}] {self.done}/{self.total} {self.done / dt if dt > 0 else 0:.2f} runs/s  {rates}"
-        self.stream.write(("\r" + line) if self.tty else (line + "\n"))
-        if self.tty and self.done == self.total:
-            self.stream.write("\n")
-        self.stream.flush()
+        self.bar.update(1)
+        if self.bar.n >= self.bar.total:
+            self.bar.close()
 
 
 def run_campaign(

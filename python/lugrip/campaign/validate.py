@@ -75,16 +75,17 @@ def _check_load(cfg, field: str) -> None:
 
 def _build(campaign: Campaign, values: dict[str, float], controllers) -> None:
     """Build the grasp of ``values`` for each of ``controllers`` (raises what a run would)."""
+    from ..sim.plant import make_plant, registered
     from ..sim.scenarios import Scenario, simulate
-    from .runner import _controller_call
+    from .definition import _controller_call
 
     scn, _ = Campaign.run_scenario(_Drawn(campaign, values), 0)
     cfg = scn.plant_config(campaign.plant)
     _check_load(cfg, f"parameters.mass = {values['mass']:g}" if "mass" in values
                 else "the base scenario's plant.object.mass")
-    if campaign.plant == "mujoco":
-        scn.scene_spec()
-        scn.estimator_for("mujoco")
+    if registered(campaign.plant):  # an engine: its scene is built (and checked) by reset
+        make_plant(campaign.plant).reset(scn, config=cfg)
+        scn.estimator_for(campaign.plant)
         return
     for name in controllers:
         kind, ctrl, obs, opts = _controller_call(name, campaign.controllers[name], scn)

@@ -6,7 +6,6 @@ from __future__ import annotations
 import argparse
 import math
 import sys
-import time
 from pathlib import Path
 
 from . import CliError, observer_options, positive_float
@@ -219,44 +218,28 @@ def register(subparsers) -> None:
 
 
 class ProgressBar:
-    """Plain-text progress: a bar over the iteration budget, the cost and its reduction.
-    Redraws in place on a terminal, one line per ``every`` iterations otherwise."""
+    """The identification's progress (tqdm) over the iteration budget, with the fit's RMSE and
+    the cost relative to the first; called as bar(iteration, cost, params)."""
 
-    def __init__(self, total: int, stream=None, width: int = 28, every: int = 10):
-        self.total = max(int(total), 1)
-        self.stream = sys.stderr if stream is None else stream
-        self.width = width
-        self.every = every
-        self.t0 = time.perf_counter()
+    def __init__(self, total: int, stream=None):
+        from tqdm import tqdm
+
+        stream = sys.stderr if stream is None else stream
+        tty = bool(getattr(stream, "isatty", lambda: False)())
         self.first: float | None = None
-        self.tty = bool(getattr(self.stream, "isatty", lambda: False)())
-        self.drawn = False
-
-    def line(self, it: int, cost: float) -> str:
-        if self.first is None:
-            self.first = cost
-        frac = min(it / self.total, 1.0)
-        fill = round(frac * self.width)
-        rel = cost / self.first if self.first else float("nan")
-        return (
-            f"identify [{'#' * fill}{'.' * (self.width - fill)}] it {it:3d}  "
-            f"RMSE {math.sqrt(max(cost, 0.0)):.4g} rad/s  cost x{rel:.3g} of the first  "
-            f"{time.perf_counter() - self.t0:5.1f} s"
-        )
+        self.bar = tqdm(total=max(int(total), 1), desc="identify", unit="it", file=stream,
+                        mininterval=0.2 if tty else 10.0, dynamic_ncols=tty)
 
     def __call__(self, it: int, cost: float, params=None) -> None:
-        text = self.line(it, cost)
-        if self.tty:
-            self.stream.write("\r" + text)
-            self.drawn = True
-        elif it == 1 or it % self.every == 0:
-            self.stream.write(text + "\n")
-        self.stream.flush()
+        if self.first is None:
+            self.first = cost
+        rel = cost / self.first if self.first else float("nan")
+        self.bar.set_postfix_str(f"RMSE {math.sqrt(max(cost, 0.0)):.4g} rad/s, cost x{rel:.3g} "
+                                 "of the first", refresh=False)
+        self.bar.update(max(0, min(int(it), self.bar.total) - self.bar.n))
 
     def close(self) -> None:
-        if self.drawn:
-            self.stream.write("\n")
-            self.stream.flush()
+        self.bar.close()
 
 
 #: The files write_report writes in its folder (identify --report refuses them without --force).
@@ -441,7 +424,8 @@ def run(args) -> int:
     if args.rubbing:
         if args.params0 is None:
             raise CliError("--rubbing needs --params0 (the fingertip's delta and gamma)")
-        from .._params import ContactParams, read_observer_settings
+        from .._observer import read_observer_settings
+        from .._params import ContactParams
 
         try:
             base = ContactParams.from_yaml(args.params0)
@@ -475,7 +459,7 @@ def run(args) -> int:
 
     block = None
     if args.params0 is not None and args.params0.suffix in (".yaml", ".yml"):
-        from .._params import read_observer_settings
+        from .._observer import read_observer_settings
 
         if not args.params0.exists():
             raise CliError(f"argument --params0: {args.params0}: no such file")

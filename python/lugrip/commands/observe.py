@@ -372,7 +372,7 @@ def write_estimates(path: Path, log, run, *, force: bool = False) -> Path:
 def observer_block(args) -> dict | None:
     """The ``observer:`` block of the --params file (settings the parameters were identified
     with), or None (no --params, or a file without the block such as objects/*.yaml)."""
-    from .._params import read_observer_settings
+    from .._observer import read_observer_settings
 
     if getattr(args, "params", None) is None:
         return None
@@ -401,7 +401,7 @@ def _observer(params, args, dt: float, block: dict | None = None):
 def run(args) -> int:
     import numpy as np
 
-    from ..sliding import score
+    from ..sim.sliding import score
 
     out = Path(args.out)
     if out.suffix.lower() not in (".csv", ".parquet", ".pq"):
@@ -492,7 +492,7 @@ def demo_section(out_dir: Path) -> str:
     the default settings, Figure 5 and the scores (Markdown)."""
     from .. import ContactParams, Observer
     from ..plot.observer import write_figure5
-    from ..sliding import score, simulate_maneuvers
+    from ..sim.sliding import score, simulate_maneuvers
 
     params = ContactParams.table1()
     data = simulate_maneuvers(params, 40, seed=5)

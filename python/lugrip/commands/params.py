@@ -143,7 +143,7 @@ def run(args: argparse.Namespace) -> int:
         raise CliError(f"argument --check: {path}: no such file")
     if path.is_dir():
         raise CliError(f"argument --check: {path} is a directory")
-    from .._params import read_observer_settings
+    from .._observer import read_observer_settings
 
     params = ContactParams.from_yaml(path)  # ValueError names the file and the field
     # the observer block is checked as `lugrip observe --params` builds it

@@ -12,6 +12,7 @@ import math
 import sys
 from pathlib import Path
 
+from ..sim.plant import plant_names, plant_renders, registered
 from . import CliError
 
 __all__ = ["register", "run"]
@@ -81,9 +82,10 @@ def register(subparsers) -> None:
     )
     p.add_argument(
         "--plant",
-        choices=("patch", "lumped", "mujoco"),
+        choices=plant_names(),
         default=None,
-        help="plant model (default: the scenario's, patch)",
+        help="plant model: lugrip's own (patch, lumped) or a registered engine "
+             "(lugrip.sim.plant; default: the scenario's, patch)",
     )
     p.add_argument(
         "--video",
@@ -135,7 +137,8 @@ def run(args: argparse.Namespace) -> int:
                               figures=not args.no_plots)
     from ..sim import report
 
-    if args.plant == "mujoco" and (args.video or not args.no_frames):
+    engine = registered(args.plant or "patch")
+    if engine and plant_renders(args.plant) and (args.video or not args.no_frames):
         report.choose_gl_backend()  # before anything imports MuJoCo
     from ..sim.scenarios import find_scenario, list_scenarios, load_scenario, scenario_dir
 
@@ -163,20 +166,24 @@ def run(args: argparse.Namespace) -> int:
         raise CliError("no scenario given (names, YAML files, 'all' or 'unseen'; see --list)")
     try:
         paths = [str(find_scenario(n)) for n in names]
-        if args.plant == "mujoco":
+        if engine:  # the engine's scene of each file, checked before anything runs
+            from ..sim.plant import make_plant
+
             for p in paths:
-                load_scenario(p).scene_spec()
+                s = load_scenario(p).for_plant(args.plant)
+                make_plant(args.plant).reset(s, config=s.plant_config(args.plant))
     except ValueError as err:
         raise CliError(str(err)) from None
-    if args.plant != "mujoco" and (args.video or args.compare or args.seeds != 1 or args.no_frames):
-        raise CliError("--video, --seeds, --compare and --no-frames need --plant mujoco")
+    if not engine and (args.video or args.compare or args.seeds != 1 or args.no_frames):
+        raise CliError("--video, --seeds, --compare and --no-frames need an engine plant "
+                       "(--plant mujoco)")
     if args.seeds < 1:
         raise CliError(f"--seeds {args.seeds}: must be >= 1")
     if args.video is not None and args.video.suffix.lower() != ".mp4":
         raise CliError(f"--video {args.video}: expected a .mp4 file")
     check_outputs(args, paths)
-    if args.plant == "mujoco":
-        return _run_mujoco(args, paths)
+    if engine:
+        return _run_engine(args, paths)
 
     results = report.run_all(
         paths,
@@ -243,7 +250,7 @@ def check_outputs(args: argparse.Namespace, scenario_paths: list[str]) -> None:
     scenario runs; the scenario files are inputs."""
     from ._output import check_dir, check_file
 
-    if args.no_plots and args.plant != "mujoco":  # only the metrics file is written
+    if args.no_plots and not registered(args.plant or "patch"):  # only the metrics file is written
         if args.json is None:
             check_dir(args.out, "--out", force=args.force, results=("metrics.json",),
                       inputs=scenario_paths)
@@ -259,7 +266,7 @@ def check_outputs(args: argparse.Namespace, scenario_paths: list[str]) -> None:
                    create_parent=True)
 
 
-def _run_mujoco(args: argparse.Namespace, paths: list[str]) -> int:
+def _run_engine(args: argparse.Namespace, paths: list[str]) -> int:
     from ..sim import report
     from ..sim.mujoco.render import RenderUnavailable, video_writer_available
 
@@ -282,6 +289,7 @@ def _run_mujoco(args: argparse.Namespace, paths: list[str]) -> int:
             video=video,
             baselines=not args.no_baselines,
             log=lambda s: print(s, file=sys.stderr, flush=True),
+            engine=args.plant,
         )
     except RenderUnavailable as err:  # raised only for the video writer; frames degrade
         raise CliError(str(err)) from None
@@ -292,7 +300,7 @@ def _run_mujoco(args: argparse.Namespace, paths: list[str]) -> int:
         m = r.metrics["lugrip"]
         seeds = data["seeds"][name]
         print(
-            f"{name:32s} mujoco {'pass' if r.passed else 'FAIL'}  scene {m.get('scene_status')}"
+            f"{name:32s} {args.plant} {'pass' if r.passed else 'FAIL'}  scene {m.get('scene_status')}"
             f"  mean force {m.get('mean_force', float('nan')):6.3f} N"
             f"  hold slip {m['hold_slip_mm']:.3f} mm  hold rot {m['hold_rotation_deg']:.3f} deg"
             f"  dropped {'yes' if m['dropped'] else 'no'}  seeds {sum(x['pass'] for x in seeds)}/{len(seeds)}",

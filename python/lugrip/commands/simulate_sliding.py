@@ -168,7 +168,7 @@ def register(subparsers) -> None:
 
 def run(args) -> int:
     from .. import write_log
-    from ..sliding import REGIMES, simulate_maneuvers
+    from ..sim.sliding import REGIMES, simulate_maneuvers
 
     out = Path(args.out)
     if out.suffix.lower() not in (".csv", ".parquet", ".pq", ".mcap"):

@@ -21,7 +21,7 @@ given). The parameters are identified FOR that observer: the result records its 
 ``lugrip observe --params`` runs with them.
 """
 
-from .._params import read_observer_settings
+from .._observer import read_observer_settings
 from ._common import (
     DEFAULT_BOUNDS,
     PARAMETERS,

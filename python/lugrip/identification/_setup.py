@@ -103,7 +103,8 @@ def read_params0(params0, observer):
     from pathlib import Path
 
     from .._contact import _as_params
-    from .._params import ContactParams, read_observer_settings
+    from .._observer import read_observer_settings
+    from .._params import ContactParams
 
     if (
         params0 is not None

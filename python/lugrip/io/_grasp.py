@@ -86,7 +86,7 @@ def read_grasp_log(path: str | os.PathLike, *, finger_topics: Sequence[str] | No
     Raises:
         LogError: as read_log, naming the finger's columns or topic.
     """
-    from . import _detect_format, _read
+    from ._files import _detect_format, _read
 
     p = Path(path)
     file = str(p)
@@ -150,7 +150,8 @@ def read_grasp_log(path: str | os.PathLike, *, finger_topics: Sequence[str] | No
 def write_grasp_log(glog: GraspLog, path: str | os.PathLike, *, overwrite: bool = False) -> Path:
     """Write a two-finger log as a CSV or Parquet table (columns of :func:`read_grasp_log`:
     t, f_n_k, f_x_k, f_y_k, tau_k per finger, command when present, maneuver)."""
-    from . import _atomic_write, need
+    from ._extras import need
+    from ._files import _atomic_write
 
     path = Path(path)
     suffix = path.suffix.lower()

@@ -4,22 +4,75 @@ optional MP4.
 MuJoCo picks its OpenGL back end from ``MUJOCO_GL`` when it is first imported; without a display
 :func:`choose_gl_backend` sets EGL (Mesa's software EGL: Debian packages ``libegl1``,
 ``libegl-mesa0``, ``libgl1-mesa-dri``) or OSMesa (``libosmesa6``): the first that opens a context. It
-must run before ``mujoco`` is imported, so it lives in :mod:`lugrip.sim.report`, which does not
-import MuJoCo. MP4 files are written through ``imageio-ffmpeg`` (a pip
+must run before ``mujoco`` is imported: this module imports MuJoCo only inside the functions
+that render. MP4 files are written through ``imageio-ffmpeg`` (a pip
 wheel that carries its own ffmpeg; ``pip install "lugrip[video]"``).
 """
 
 from __future__ import annotations
 
+import ctypes.util
 import os
+import sys
 from collections.abc import Sequence
 from pathlib import Path
 
 import numpy as np
 
-from ..report import GL_PACKAGES, choose_gl_backend
 
-__all__ = ["FrameRecorder", "RenderUnavailable", "choose_gl_backend", "video_writer_available"]
+__all__ = [
+    "GL_PACKAGES",
+    "FrameRecorder",
+    "RenderUnavailable",
+    "choose_gl_backend",
+    "video_writer_available",
+]
+
+#: Debian packages of each offscreen OpenGL back end (documented in validation/mujoco/README.md).
+GL_PACKAGES = {
+    "egl": "libegl1 libegl-mesa0 libgl1-mesa-dri",
+    "osmesa": "libosmesa6",
+}
+
+
+def choose_gl_backend() -> str | None:
+    """Set ``MUJOCO_GL`` for offscreen rendering when it is unset and there is no display:
+    "egl" when libEGL is installed and opens a context, else "osmesa" when libOSMesa does. MuJoCo reads the variable
+    when it is first imported, so this must run before. Returns the back end in force (None:
+    none found, or MuJoCo was imported already; rendering then reports why it failed)."""
+    current = os.environ.get("MUJOCO_GL")
+    if current:
+        return current.lower()
+    if os.environ.get("DISPLAY"):
+        return "glfw"
+    if "mujoco" in sys.modules:
+        return None
+    for backend, lib in (("egl", "EGL"), ("osmesa", "OSMesa")):
+        if ctypes.util.find_library(lib) and _gl_context_works(backend):
+            os.environ["MUJOCO_GL"] = backend
+            return backend
+    return None
+
+
+def _gl_context_works(backend: str) -> bool:
+    """Whether MuJoCo can open an offscreen context with `backend` here, tried in a child
+    process (MuJoCo fixes its back end at import; libEGL may be installed without a usable
+    device, as on a container without a GPU, where OSMesa still renders)."""
+    import subprocess
+
+    probe = "import mujoco; c = mujoco.GLContext(8, 8); c.make_current(); c.free()"
+    try:
+        p = subprocess.run(
+            [sys.executable, "-c", probe],
+            env={**os.environ, "MUJOCO_GL": backend},
+            capture_output=True,
+            timeout=60,
+            check=False,
+        )
+    except (OSError, subprocess.SubprocessError):
+        return False
+    return p.returncode == 0
+
 
 
 class RenderUnavailable(RuntimeError):

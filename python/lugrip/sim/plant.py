@@ -1,0 +1,287 @@
+"""The Plant interface: what a grasp simulator gives lugrip's closed loop, and the registry of
+plant kinds.
+
+A plant simulates the gripper, its two fingertip force/torque sensors, the grasped object and the
+robot's moves and disturbances. It knows nothing of lugrip's observers, controller, baselines,
+faults or judging: the closed-loop runner (:mod:`lugrip.sim.runner`) owns those for every
+plant. A plant kind is one module with a class that satisfies :class:`Plant` and one call of
+:func:`register_plant` (a line in the built-in registrations at the end of this module, which
+import the plant's module only when it is used). Every ``--plant`` choice, scenario check and
+campaign asks this registry; nothing else names a plant kind.
+
+The reference implementation is :class:`lugrip.sim.mujoco.plant.MujocoPlant`; the runner is
+:func:`lugrip.sim.runner.run_plant_loop`.
+
+The cycle
+---------
+::
+
+    plant = make_plant("mujoco")                 # a registered kind, its options as keywords
+    clock = plant.reset(scene, seed, config=cfg)  # -> PlantClock (sample period, command ratio)
+    out = plant.step(np.full(1, f_init))          # sample 0
+    out = plant.step(np.full(clock.command_ratio, f_cmd))  # the next command period, ...
+
+``reset(scene, seed=None, *, config=None)``
+    ``scene`` is the parsed scenario, a :class:`lugrip.sim.scenarios.Scenario` (already
+    ``scene.for_plant(name)``): the plant reads its own block from it, ``scene.block(name)``
+    (a dict: the scenario file's top-level key of the plant's name, e.g. ``mujoco:`` -- which
+    ``scene.scene_spec()`` parses for MuJoCo -- or ``drake:``; any registered name is accepted
+    as a key), and may read ``scene.duration`` and ``scene.name``. ``config`` is the
+    :class:`lugrip.sim.PlantConfig` of the run (object mass/inertia/CoG [kg, kg m^2, m];
+    contact parameters; actuator lag, rate limit, range and ``f_init``; sensor rate, noise and
+    bias; gripper moves; disturbances; drop limits; seed). When None it is
+    ``scene.plant_config(name, seed)``; a caller passes its own when it changed it (a campaign's
+    drawn object). ``seed`` (None: ``config.seed``) seeds the sensor noise. Returns the
+    :class:`PlantClock`. Reset may be called again to start a new run on the same object.
+
+``step(commands)``
+    ``commands``: a 1-D float array, one entry per sensor sample to simulate: the grip-force
+    command [N] at the actuator's input during that sample (the plant applies its actuator lag,
+    rate limit and range to it). The runner calls it with one sample after reset (sample 0),
+    then with ``command_ratio`` samples at a time (the command period, the last sample being
+    the next command tick); any length >= 1 must work. Returns the :class:`PlantSamples` of
+    those samples.
+
+``scene_status()``
+    A dict {status, detail, time, contact_time}: ``status`` is "ok" or a short code naming a
+    scene fault (the object not between the fingers, a finger closing on nothing, a contact
+    lost after the grasp; :data:`SCENE_STATUS`), ``time`` [s] when it was found, ``contact_time``
+    [s] when both fingers first touched the object (None: not yet). Scene faults never raise.
+
+Frames and signs (all arrays float64 unless said, n = samples of the call, finger 0 and 1)
+------------------------------------------------------------------------------------------
+* fingertip sensor frame: origin on the fingertip axis at its face, z along the fingertip axis
+  from the face into the finger (the direction of the normal force the object exerts on the
+  fingertip), x and y in the fingertip plane, right-handed (docs/sliding_log.md).
+* ``wrench`` (n, 2, 4): what each sensor reads, (f_n, f_x, f_y, tau) = the wrench the object
+  exerts on the fingertip in its sensor frame [N, N, N, N m], tau about the sensor z axis,
+  averaged over the sample period, with the sensor's bias and noise (``config.sensor``).
+  ``wrench_true`` (n, 2, 4): the same without bias and noise.
+* the hand frame: the plane the object moves in (the finger plane), X horizontal and Y up when
+  the hand is not rolled; Z is the grasp axis, from finger 0 to finger 1. The world plane:
+  horizontal, vertical. Angles are positive about Z (right-hand rule).
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import importlib
+from collections.abc import Callable, Mapping
+from typing import Any, Protocol, runtime_checkable
+
+import numpy as np
+
+__all__ = [
+    "SCENE_STATUS",
+    "Plant",
+    "PlantClock",
+    "PlantSamples",
+    "make_plant",
+    "plant_description",
+    "plant_names",
+    "plant_renders",
+    "register_plant",
+    "registered",
+]
+
+#: Scene status codes a plant reports (``scene_status()["status"]``), with their meaning.
+SCENE_STATUS: dict[str, str] = {
+    "ok": "both fingers touched the object and kept contact from the lift start on",
+    "object_not_reached": "a finger never touched the object: it is not between the fingers",
+    "closed_on_nothing": "a finger reached its closing stop without touching anything",
+    "lost_contact": "a finger lost contact with the object after the grasp was established",
+}
+
+
+@dataclasses.dataclass(frozen=True)
+class PlantClock:
+    """The timing a plant runs at, returned by ``reset``."""
+
+    sample_period: float  #: sensor sample period [s] (the observers' and controller's dt)
+    command_ratio: int  #: sensor samples per grip-force command (the command period)
+
+
+@dataclasses.dataclass
+class PlantSamples:
+    """The fingertip samples and the ground truth of ``step``'s n sensor samples.
+
+    Measured (what lugrip's observers and controller may use):
+
+    * ``t`` (n,): sample times from the start of the run [s] (sample i at i * sample_period).
+    * ``wrench`` (n, 2, 4): each fingertip sensor's reading (f_n, f_x, f_y, tau) [N, N, N, N m],
+      the object's wrench on the fingertip in the sensor frame (module docstring), averaged
+      over the sample, with bias and noise.
+
+    Ground truth (for logs, metrics and judging only):
+
+    * ``wrench_true`` (n, 2, 4): ``wrench`` without bias and noise.
+    * ``grip_force`` (n,): the force the gripper's actuator actually applies at the end of the
+      sample (after its lag, rate limit and range) [N].
+    * ``contact`` (n, 2) bool: fingertip i touches the object (at the end of the sample).
+    * ``slip`` (n, 2): displacement of the object's grasp point relative to the fingertips
+      since reset, in the hand frame (X, Y) [m].
+    * ``rotation`` (n,): rotation of the object relative to the fingertips since reset [rad]
+      (positive about the grasp axis from finger 0 to finger 1).
+    * ``theta`` (n,): the object's angle in the world plane [rad] (0 at rest).
+    * ``cog`` (n, 2): the object's centre of gravity relative to the fingertips' midpoint (the
+      grasp point at rest), world plane axes (horizontal, vertical) [m]; with ``theta``, the
+      object's pose relative to the hand.
+    * ``omega`` (n, 2): the object's spin relative to fingertip i about the sensor z axis
+      [rad/s] (0 without contact).
+    * ``v_slip`` (n, 2): the object's in-plane slip speed relative to fingertip i at the sensor
+      origin [m/s] (0 without contact).
+    * ``external`` (n, 3): the disturbance applied to the object: world force (horizontal,
+      vertical) [N] and torque about its CoG [N m].
+    * ``gripper_y`` (n,): the grasp point's height [m] (the hand's lift).
+    * ``extra``: plant-specific columns, each (n,), logged with the run under their own names
+      (MuJoCo: ``pad_deflection_0``, ``pad_twist_1``, ``roll``, ...).
+    """
+
+    t: np.ndarray
+    wrench: np.ndarray
+    wrench_true: np.ndarray
+    grip_force: np.ndarray
+    contact: np.ndarray
+    slip: np.ndarray
+    rotation: np.ndarray
+    theta: np.ndarray
+    cog: np.ndarray
+    omega: np.ndarray
+    v_slip: np.ndarray
+    external: np.ndarray
+    gripper_y: np.ndarray
+    extra: dict[str, np.ndarray] = dataclasses.field(default_factory=dict)
+
+    def __len__(self) -> int:
+        return int(self.t.shape[0])
+
+    def check(self) -> PlantSamples:
+        """Raise ValueError when an array's shape does not match n samples (a plant's bug)."""
+        n = len(self)
+        shapes = {
+            "wrench": (n, 2, 4), "wrench_true": (n, 2, 4), "grip_force": (n,), "contact": (n, 2),
+            "slip": (n, 2), "rotation": (n,), "theta": (n,), "cog": (n, 2), "omega": (n, 2),
+            "v_slip": (n, 2), "external": (n, 3), "gripper_y": (n,),
+        }
+        for name, shape in shapes.items():
+            got = np.shape(getattr(self, name))
+            if got != shape:
+                raise ValueError(f"PlantSamples.{name}: shape {got}, expected {shape}")
+        for name, col in self.extra.items():
+            if np.shape(col) != (n,):
+                raise ValueError(f"PlantSamples.extra[{name!r}]: shape {np.shape(col)}, expected ({n},)")
+        return self
+
+
+@runtime_checkable
+class Plant(Protocol):
+    """A grasp simulator lugrip's closed loop runs on (see the module docstring)."""
+
+    #: the registered name of the plant kind ("mujoco", ...)
+    name: str
+
+    def reset(self, scene: Any, seed: int | None = None, *, config: Any = None) -> PlantClock:
+        """Start a run of ``scene`` (a :class:`lugrip.sim.scenarios.Scenario`) with the run's
+        :class:`lugrip.sim.PlantConfig` ``config`` (None: ``scene.plant_config(name, seed)``)."""
+        ...
+
+    def step(self, commands: np.ndarray) -> PlantSamples:
+        """Simulate ``len(commands)`` sensor samples, ``commands[j]`` the grip-force command
+        [N] at the actuator input during sample j."""
+        ...
+
+    def scene_status(self) -> dict[str, Any]:
+        """{status, detail, time, contact_time} (module docstring)."""
+        ...
+
+
+# --- the registry ----------------------------------------------------------------------------
+
+#: name -> (factory or "module:attribute", one line of description)
+_REGISTRY: dict[str, tuple[Callable[..., Plant] | str, str]] = {}
+#: registered plants whose factory takes ``frame_callback`` (MuJoCo's offscreen frames)
+_RENDERS: set[str] = set()
+
+
+def register_plant(name: str, factory: Callable[..., Plant] | str, description: str = "", *,
+                   frames: bool = False) -> None:
+    """Make plant kind ``name`` available to :func:`make_plant` and ``--plant``.
+
+    ``factory`` is a callable returning a :class:`Plant` (called with :func:`make_plant`'s
+    keyword options), or a ``"module:attribute"`` string naming one, imported on first use (so
+    an engine's package is imported only when its plant is used). Registering a name again
+    replaces it. ``frames``: the factory takes ``frame_callback=f(model, data, t)`` called
+    after every sensor sample with MuJoCo's model and data (``lugrip simulate --video`` and the
+    report's frames)."""
+    key = str(name).strip().lower()
+    if not key or not key.replace("_", "").replace("-", "").isalnum():
+        raise ValueError(f"plant name {name!r}: expected letters, digits, '-' or '_'")
+    if key in _C_PLANTS:
+        raise ValueError(f"plant name {key!r} is one of lugrip's own C++ plants")
+    if not (callable(factory) or (isinstance(factory, str) and ":" in factory)):
+        raise TypeError("factory: expected a callable or a 'module:attribute' string")
+    _REGISTRY[key] = (factory, str(description))
+    _RENDERS.discard(key)
+    if frames:
+        _RENDERS.add(key)
+
+
+def plant_renders(name: str) -> bool:
+    """Plant kind ``name`` renders MuJoCo frames (``register_plant(..., frames=True)``)."""
+    return str(name).strip().lower() in _RENDERS
+
+
+def plant_names() -> tuple[str, ...]:
+    """Every plant kind a scenario may run on: lugrip's own C++ plants ("patch", "lumped",
+    run by the C++ closed loop) and the registered ones."""
+    return (*_C_PLANTS, *_REGISTRY)
+
+
+def plant_description(name: str) -> str:
+    """The one-line description of plant kind ``name``."""
+    key = str(name).strip().lower()
+    if key in _C_PLANTS:
+        return _C_PLANTS[key]
+    if key not in _REGISTRY:
+        raise ValueError(f"unknown plant {name!r}; known: {', '.join(plant_names())}")
+    return _REGISTRY[key][1]
+
+
+def make_plant(name: str, **options: Any) -> Plant:
+    """A new plant of the registered kind ``name``, built with ``options`` (the kind's own
+    keywords, e.g. MuJoCo's ``frame_callback``)."""
+    key = str(name).strip().lower()
+    if key not in _REGISTRY:
+        raise ValueError(f"unknown plant {name!r}; registered: {', '.join(_REGISTRY) or 'none'}")
+    factory, _ = _REGISTRY[key]
+    if isinstance(factory, str):
+        module, _, attr = factory.partition(":")
+        try:
+            factory = getattr(importlib.import_module(module), attr)
+        except ModuleNotFoundError as err:
+            raise ImportError(f"the {key!r} plant needs the package {err.name!r}, which is not "
+                              "installed") from err
+    plant = factory(**options)
+    if not isinstance(plant, Plant):
+        raise TypeError(f"plant {key!r}: {factory!r} returned {type(plant).__name__}, which "
+                        "lacks reset/step/scene_status")
+    return plant
+
+
+def registered(name: str) -> bool:
+    """``name`` is a registered (Plant-interface) kind, not one of the C++ plants."""
+    return str(name).strip().lower() in _REGISTRY
+
+
+#: lugrip's own plants, run by the C++ closed loop (lugrip.sim.run_closed_loop)
+_C_PLANTS: Mapping[str, str] = {
+    "patch": "lugrip's distributed-contact (pressure patch) grasp plant, in C++",
+    "lumped": "lugrip's lumped LuGre/limit-surface slider plant, in C++ (no translational slip)",
+}
+
+register_plant(
+    "mujoco",
+    "lugrip.sim.mujoco.plant:MujocoPlant",
+    "MuJoCo gripper with compliant pads and condim-4 contacts (an independent engine)",
+    frames=True,
+)
