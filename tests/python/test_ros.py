@@ -289,12 +289,14 @@ def _identify_recording_like_csv(tmp_path, rec_log: str) -> None:
                    omega_topic="/lugrip_gripper_sim/omega_true_0")
     run = np.genfromtxt(tmp_path / "run.csv", delimiter=",", names=True)
     started = np.flatnonzero(run["status"] != 3)[0]  # the controller's start: first published
-    # Reliable QoS loses nothing once the recorder has matched the publisher; discovery may
-    # match it a few samples after the sim's first one (seen: 48 of 9990 on a loaded machine).
-    # The recording is then the run's last samples, none missing in between.
+    # Reliable QoS loses nothing once the recorder has matched the publisher. The recorder
+    # subscribes when it discovers the publisher (as ros2 bag record does), so it misses the
+    # samples the sim publishes before that (seen: 48 of 9990 with the Python MuJoCo loop,
+    # 1763 with the C++ stepper, whose sim runs faster). The recording is then the run's last
+    # samples, none missing in between, and holds the pivot's slide (the second half).
     total = len(run["t"]) - started
     k = len(rec)
-    assert total - 0.02 * total <= k <= total, (k, total)
+    assert total // 2 <= k <= total, (k, total)
     first = len(run["t"]) - k
     cols = {c: run[f"{c}_meas_0"][first:] for c in ("f_n", "f_t", "tau")}
     np.testing.assert_allclose(np.asarray(rec.f_n), cols["f_n"], rtol=1e-9, atol=1e-12)

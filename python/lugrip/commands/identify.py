@@ -222,15 +222,18 @@ class ProgressBar:
     the cost relative to the first; called as bar(iteration, cost, params)."""
 
     def __init__(self, total: int, stream=None):
-        from tqdm import tqdm
-
-        stream = sys.stderr if stream is None else stream
-        tty = bool(getattr(stream, "isatty", lambda: False)())
+        self.total = max(int(total), 1)
+        self.stream = sys.stderr if stream is None else stream
         self.first: float | None = None
-        self.bar = tqdm(total=max(int(total), 1), desc="identify", unit="it", file=stream,
-                        mininterval=0.2 if tty else 10.0, dynamic_ncols=tty)
+        self.bar = None  # drawn at the first iteration: a refusal before it prints no bar
 
     def __call__(self, it: int, cost: float, params=None) -> None:
+        if self.bar is None:
+            from tqdm import tqdm
+
+            tty = bool(getattr(self.stream, "isatty", lambda: False)())
+            self.bar = tqdm(total=self.total, desc="identify", unit="it", file=self.stream,
+                            mininterval=0.2 if tty else 10.0, dynamic_ncols=tty)
         if self.first is None:
             self.first = cost
         rel = cost / self.first if self.first else float("nan")
@@ -239,7 +242,8 @@ class ProgressBar:
         self.bar.update(max(0, min(int(it), self.bar.total) - self.bar.n))
 
     def close(self) -> None:
-        self.bar.close()
+        if self.bar is not None:
+            self.bar.close()
 
 
 #: The files write_report writes in its folder (identify --report refuses them without --force).

@@ -33,7 +33,7 @@ numbering: header = row 1) or message, and the column.
 
 from __future__ import annotations
 
-from ._extras import MissingExtraError
+from ._extras import MissingExtraError, need  # noqa: F401 (need: the commands check an extra through it)
 from ._files import (
     FORMATS,
     find_maneuvers,
