@@ -1,5 +1,6 @@
-"""Standing reserve for the task's pulses (controller ``reserve: disturbances`` in a scenario,
-GraspController ``reserve_force`` / ``reserve_torque``).
+"""Standing reserve for the task's pulses (GraspController ``reserve_force`` /
+``reserve_torque``, stated as numbers by the scenes, and the rule
+``lugrip.sim.scenarios.disturbance_reserve`` that computes them from an expected pulse list).
 
 The rule is checked against the same numbers written out by hand for the 0.45 kg box. The
 closed loop runs on an independent plant: MuJoCo's contact solver with the gripper's 30 ms lag
@@ -39,15 +40,17 @@ def test_reserve_rule_for_the_box_by_hand():
 def test_reserve_rule_with_the_rate_limit_is_its_own_fixed_point():
     """With the scene's identified contact and 200 N/s the reaction time adds the ramp from the
     reserve's force to the force the whole pulse needs; the solved t_r reproduces itself
-    (consistency with lugrip's static grasp force), and the reserve only grows."""
+    (consistency with lugrip's static grasp force), and the reserve only grows. The box scene
+    states this envelope as numbers (rounded to 3 digits); its loader derives nothing."""
     import lugrip
     from lugrip.sim._closed_loop import estimator_params
 
     scn = sc.load_scenario(sc.scenario_dir() / "unseen" / "box_heavy.yaml")
-    r = scn.reserve
-    assert scn.controller["reserve_force"] == r["reserve_force"]
-    assert scn.controller["reserve_torque"] == r["reserve_torque"]
     contact = estimator_params(scn.plant_config().contact, scn.estimator_for("mujoco"))
+    r = sc.disturbance_reserve(scn.plant, scn.criteria_by_plant["mujoco"], 0.02,
+                               contact=contact, rate_up=200.0)
+    assert scn.controller["reserve_force"] == pytest.approx(r["reserve_force"], rel=5e-3)
+    assert scn.controller["reserve_torque"] == pytest.approx(r["reserve_torque"], rel=5e-3)
     load_f, load_t = 0.5 * 0.45 * 9.81, 0.0
     full = max(lugrip.static_grasp_force(contact, load_f + 1.5, load_t, 1.0)
                - lugrip.static_grasp_force(contact, load_f + r["reserve_force"], load_t, 1.0),
@@ -59,11 +62,13 @@ def test_reserve_rule_with_the_rate_limit_is_its_own_fixed_point():
     assert r["reserve_force"] > bare["reserve_force"] and r["reserve_torque"] > bare["reserve_torque"]
 
 
-def test_reserve_rule_rejects_an_unknown_rule(tmp_path):
+def test_a_scene_may_not_derive_its_reserve_from_its_own_pulses(tmp_path):
     src = (sc.scenario_dir() / "unseen" / "box_heavy.yaml").read_text()
     bad = tmp_path / "bad.yaml"
-    bad.write_text(src.replace("reserve: disturbances", "reserve: guess"))
-    with pytest.raises(ValueError, match="reserve"):
+    bad.write_text(src.replace("reserve_force: 1.38, reserve_torque: 0.00682",
+                               "reserve: disturbances"))
+    assert bad.read_text() != src
+    with pytest.raises(ValueError, match="state the task's envelope as numbers"):
         sc.load_scenario(bad)
 
 

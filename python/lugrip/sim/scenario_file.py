@@ -1,6 +1,7 @@
 """Scenario files: the YAML layout of :mod:`lugrip.sim.scenarios` (keys, criteria names, plant
-blocks, known limits), loading, listing and checking them, and the standing reserve
-derived from a scenario's pulses."""
+blocks, known limits), loading, listing and checking them, and a rule that computes a standing
+reserve from an expected pulse list (a tool for stating a task's envelope; no scene derives its
+own)."""
 
 from __future__ import annotations
 
@@ -190,8 +191,6 @@ class Scenario:
     criteria_by_plant: dict = dataclasses.field(default_factory=dict)
     faults: dict = dataclasses.field(default_factory=dict)
     source: Path | None = None
-    #: the standing reserve's derivation (controller ``reserve: disturbances``), else empty
-    reserve: dict = dataclasses.field(default_factory=dict)
     #: the blocks of registered engines other than MuJoCo, by plant name (see :meth:`block`)
     engines: dict = dataclasses.field(default_factory=dict)
     #: plant name -> why this scenario is known to fail its criteria on that plant (the demo
@@ -279,30 +278,14 @@ class Scenario:
         )
         if s.suite not in SUITES:
             raise ValueError(f"{where}: suite {s.suite!r}: expected one of {', '.join(SUITES)}")
-        reserve = s.controller.pop("reserve", None)
-        if reserve is not None:
-            if reserve != "disturbances":
-                raise ValueError(
-                    f"{where}: controller.reserve: {reserve!r}: the only rule is 'disturbances' "
-                    "(or give reserve_force / reserve_torque)"
-                )
-            crit = s.criteria_by_plant.get("mujoco", s.criteria)
-            ratio = int(s.controller.get("command_ratio", 10))
-            rate = float(s.controller.get("sensor_rate", 500.0))
-            est = s.estimator_for("mujoco") if "mujoco" in s.estimator else s.estimator_for(
-                s.plant_model()
+        if "reserve" in s.controller:
+            raise ValueError(
+                f"{where}: controller.reserve: {s.controller['reserve']!r}: a scene does not "
+                "derive its reserve from its own pulses; state the task's envelope as numbers, "
+                "reserve_force [N] and reserve_torque [N m] per finger "
+                "(lugrip.sim.scenarios.disturbance_reserve computes them from an expected pulse "
+                "list), or leave it to the reserve the controller learns from the pushes"
             )
-            plant_contact = s.plant_config().contact
-            contact = estimator_params(plant_contact, est) or plant_contact
-            s.reserve = disturbance_reserve(
-                s.plant,
-                crit,
-                ratio / rate,
-                contact=contact,
-                rate_up=float(s.controller.get("max_rate_up", math.inf)),
-            )
-            for key in ("reserve_force", "reserve_torque"):
-                s.controller.setdefault(key, s.reserve[key])
         s.plant_config()  # validates the plant block now, naming bad fields
         if s.mujoco:
             s.scene_spec()  # and the MuJoCo scene
@@ -313,7 +296,6 @@ class Scenario:
     def to_dict(self) -> dict:
         d = dataclasses.asdict(self)
         d.pop("source")
-        d.pop("reserve")
         d.update(d.pop("engines"))
         if d["steady_window"] is not None:
             d["steady_window"] = list(d["steady_window"])
