@@ -49,6 +49,7 @@ from .._yaml import load_yaml, to_number
 from . import faults as _faults
 from ._closed_loop import ClosedLoopRun, estimator_params, run_closed_loop
 from ._plant import PlantConfig
+from .plant import plant_names, registered
 
 __all__ = [
     "CRITERIA",
@@ -256,7 +257,7 @@ class Scenario:
             unknown = sorted(set(crit) - set(CRITERIA))
             if unknown:
                 raise ValueError(f"{where}: unknown criteria {', '.join(unknown)}")
-        if not set(by_plant) <= set(PLANT_MODELS):
+        if not set(by_plant) <= set(plant_names()):
             raise ValueError(
                 f"{where}: criteria_by_plant: keys must be among {', '.join(PLANT_MODELS)}"
             )
@@ -264,7 +265,7 @@ class Scenario:
         if not isinstance(plant, Mapping):
             raise ValueError(f"{where}: plant: expected a mapping (model: patch | lumped | mujoco, ...)")  # noqa: TRY004 (file content)
         model = plant.get("model", "patch")
-        if not isinstance(model, str) or model not in PLANT_MODELS:
+        if not isinstance(model, str) or model not in plant_names():
             raise ValueError(f"{where}: plant.model: must be one of {', '.join(PLANT_MODELS)}")
         sw = data.get("steady_window")
         if sw is not None and (not isinstance(sw, Sequence) or isinstance(sw, str) or len(sw) != 2):
@@ -352,8 +353,8 @@ class Scenario:
     def plant_model(self, model: str | None = None) -> str:
         """The plant model a run uses: `model`, else the file's ``plant.model`` (patch)."""
         m = str(model if model is not None else self.plant.get("model", "patch"))
-        if m not in PLANT_MODELS:
-            raise ValueError(f"plant model {m!r}: expected one of {', '.join(PLANT_MODELS)}")
+        if m not in plant_names():
+            raise ValueError(f"plant model {m!r}: expected one of {', '.join(plant_names())}")
         return m
 
     def plant_config(self, model: str | None = None, seed: int | None = None) -> PlantConfig:
@@ -363,7 +364,7 @@ class Scenario:
         d = copy.deepcopy(self.plant)
         if model is not None:
             d["model"] = model
-        if d.get("model") == "mujoco":
+        if registered(str(d.get("model", "patch"))):  # an engine reads its scene itself
             d["model"] = "patch"
         if seed is not None:
             d["seed"] = int(seed)
@@ -443,7 +444,7 @@ def _estimator_block(value: Any, where: str) -> dict:
     parameters the estimator side uses with that plant."""
     if value is None:
         return {}
-    if not isinstance(value, Mapping) or not set(value) <= set(PLANT_MODELS):
+    if not isinstance(value, Mapping) or not set(value) <= set(plant_names()):
         raise ValueError(
             f"{where}: estimator: expected a mapping with keys among {', '.join(PLANT_MODELS)}"
         )
@@ -815,6 +816,22 @@ def simulate(
             kind=kind,
             estimator=est,
             frame_callback=frame_callback,
+            **options,
+        )
+    if registered(model):
+        from .plant import make_plant
+        from .runner import run_plant_loop
+
+        return run_plant_loop(
+            make_plant(model),
+            scenario,
+            cfg,
+            scenario.controller,
+            scenario.observer,
+            schedule,
+            scenario.duration,
+            kind=kind,
+            estimator=est,
             **options,
         )
     return run_closed_loop(
