@@ -117,7 +117,7 @@ class _Gripper:
 
     def __init__(self, spec, *, mu: float, mass: float, inertia: float, cog, pad: DrakePad,
                  timestep: float = 1e-3, approximation: str = "lagged",
-                 stiction_tolerance: float = 1e-5, grasp_height: float = 0.1):
+                 stiction_tolerance: float = 1e-6, grasp_height: float = 0.1):
         from pydrake.geometry import Box, Cylinder
         from pydrake.math import RigidTransform, RotationMatrix, RollPitchYaw
         from pydrake.multibody.plant import (
@@ -291,7 +291,7 @@ class DrakePlant:
     name = "drake"
 
     def __init__(self, *, pad: DrakePad | None = None, timestep: float = 1e-3,
-                 approximation: str = "lagged", stiction_tolerance: float = 1e-5):
+                 approximation: str = "lagged", stiction_tolerance: float = 1e-6):
         self.pad = pad if pad is not None else DrakePad()
         self.timestep = float(timestep)
         self.approximation = approximation

@@ -58,10 +58,10 @@ class RigSettings:
     approximation: str = "lagged"
     #: Drake's friction regularisation: slip speed below which friction is proportional to
     #: the slip [m/s]
-    stiction_tolerance: float = 1e-5
-    #: gross sliding: slip speed |v| + |omega| a at the patch edge above this many stiction
-    #: tolerances (the regularised friction is saturated over the patch)
-    slide_factor: float = 3.0
+    stiction_tolerance: float = 1e-6
+    #: gross sliding: slip speed |v| + |omega| a at the patch edge above this [m/s] (far above
+    #: the regularisation's creep, so the friction is saturated over the patch)
+    slip_speed: float = 1e-4
 
     def __post_init__(self):
         for f in dataclasses.fields(self):
@@ -280,7 +280,7 @@ class DrakeRubbingRig:
         rig.reset()
         jm, jp, ctx = rig.mount_joint, rig.pad_joint, rig.context
         mu = self.pad.mu
-        v_slide = s.slide_factor * s.stiction_tolerance
+        v_slide = s.slip_speed
         for n in range(n_steps):
             # the mount's velocity over the step lands it on the next planned pose (its position
             # is never set: a teleport would move it under the contact)
