@@ -34,6 +34,9 @@ from typing import Any
 
 import numpy as np
 
+from ..mujoco.gripper import _object_bottom
+from ..mujoco.loop import disturbance_wrench
+from ..mujoco.plant import MujocoPlant
 from ..plant import PlantClock, PlantSamples
 from .pad import DrakePad, PadWrench, add_pad, rigid_properties
 
@@ -54,8 +57,6 @@ def pad_parameters():
                                 "directory of this installation")
     return ContactParams.from_yaml(objects / PAD_FILE)
 
-#: Consecutive contact-free sensor samples after which a pad's contact counts as lost.
-_LOST_SAMPLES = 10
 #: each pad's twist axis (its z) along world x: -1 for pad 0, +1 for pad 1
 _TWIST_SIGN = (-1.0, 1.0)
 #: pad frames in world (columns x, y, z; z from the face into the finger), as the MuJoCo scene's
@@ -73,43 +74,6 @@ def min_jerk(t: float, t0: float, T: float) -> float:
     """The minimum-jerk ramp 0 -> 1 over [t0, t0 + T]."""
     u = min(max((t - t0) / T, 0.0), 1.0) if T > 0 else float(t >= t0)
     return u**3 * (10.0 - 15.0 * u + 6.0 * u * u)
-
-
-def _pulse(shape: str, u: float) -> float:
-    if shape in ("rectangular", "rect"):
-        return 1.0
-    if shape in ("half_sine", "halfsine"):
-        return math.sin(math.pi * u)
-    if shape == "ramp":
-        return u
-    return 1.0 - abs(2.0 * u - 1.0)  # triangle
-
-
-def _disturbance(disturbances, t: float, theta: float) -> tuple[float, float, float]:
-    """The active pulses at t [s] for the object at angle theta: world force (horizontal,
-    vertical) [N] at the CoG and the torque about it [N m] (the pulse's point relative to the
-    CoG turns with the object)."""
-    fx = fy = tau = 0.0
-    c, s = math.cos(theta), math.sin(theta)
-    for d in disturbances:
-        u = (t - d.t_start) / d.duration
-        if not (0.0 <= u < 1.0):
-            continue
-        a = _pulse(d.shape, u)
-        px = c * d.point[0] - s * d.point[1]
-        py = s * d.point[0] + c * d.point[1]
-        qx, qy = a * d.force[0], a * d.force[1]
-        fx += qx
-        fy += qy
-        tau += a * d.torque + px * qy - py * qx
-    return fx, fy, tau
-
-
-def _object_bottom(spec, center_z: float) -> float:
-    if spec.shape == "box":
-        return center_z - spec.size[2]
-    r, half = spec.size
-    return center_z - (half if spec.axis == "vertical" else r)
 
 
 class _Gripper:
@@ -329,6 +293,7 @@ class DrakePlant:
         self._touched = np.zeros(2, dtype=bool)
         self._lost = np.zeros(2, dtype=int)
         self._lift_start = min((x.t_start for x in cfg.moves), default=math.inf)
+        self._travel = g.travel
         self._status = {"status": "ok", "detail": "", "time": None, "contact_time": None}
         self.wall_time = 0.0
         return PlantClock(sample_period=self._T,
@@ -389,7 +354,7 @@ class DrakePlant:
                 hj.set_translational_velocity(ctx, vel[:2])
                 hj.set_angular_velocity(ctx, vel[2])
                 th = float(oj.get_rotation(ctx))
-                wrench = _disturbance(self.cfg.disturbances, t, th)
+                wrench = disturbance_wrench(self.cfg.disturbances, t, th)
                 # gripper force: first-order lag and rate limit toward the held command
                 f = target_cmd + (self._f_act - target_cmd) * self._decay
                 f = min(max(f, self._f_act - self._step_max), self._f_act + self._step_max)
@@ -460,36 +425,9 @@ class DrakePlant:
             omega=omega, v_slip=v_slip, external=external, gripper_y=hand_z, extra=extra,
         )
 
-    def _scene_faults(self, t, contact, fingers) -> None:
-        """The scene status (never raises): a pad that never reached the object, a finger at
-        its stop without contact, a contact lost after the grasp."""
-        st = self._status
-        g = self.model
-        for j in range(t.shape[0]):
-            ts = float(t[j])
-            if st["contact_time"] is None and contact[j].all():
-                st["contact_time"] = ts
-            if st["status"] != "ok":
-                continue
-            self._touched |= contact[j]
-            touched = self._touched
-            if touched.all():
-                self._lost = np.where(contact[j], 0, self._lost + 1)
-                k = int(np.argmax(self._lost))
-                if self._lost[k] >= _LOST_SAMPLES:
-                    st.update(status="lost_contact", time=ts,
-                              detail=f"pad {k} without contact for "
-                                     f"{_LOST_SAMPLES * self._T * 1e3:.0f} ms")
-                continue
-            at_stop = fingers[j] >= g.travel - 2e-4
-            free = [k for k in (0, 1) if at_stop[k] and not touched[k]]
-            if free:
-                between = g.object_between()
-                st.update(
-                    status="closed_on_nothing" if between else "object_not_reached", time=ts,
-                    detail=f"finger {free[0]} closed to its stop without contact"
-                    + ("" if between else "; the object is not between the fingers"))
-            elif ts >= self._lift_start:
-                st.update(status="object_not_reached", time=ts,
-                          detail=f"pad(s) {[k for k in (0, 1) if not touched[k]]} without "
-                                 "contact at the lift start")
+    #: the scene status (never raises), as the MuJoCo plant finds it: a pad that never reached
+    #: the object, a finger at its stop without contact, a contact lost after the grasp
+    _scene_faults = MujocoPlant._scene_faults
+
+    def _object_between(self) -> bool:
+        return self.model.object_between()
