@@ -13,7 +13,8 @@ import math
 import numpy as np
 import pytest
 
-pydrake = pytest.importorskip("pydrake", reason="Drake is not installed (pip install 'lugrip[drake]')")
+pydrake = pytest.importorskip(
+    "pydrake", reason="Drake is not installed (pip install 'lugrip[drake]')")
 
 from lugrip import identify  # noqa: E402
 from lugrip.rigs import RubbingDesign  # noqa: E402

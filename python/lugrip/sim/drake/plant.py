@@ -93,7 +93,6 @@ class _Gripper:
             FixedOffsetFrame,
             PlanarJoint,
             PrismaticJoint,
-            RotationalInertia,
             SpatialInertia,
             UnitInertia,
         )
@@ -134,8 +133,8 @@ class _Gripper:
         M = SpatialInertia(mass=float(mass), p_PScm_E=[0.0, cy, cz],
                            G_SP_E=UnitInertia(i_obj / mass, i_obj / mass, i_obj / mass)
                            .ShiftFromCenterOfMass([0.0, -cy, -cz]))
-        del RotationalInertia
-        carrier = plant.AddRigidBody("object_carrier", objects, SpatialInertia.SolidSphereWithMass(1e-3, 1e-3))
+        carrier = plant.AddRigidBody(
+            "object_carrier", objects, SpatialInertia.SolidSphereWithMass(1e-3, 1e-3))
         obj = plant.AddRigidBody("object", objects, M)
         self.object = obj
         start = plant.AddFrame(FixedOffsetFrame(

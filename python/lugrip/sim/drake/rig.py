@@ -100,7 +100,8 @@ class _RigModel:
         plant.RegisterCollisionGeometry(
             plant.world_body(), RigidTransform([0.0, 0.0, -0.01]), Box(0.4, 0.4, 0.02), "slab",
             rigid_properties(pad.mu, 0.05))
-        mount = plant.AddRigidBody("mount", SpatialInertia.SolidBoxWithMass(s.mount_mass, 0.1, 0.1, 0.1))
+        mount = plant.AddRigidBody(
+            "mount", SpatialInertia.SolidBoxWithMass(s.mount_mass, 0.1, 0.1, 0.1))
         finger = plant.AddRigidBody(
             "finger", SpatialInertia.SolidBoxWithMass(s.finger_mass, 0.01, 0.01, 0.01))
         self.mount_joint = plant.AddJoint(
@@ -166,9 +167,11 @@ def _capacity(pad, forces, s, omega, duration):
             rig.step()
         taus = []
         n = round(duration / h)
+        ctx = rig.context
         for k in range(n):
-            jm.set_angular_velocity(rig.context, (omega * (k + 1) * h - jm.get_rotation(rig.context)) / h)
-            jm.set_translational_velocity(rig.context, -np.asarray(jm.get_translation(rig.context)) / h)
+            # velocities landing the mount on the spin's pose (a pure spin about the pad axis)
+            jm.set_angular_velocity(ctx, (omega * (k + 1) * h - jm.get_rotation(ctx)) / h)
+            jm.set_translational_velocity(ctx, -np.asarray(jm.get_translation(ctx)) / h)
             rig.step()
             if k >= n // 2:
                 taus.append(abs(rig.sensor.read(rig.context)[0][3]))
@@ -278,7 +281,7 @@ class DrakeRubbingRig:
         acc = np.zeros(7)
         slide_all = True
         rig.reset()
-        jm, jp, ctx = rig.mount_joint, rig.pad_joint, rig.context
+        jm, ctx = rig.mount_joint, rig.context
         mu = self.pad.mu
         v_slide = s.slip_speed
         for n in range(n_steps):
@@ -315,7 +318,6 @@ class DrakeRubbingRig:
                 sliding[k] = slide_all
                 acc[:] = 0.0
                 slide_all = True
-        del jp
         truth = self.truth()
         fn = np.maximum(out["f_n"], 1e-6)
         ft = np.hypot(out["f_x"], out["f_y"])
