@@ -793,8 +793,9 @@ def simulate(
     frame_callback=None,
     **options,
 ) -> ClosedLoopRun:
-    """One closed-loop run of `scenario` on plant `model` (patch, lumped: lugrip's C++ loop;
-    mujoco: :func:`lugrip.sim.mujoco.loop.run_mujoco_loop`) with controller `kind`."""
+    """One closed-loop run of `scenario` on plant `model` (patch, lumped: lugrip's C++ loop; a
+    registered engine, mujoco, drake: :func:`lugrip.sim.runner.run_plant_loop` on its plant)
+    with controller `kind`."""
     est = scenario.estimator_for(model)
     if scenario.faults:
         options = dict(
@@ -803,27 +804,14 @@ def simulate(
             stuck_samples=scenario.faults.get("stuck_samples", 0),
             healthy_finger_fallback=scenario.faults.get("healthy_finger_fallback", False),
         )
-    if model == "mujoco":
-        from .mujoco.loop import run_mujoco_loop
-
-        return run_mujoco_loop(
-            cfg,
-            scenario.scene_spec(),
-            scenario.controller,
-            scenario.observer,
-            schedule,
-            scenario.duration,
-            kind=kind,
-            estimator=est,
-            frame_callback=frame_callback,
-            **options,
-        )
-    if registered(model):
+    if registered(model):  # an engine's plant through the one runner (MuJoCo: frames)
         from .plant import make_plant
         from .runner import run_plant_loop
 
+        engine = make_plant(model, **({} if frame_callback is None
+                                      else {"frame_callback": frame_callback}))
         return run_plant_loop(
-            make_plant(model),
+            engine,
             scenario,
             cfg,
             scenario.controller,

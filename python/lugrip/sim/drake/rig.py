@@ -29,8 +29,8 @@ from dataclasses import asdict, dataclass
 
 import numpy as np
 
-from ...io import SlidingLog
 from ...rigs._data import RigTruth, RubbingData
+from ...rigs.mujoco_rig import _theta_many, _theta_segments, engine_log, mount_poses
 from ...rigs.motion import ManeuverPlan, RubbingDesign, plan_maneuvers, stack_times
 from .pad import DrakePad, PadWrench, add_pad, rigid_properties
 
@@ -180,8 +180,6 @@ def _capacity(pad, forces, s, omega, duration):
 
 
 def _theta_profile(plan: ManeuverPlan):
-    from ...rigs.mujoco_rig import _theta_many, _theta_segments, mount_poses
-
     return _theta_segments(plan), _theta_many, mount_poses
 
 
@@ -348,33 +346,8 @@ class DrakeRubbingRig:
         wall = time.perf_counter()
         plans = self.plans(design, n, seed)
         starts = stack_times(plans, 1.0 / design.sample_rate)
-        cols: dict[str, list[np.ndarray]] = {
-            k: [] for k in ("t", "f_n", "f_x", "f_y", "tau", "omega", "maneuver")}
-        phase, load, c_tilde, v_true = [], [], [], []
-        for plan, t_start in zip(plans, starts):
-            r = self.run_maneuver(plan)
-            f_n, f_x, f_y, tau = plan.sensor(r["f_n"], r["f_x"], r["f_y"], r["tau"])
-            cols["t"].append(t_start + plan.t)
-            cols["f_n"].append(f_n)
-            cols["f_x"].append(f_x)
-            cols["f_y"].append(f_y)
-            cols["tau"].append(tau)
-            cols["omega"].append(r["omega"])
-            cols["maneuver"].append(np.full(len(plan.t), plan.index, dtype=np.int64))
-            ph = plan.commanded_phase()
-            ph[(ph == 1) & r["sliding"]] = 2
-            phase.append(ph)
-            load.append(r["load_ratio"])
-            sign = np.sign(plan.c_tilde_signed(1.0))
-            c_geom = sign * r["cor_distance"] / self.radius(np.maximum(r["f_n"], 1e-9))
-            slip_ok = (ph == 2) & np.isfinite(r["c_tilde_slip"])
-            c_tilde.append(np.where(slip_ok, r["c_tilde_slip"], c_geom))
-            v_true.append(r["v"])
-        cat = {k: np.concatenate(v) for k, v in cols.items()}
-        log = SlidingLog.from_arrays(
-            cat["t"], cat["f_n"], cat["tau"], f_x=cat["f_x"], f_y=cat["f_y"],
-            omega=cat["omega"], maneuver=cat["maneuver"],
-            meta={"plant": "drake", "seed": int(seed)})
+        runs = [self.run_maneuver(plan) for plan in plans]
+        log, labels = engine_log(plans, starts, runs, self.radius, plant="drake", seed=seed)
         meta = {
             "plant": "drake",
             "drake": getattr(pydrake, "__version__", "unknown"),
@@ -385,7 +358,4 @@ class DrakeRubbingRig:
             "settings": asdict(self.settings),
             "seconds": time.perf_counter() - wall,
         }
-        return RubbingData(
-            log=log, phase=np.concatenate(phase), load_ratio=np.concatenate(load),
-            c_tilde_true=np.concatenate(c_tilde), v_true=np.concatenate(v_true),
-            truth=self.truth(), meta=meta)
+        return RubbingData(log=log, **labels, truth=self.truth(), meta=meta)
