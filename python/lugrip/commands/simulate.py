@@ -31,6 +31,7 @@ examples:
   lugrip simulate all --short --plant lumped --no-baselines
   lugrip simulate box_heavy --plant mujoco --video out/box.mp4
   lugrip simulate all unseen --plant mujoco --seeds 8 --compare patch
+  lugrip simulate all unseen --plant drake --no-plots   # Drake (pip install "lugrip[drake]")
   lugrip simulate scenarios/faults/*.yaml --no-plots     # sensor and actuator faults
   lugrip simulate --list
 MuJoCo plant: writes DIR/mujoco.md, DIR/mujoco_<scenario>.png (frames of the lift and the pivot
@@ -80,12 +81,13 @@ def register(subparsers) -> None:
         action="store_true",
         help="CI mode: the scenarios' short overrides and a 5 %% constant-force search",
     )
+    from ..sim.plant import plant_names
+
     p.add_argument(
         "--plant",
         choices=plant_names(),
         default=None,
-        help="plant model: lugrip's own (patch, lumped) or a registered engine "
-             "(lugrip.sim.plant; default: the scenario's, patch)",
+        help="plant model: " + ", ".join(plant_names()) + " (default: the scenario's, patch)",
     )
     p.add_argument(
         "--video",

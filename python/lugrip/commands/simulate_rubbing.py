@@ -22,6 +22,7 @@ examples:
   lugrip simulate-rubbing --plant grid-stribeck --maneuvers 160 --seed 0 --out rub_i
   lugrip simulate-rubbing --plant grid-viscous --maneuvers 12 --out ci_set --force
   lugrip simulate-rubbing --plant patch --preset plastic_bottle --out patch_set
+  lugrip simulate-rubbing --plant drake --maneuvers 60 --out drake_set   # pip install "lugrip[drake]"
 
 The directory receives log.parquet (or log.csv with --format csv: the sensor wrench, the true
 omega and the maneuver ids, docs/sliding_log.md), labels.npz (phase 0 approach / 1 presliding
@@ -54,7 +55,7 @@ def register(subparsers) -> None:
     p = subparsers.add_parser(
         "simulate-rubbing",
         help="rubbing data with ground truth from a prescribed-motion plant (grid, patch, "
-             "lumped, MuJoCo)",
+             "lumped, MuJoCo, Drake)",
         description=textwrap.fill(
             "Rub a fingertip against a fixed slider with prescribed motion, as a robot would: "
             "press, turn about a CoR fixed in the finger frame (c~ from 0.05 to 20 contact "

@@ -395,35 +395,12 @@ class MujocoRubbingRig:
         dt = 1.0 / design.sample_rate
         starts = stack_times(plans, dt)
         built = self.build()
-        cols: dict[str, list[np.ndarray]] = {
-            k: [] for k in ("t", "f_n", "f_x", "f_y", "tau", "omega", "maneuver")
-        }
-        phase, load, c_tilde, v_true = [], [], [], []
+        runs = [self.run_maneuver(plan, built) for plan in plans]
         f_n_dev = []
-        for plan, t_start in zip(plans, starts):
-            r = self.run_maneuver(plan, built)
+        for plan, r in zip(plans, runs):
             moving = plan.commanded_phase() >= 1
             dev = np.abs(r["f_n"][moving] / plan.f_n[moving] - 1.0)
             f_n_dev.append((float(np.max(dev)), float(np.mean(dev > _BOUNCE))))
-            f_n, f_x, f_y, tau = plan.sensor(r["f_n"], r["f_x"], r["f_y"], r["tau"])
-            cols["t"].append(t_start + plan.t)
-            cols["f_n"].append(f_n)
-            cols["f_x"].append(f_x)
-            cols["f_y"].append(f_y)
-            cols["tau"].append(tau)
-            cols["omega"].append(r["omega"])
-            cols["maneuver"].append(np.full(len(plan.t), plan.index, dtype=np.int64))
-            ph = plan.commanded_phase()
-            ph[(ph == 1) & r["sliding"]] = 2
-            phase.append(ph)
-            load.append(r["load_ratio"])
-            # in gross sliding the CoR of the pad's actual slip; elsewhere (no slip) that of the
-            # prescribed motion seen from the contact point
-            sign = np.sign(plan.c_tilde_signed(1.0))
-            c_geom = sign * r["cor_distance"] / self.radius(np.maximum(r["f_n"], 1e-9))
-            slip_ok = (ph == 2) & np.isfinite(r["c_tilde_slip"])
-            c_tilde.append(np.where(slip_ok, r["c_tilde_slip"], c_geom))
-            v_true.append(r["v"])
         bounced = [i for i, (_, share) in enumerate(f_n_dev) if share > _BOUNCE_SHARE]
         if bounced:
             warnings.warn(
@@ -433,17 +410,7 @@ class MujocoRubbingRig:
                 "cone makes a fast-sliding pad bounce; keep contact speeds below about 5 mm/s)",
                 stacklevel=2,
             )
-        cat = {k: np.concatenate(v) for k, v in cols.items()}
-        log = SlidingLog.from_arrays(
-            cat["t"],
-            cat["f_n"],
-            cat["tau"],
-            f_x=cat["f_x"],
-            f_y=cat["f_y"],
-            omega=cat["omega"],
-            maneuver=cat["maneuver"],
-            meta={"plant": "mujoco", "seed": int(seed)},
-        )
+        log, labels = engine_log(plans, starts, runs, self.radius, plant="mujoco", seed=seed)
         meta = {
             "plant": "mujoco",
             "mujoco": mujoco.__version__,
@@ -457,15 +424,48 @@ class MujocoRubbingRig:
             "normal_force_deviation_share": max(share for _, share in f_n_dev),
             "normal_force_bounce_maneuvers": bounced,
         }
-        return RubbingData(
-            log=log,
-            phase=np.concatenate(phase),
-            load_ratio=np.concatenate(load),
-            c_tilde_true=np.concatenate(c_tilde),
-            v_true=np.concatenate(v_true),
-            truth=self.truth(),
-            meta=meta,
-        )
+        return RubbingData(log=log, **labels, truth=self.truth(), meta=meta)
+
+
+def engine_log(plans, starts, runs, radius, *, plant: str, seed: int):
+    """The sensor log and labels of an engine rig's maneuvers (``runs``: the dicts of its
+    ``run_maneuver``, one per plan, starting at ``starts`` [s]): each plan's sensor (offsets,
+    noise) on the run's true wrench, the engine's own omega; phase 2 where the engine slides
+    while the motion runs; ``c_tilde_true`` in gross sliding the CoR of the actual slip over
+    ``radius(f_n)``, elsewhere (no slip) that of the prescribed motion seen from the contact
+    point. Returns (SlidingLog, {phase, load_ratio, c_tilde_true, v_true})."""
+    cols: dict[str, list[np.ndarray]] = {
+        k: [] for k in ("t", "f_n", "f_x", "f_y", "tau", "omega", "maneuver")
+    }
+    phase, load, c_tilde, v_true = [], [], [], []
+    for plan, t_start, r in zip(plans, starts, runs):
+        f_n, f_x, f_y, tau = plan.sensor(r["f_n"], r["f_x"], r["f_y"], r["tau"])
+        cols["t"].append(t_start + plan.t)
+        cols["f_n"].append(f_n)
+        cols["f_x"].append(f_x)
+        cols["f_y"].append(f_y)
+        cols["tau"].append(tau)
+        cols["omega"].append(r["omega"])
+        cols["maneuver"].append(np.full(len(plan.t), plan.index, dtype=np.int64))
+        ph = plan.commanded_phase()
+        ph[(ph == 1) & r["sliding"]] = 2
+        phase.append(ph)
+        load.append(r["load_ratio"])
+        sign = np.sign(plan.c_tilde_signed(1.0))
+        c_geom = sign * r["cor_distance"] / radius(np.maximum(r["f_n"], 1e-9))
+        slip_ok = (ph == 2) & np.isfinite(r["c_tilde_slip"])
+        c_tilde.append(np.where(slip_ok, r["c_tilde_slip"], c_geom))
+        v_true.append(r["v"])
+    cat = {k: np.concatenate(v) for k, v in cols.items()}
+    log = SlidingLog.from_arrays(
+        cat["t"], cat["f_n"], cat["tau"], f_x=cat["f_x"], f_y=cat["f_y"], omega=cat["omega"],
+        maneuver=cat["maneuver"], meta={"plant": plant, "seed": int(seed)},
+    )
+    labels = {
+        "phase": np.concatenate(phase), "load_ratio": np.concatenate(load),
+        "c_tilde_true": np.concatenate(c_tilde), "v_true": np.concatenate(v_true),
+    }
+    return log, labels
 
 
 def _sweep_plan(rig: MujocoRubbingRig, c_tilde: float, f_n: float) -> ManeuverPlan:

@@ -16,6 +16,16 @@ PLANTS: dict[str, str] = {
              "kinematics",
     "mujoco": "MuJoCo pad on a compliant mount rubbing a fixed slider (lugrip.rigs.mujoco_rig, "
               "needs mujoco)",
+    "drake": "Drake compliant-hydroelastic pad on a compliant mount rubbing a rigid slab: the "
+             "patch's pressure field and limit surface from the engine (lugrip.sim.drake.rig, "
+             "needs drake)",
+}
+
+#: the engine rigs: plant name -> (module relative to lugrip, class, pip package, the
+#: package's import name)
+_ENGINE_RIGS: dict[str, tuple[str, str, str, str]] = {
+    "mujoco": (".rigs.mujoco_rig", "MujocoRubbingRig", "mujoco", "mujoco"),
+    "drake": (".sim.drake.rig", "DrakeRubbingRig", "drake", "pydrake"),
 }
 
 
@@ -40,19 +50,19 @@ def make_rig(name: str, *, params=None):
         return cls() if params is None else cls(params=params)
     import importlib
 
-    module = __name__.rsplit(".", 1)[0] + ".mujoco_rig"
+    relative, attr, package, import_name = _ENGINE_RIGS[key]
+    module = __name__.split(".", 1)[0] + relative
     try:
-        mujoco_rig = importlib.import_module(module)
+        engine_rig = importlib.import_module(module)
     except ModuleNotFoundError as err:
         if err.name == module:
-            raise ImportError("the 'mujoco' plant is not available in this installation "
+            raise ImportError(f"the {key!r} plant is not available in this installation "
                               f"(module {module} is missing)") from None
-        if (err.name or "").split(".")[0] == "mujoco":
-            raise ImportError("the 'mujoco' plant needs the mujoco package: "
-                              "pip install mujoco") from None
+        if (err.name or "").split(".")[0] == import_name:
+            raise ImportError(f"the {key!r} plant needs the {package} package: "
+                              f"pip install {package}") from None
         raise
-    for attr in ("MujocoRubbingRig", "MujocoRig"):
-        cls = getattr(mujoco_rig, attr, None)
-        if cls is not None:
-            return cls()
-    raise ImportError("lugrip.rigs.mujoco_rig defines no MujocoRubbingRig class")
+    cls = getattr(engine_rig, attr, None)
+    if cls is None:
+        raise ImportError(f"{module} defines no {attr} class")
+    return cls()

@@ -42,6 +42,11 @@ The cycle
     the next command tick); any length >= 1 must work. Returns the :class:`PlantSamples` of
     those samples.
 
+``estimator(config)`` (optional)
+    The contact parameters lugrip's observers and controller use on this plant when the
+    scenario names none for it (an engine whose contact is not lugrip's model states what
+    identification on it gives); without it, the plant block's contact.
+
 ``scene_status()``
     A dict {status, detail, time, contact_time}: ``status`` is "ok" or a short code naming a
     scene fault (the object not between the fingers, a finger closing on nothing, a contact
@@ -284,4 +289,10 @@ register_plant(
     "lugrip.sim.mujoco.plant:MujocoPlant",
     "MuJoCo gripper with compliant pads and condim-4 contacts (an independent engine)",
     frames=True,
+)
+register_plant(
+    "drake",
+    "lugrip.sim.drake.plant:DrakePlant",
+    "Drake gripper with compliant-hydroelastic pads: the patch's pressure field and limit "
+    "surface from the engine (an independent engine; pip install 'lugrip[drake]')",
 )

@@ -103,7 +103,11 @@ def run_plant_loop(
     if kind not in ("lugrip", "constant_force", "friction_cone"):
         raise ValueError(f"kind {kind!r}: expected lugrip, constant_force or friction_cone")
     contact = config.contact
-    est = estimator_params(contact, estimator) or contact
+    est = estimator_params(contact, estimator)
+    if est is None:  # the plant's own belief about its contact, when it states one
+        own = getattr(plant, "estimator", None)
+        est = own(config) if callable(own) else None
+    est = est or contact
     clock = plant.reset(scene, config=config)
     T_s = float(clock.sample_period)
     ctrl_s = {"sensor_rate": 1.0 / T_s, "command_ratio": int(clock.command_ratio)}
