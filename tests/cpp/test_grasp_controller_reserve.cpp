@@ -119,6 +119,18 @@ TEST(ControllerReserve, ValidationNamesANegativeOrNonFiniteReserve) {
 
 // --- the reserve learned from the pushes (no setting; part of the load floors) --------------
 
+namespace {
+// A settled 2.2 N load, a 1 N push for 0.2 s (100 samples), then the load again for 40 ms;
+// *during: the reserve at the push's last sample.
+void push_and_return(GraspController& c, GraspControllerOutput& out, double* during = nullptr) {
+  c.reset(2.0);
+  settle(c, both(0.3, 2.2, 0.0));
+  for (int k = 0; k < 100; ++k) c.step(both(0.3, 3.2, 0.0), out);
+  if (during) *during = out.reserve_force;
+  for (int k = 0; k < 20; ++k) c.step(both(0.3, 2.2, 0.0), out);
+}
+}  // namespace
+
 TEST(ControllerReserve, APushSeenIsLearnedAsAReserveThatDecaysOverTenSeconds) {
   // Synthetic observer values (the model's own solver as the reference): a steady 2.2 N load,
   // a 1 N push for 0.2 s, then the load again. After the push the floor holds the load plus 0.6
@@ -126,12 +138,10 @@ TEST(ControllerReserve, APushSeenIsLearnedAsAReserveThatDecaysOverTenSeconds) {
   // too), so 10 s later the reserve is e^-1 of it to within the decay of the peak.
   const ContactParams p = box();
   GraspController c(p, quiet());
-  c.reset(2.0);
-  settle(c, both(0.3, 2.2, 0.0));
   GraspControllerOutput out;
-  for (int k = 0; k < 100; ++k) c.step(both(0.3, 3.2, 0.0), out);  // 0.2 s push
-  EXPECT_NEAR(out.reserve_force, 0.0, 1e-12);  // the push itself: nothing came and went yet
-  for (int k = 0; k < 20; ++k) c.step(both(0.3, 2.2, 0.0), out);
+  double during = -1.0;
+  push_and_return(c, out, &during);
+  EXPECT_NEAR(during, 0.0, 1e-12);  // the push itself: nothing came and went yet
   // the peak decays over 10 s from 3.2 toward 2.2 while the excursion is measured
   EXPECT_NEAR(out.reserve_force, 0.6 * 1.0, 0.6 * 0.02);
   // the PI at S = 0.3 unwinds onto the floor: the load plus the reserve at S = 1
@@ -159,10 +169,7 @@ TEST(ControllerReserve, ALoadThatFallsToNothingIsAReleaseNotAPush) {
   EXPECT_DOUBLE_EQ(out.reserve_torque, 0.0);
   // and the paper's law learns nothing
   GraspController paper(p, paper_settings());
-  paper.reset(2.0);
-  settle(paper, both(0.3, 2.2, 0.0));
-  for (int k = 0; k < 100; ++k) paper.step(both(0.3, 3.2, 0.0), out);
-  for (int k = 0; k < 20; ++k) paper.step(both(0.3, 2.2, 0.0), out);
+  push_and_return(paper, out);
   EXPECT_DOUBLE_EQ(out.reserve_force, 0.0);
 }
 
@@ -171,10 +178,7 @@ TEST(ControllerReserve, TheStatedReserveWinsWhereItIsLarger) {
   GraspControllerSettings s = quiet();
   s.reserve_force = 2.0;
   GraspController c(p, s);
-  c.reset(2.0);
-  settle(c, both(0.3, 2.2, 0.0));
   GraspControllerOutput out;
-  for (int k = 0; k < 100; ++k) c.step(both(0.3, 3.2, 0.0), out);
-  for (int k = 0; k < 20; ++k) c.step(both(0.3, 2.2, 0.0), out);
+  push_and_return(c, out);
   EXPECT_DOUBLE_EQ(out.reserve_force, 2.0);
 }
