@@ -14,20 +14,13 @@
 #include <vector>
 
 #include "common.hpp"
+#include "lugrip/detail/field_table.hpp"
 
 namespace lugrip_bind {
 
-template <class S, class T>
-struct Field {
-  const char* name;
-  T S::*member;
-  const char* doc;
-};
-
-template <class S, class T>
-constexpr Field<S, T> field(const char* name, T S::*member, const char* doc) {
-  return Field<S, T>{name, member, doc};
-}
+// one Field type for the core's tables (lugrip/detail/field_table.hpp) and the bindings' own
+using lugrip::detail::Field;
+using lugrip::detail::field;
 
 //! Specialised in tables.hpp: `static constexpr auto fields = std::make_tuple(field(...), ...);`
 template <class S>

@@ -8,6 +8,9 @@
 #include <limits>
 #include <sstream>
 #include <stdexcept>
+#include <type_traits>
+
+#include "lugrip/grasp_controller_fields.hpp"
 
 namespace lugrip {
 
@@ -57,7 +60,7 @@ ContactParams read_contact(const YAML::Node& block, const std::string& where) {
   int required = 0;
   for (const auto& kv : block) {
     const std::string key = kv.first.as<std::string>();
-    if (key == "observer") continue;  // flat layout: the observer block is not a parameter
+    if (key == "observer" || key == "controller") continue;  // flat layout: blocks of their own
     YAML::Node v = kv.second;
     const std::string at = where + "." + key;
     if (v.IsMap()) {
@@ -147,6 +150,35 @@ ObserverSettings read_observer(const YAML::Node& block, const std::string& where
   return s;
 }
 
+GraspControllerSettings read_controller(const YAML::Node& block, const std::string& where) {
+  if (!block.IsMap()) fail(where, "expected a mapping of controller settings");
+  GraspControllerSettings s;
+  for (const auto& kv : block) {
+    const std::string key = kv.first.as<std::string>();
+    const YAML::Node& v = kv.second;
+    const std::string at = where + "." + key;
+    if (v.IsNull()) continue;  // "not given"
+    bool known = false;
+    detail::for_each_entry(grasp_controller_fields, [&](const auto& f) {
+      if (known || key != f.name) return;
+      known = true;
+      using T = std::decay_t<decltype(s.*(f.member))>;
+      if constexpr (std::is_same_v<T, bool>) s.*(f.member) = boolean(v, at);
+      else if constexpr (std::is_integral_v<T>) s.*(f.member) = integer(v, at);
+      else s.*(f.member) = number(v, at);
+    });
+    if (!known) fail(at, "unknown controller setting");
+  }
+  std::string msg;
+  if (!validate(s, &msg)) {
+    std::istringstream lines(msg);
+    std::string first;
+    std::getline(lines, first);
+    fail(where, first);
+  }
+  return s;
+}
+
 }  // namespace
 
 ParameterFile parse_parameter_file(const std::string& yaml_text, const std::string& name) {
@@ -167,6 +199,11 @@ ParameterFile parse_parameter_file(const std::string& yaml_text, const std::stri
       file.observer = read_observer(obs, "observer");
       file.has_observer = true;
     }
+    const YAML::Node ctl = root["controller"];
+    if (ctl && !ctl.IsNull()) {
+      file.controller = read_controller(ctl, "controller");
+      file.has_controller = true;
+    }
   } catch (const std::invalid_argument& e) {
     fail(name, e.what());
   } catch (const YAML::Exception& e) {
@@ -185,6 +222,10 @@ ParameterFile load_parameter_file(const std::string& path) {
   std::string content(static_cast<size_t>(size > 0 ? size : 0), '\0');
   in.read(content.data(), static_cast<std::streamsize>(content.size()));
   return parse_parameter_file(content, path);
+}
+
+SlipControlSettings slip_control_settings(const ParameterFile& file) {
+  return slip_control_settings(file, file.controller);
 }
 
 SlipControlSettings slip_control_settings(const ParameterFile& file, const GraspControllerSettings& controller) {

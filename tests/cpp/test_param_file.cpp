@@ -7,6 +7,10 @@
 #include <stdexcept>
 #include <string>
 
+#include <sstream>
+#include <type_traits>
+
+#include "lugrip/grasp_controller_fields.hpp"
 #include "lugrip/param_file.hpp"
 
 using namespace lugrip;
@@ -115,4 +119,70 @@ TEST(ParamFile, ReadsTheFrictionRatiosAndDefaultsThemToOne) {
   EXPECT_NE(error_of(base + ", static_ratio: 0.8, kinetic_ratio: 0.9}\n").find("static_ratio = 0.8"),
             std::string::npos);
   EXPECT_NE(error_of(base + ", kinetic_ratio: 4}\n").find("kinetic_ratio = 4"), std::string::npos);
+}
+
+// --- the controller block (GraspControllerSettings by name, from the core's field table) -----
+
+TEST(ParamFile, AnIdentificationResultWithAControllerBlockMakesTheSlipControl) {
+  // the identify file above with the robot's controller settings added to it
+  const std::string text = std::string(kIdentified) +
+                           "controller: {f_max: 15.0, max_rate_up: 100.0, command_ratio: 5, "
+                           "slip_reflex: false, reserve_force: 0.5, s_ref: 0.7}\n";
+  const ParameterFile f = parse_parameter_file(text);
+  ASSERT_TRUE(f.has_controller);
+  EXPECT_EQ(f.controller.f_max, 15.0);
+  EXPECT_EQ(f.controller.command_ratio, 5);
+  EXPECT_FALSE(f.controller.slip_reflex);
+  EXPECT_EQ(f.controller.k_p, GraspControllerSettings().k_p);  // not given: the default
+  SlipControl sc(f.params, slip_control_settings(f));
+  EXPECT_EQ(sc.settings().controller.f_max, 15.0);
+  EXPECT_EQ(sc.settings().controller.reserve_force, 0.5);
+  EXPECT_EQ(sc.controller().settings().s_ref, 0.7);
+  EXPECT_EQ(sc.observer(0).settings().bandwidth, 800.0);  // and the observer block as before
+  // an explicit controller replaces the file's
+  EXPECT_EQ(slip_control_settings(f, GraspControllerSettings()).controller.f_max, 20.0);
+  // no block: the defaults
+  EXPECT_FALSE(parse_parameter_file(kIdentified).has_controller);
+}
+
+TEST(ParamFile, EveryControllerFieldOfTheTableIsRead) {
+  // Each field of grasp_controller_fields, alone in a controller block with a value other than
+  // its default (that validate() accepts), reads back into its own member and nowhere else.
+  const std::string base = "contact: {mu: 0.5, beta_a: 1e7, sigma0: 16, sigma_z: 2, delta: 0.0018, gamma: 0.25}\n";
+  int n = 0;
+  detail::for_each_entry(grasp_controller_fields, [&](const auto& f) {
+    ++n;
+    GraspControllerSettings want;
+    using T = std::decay_t<decltype(want.*(f.member))>;
+    std::ostringstream value;
+    if constexpr (std::is_same_v<T, bool>) {
+      want.*(f.member) = !(want.*(f.member));
+      value << (want.*(f.member) ? "true" : "false");
+    } else if constexpr (std::is_integral_v<T>) {
+      want.*(f.member) = want.*(f.member) + 1;
+      value << want.*(f.member);
+    } else {
+      // 2x the default (or 0.5 where the default is 0 or the doubled value is refused)
+      const double d = want.*(f.member);
+      want.*(f.member) = d == 0.0 ? 0.5 : 1.1 * d;
+      if (!validate(want, nullptr)) want.*(f.member) = d == 0.0 ? 0.01 : 0.9 * d;
+      value.precision(17);
+      value << want.*(f.member);
+    }
+    ASSERT_TRUE(validate(want, nullptr)) << f.name;
+    const ParameterFile file = parse_parameter_file(base + "controller: {" + f.name + ": " + value.str() + "}\n");
+    EXPECT_EQ(to_string(file.controller), to_string(want)) << f.name;
+  });
+  EXPECT_EQ(n, 25);  // every setting of GraspControllerSettings (docs/controller.md)
+}
+
+TEST(ParamFile, BadControllerFieldsAreNamed) {
+  const std::string base = "contact: {mu: 0.5, beta_a: 1e7, sigma0: 16, sigma_z: 2, delta: 0.0018, gamma: 0.25}\n";
+  EXPECT_NE(error_of(base + "controller: {k_pp: 1}").find("controller.k_pp: unknown controller setting"), std::string::npos);
+  EXPECT_NE(error_of(base + "controller: {k_p: -1}").find("controller: k_p = -1"), std::string::npos);
+  EXPECT_NE(error_of(base + "controller: {command_ratio: 2.5}").find("controller.command_ratio: expected an integer"), std::string::npos);
+  EXPECT_NE(error_of(base + "controller: {feedforward: 3}").find("controller.feedforward: expected true or false"), std::string::npos);
+  EXPECT_NE(error_of(base + "controller: 5").find("expected a mapping of controller settings"), std::string::npos);
+  // the flat layout skips the block like the observer's
+  EXPECT_TRUE(parse_parameter_file("mu: 0.5\nbeta_a: 1e7\nsigma0: 16\nsigma_z: 2\ndelta: 0.0018\ngamma: 0.25\ncontroller: {f_max: 12}\n").has_controller);
 }
