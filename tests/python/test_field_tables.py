@@ -179,3 +179,30 @@ def test_docs_cor_settings_table_matches_the_struct():
     for field, (_meaning, _unit, rng, value) in rows.items():
         assert _default_matches(getattr(default, field), value), (field, value)
         _check_ranges(_core.validate_cor_settings, _core.CorSettings, field, rng, False)
+
+
+def test_docs_controller_table_names_real_settings_with_their_defaults():
+    """docs/conventions.md's table of the controller's additions to the paper: every row is a
+    field of GraspControllerSettings (the core's table, lugrip/grasp_controller_fields.hpp, as
+    the bindings expose it) and its default column starts with the compiled default ("on"/"off"
+    for a switch, a number with its unit otherwise). A field renamed or a default changed in
+    the code without the page fails here."""
+    text = (REPO / "docs" / "conventions.md").read_text()
+    start = text.index("| setting | default | what it does |")
+    rows = {}
+    for line in text[start:].splitlines()[2:]:
+        if not line.startswith("| `"):
+            break
+        cells = [c.strip() for c in line.strip("|").split("|")]
+        rows[cells[0].strip("`")] = cells[1]
+    assert len(rows) >= 8
+    fields = {f[0]: f[1] for f in _core.GraspControllerSettings.fields}
+    assert set(rows) <= set(fields), sorted(set(rows) - set(fields))
+    default = _core.GraspControllerSettings()
+    for name, text_default in rows.items():
+        value = getattr(default, name)
+        first = text_default.split()[0]
+        if fields[name] == "bool":
+            assert first == ("on" if value else "off"), (name, text_default)
+        else:
+            assert float(first) == pytest.approx(value, rel=1e-12), (name, text_default)
