@@ -54,6 +54,18 @@ std::string text(const YAML::Node& n, const std::string& where) {
   return n.Scalar();
 }
 
+// validate() on a read block; throws with its first bad field.
+template <class T>
+void validated(const T& value, const std::string& where) {
+  std::string msg;
+  if (!validate(value, &msg)) {
+    std::istringstream lines(msg);
+    std::string first;
+    std::getline(lines, first);
+    fail(where, first);
+  }
+}
+
 ContactParams read_contact(const YAML::Node& block, const std::string& where) {
   if (!block.IsMap()) fail(where, "expected a mapping of contact parameters");
   ContactParams p;
@@ -83,13 +95,7 @@ ContactParams read_contact(const YAML::Node& block, const std::string& where) {
     if (key != "k" && key != "c_max" && key != "static_ratio" && key != "kinetic_ratio") ++required;
   }
   if (required < 6) fail(where, "needs mu, beta_a, sigma0, sigma_z, delta and gamma");
-  std::string msg;
-  if (!validate(p, &msg)) {
-    std::istringstream lines(msg);
-    std::string first;
-    std::getline(lines, first);
-    fail(where, first);
-  }
+  validated(p, where);
   return p;
 }
 
@@ -140,13 +146,7 @@ ObserverSettings read_observer(const YAML::Node& block, const std::string& where
   }
   // The Python Observer's rule: a gain alone means a fixed gain.
   if (!mode) s.gain_mode = gain && !bandwidth ? GainMode::Fixed : GainMode::Bandwidth;
-  std::string msg;
-  if (!validate(s, &msg)) {
-    std::istringstream lines(msg);
-    std::string first;
-    std::getline(lines, first);
-    fail(where, first);
-  }
+  validated(s, where);
   return s;
 }
 
@@ -169,13 +169,7 @@ GraspControllerSettings read_controller(const YAML::Node& block, const std::stri
     });
     if (!known) fail(at, "unknown controller setting");
   }
-  std::string msg;
-  if (!validate(s, &msg)) {
-    std::istringstream lines(msg);
-    std::string first;
-    std::getline(lines, first);
-    fail(where, first);
-  }
+  validated(s, where);
   return s;
 }
 
