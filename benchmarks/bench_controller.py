@@ -36,11 +36,10 @@ from sections import markers, write_section  # noqa: E402
 #: the additions to the paper's law, each switched off alone
 SINGLE_OFF = {
     "no_slope_gain": {"gain_force": 0.0},
-    "no_feedforward": {"feedforward": False},
-    "no_slip_reflex": {"slip_reflex": False},
+    "no_load_floors": {"load_floors": False},
     "no_lag_overshoot": {"reaction_lag": 0.0},
     "no_ceiling": {"ceiling_factor": 0.0},
-    # the standing reserve the unseen scenes derive from their pulses (the paper's scenes have none)
+    # the push envelope the unseen scenes state (the paper's scenes have none)
     "no_reserve": {"reserve_force": 0.0, "reserve_torque": 0.0},
 }
 VARIANTS = {"default": {}, "paper": dict(lugrip.PAPER_SETTINGS), **SINGLE_OFF}

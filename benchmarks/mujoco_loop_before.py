@@ -143,7 +143,7 @@ def run_mujoco_loop(
     injector = _core.FaultInjector(fault_specs(faults), T_s) if faults else None
     limits = {
         k: getattr(ctrl.settings.controller, k)
-        for k in ("f_min", "f_max", "max_rate_up", "max_rate_down")
+        for k in ("f_min", "f_max", "max_rate")
     }
     events = sorted(_schedule(mode_schedule), key=lambda e: e[0]) if kind == "lugrip" else []
     rng = np.random.default_rng(plant.seed)

@@ -55,7 +55,7 @@ int main(int argc, char** argv) {
   lugrip::SlipControlSettings settings;     // observer at 500 Hz, controller defaults
   settings.controller.f_min = 0.2;          // [N] never less than this
   settings.controller.f_max = 15.0;         // [N] gripper limit
-  settings.controller.max_rate_up = 100.0;  // [N/s]
+  settings.controller.max_rate = 100.0;  // [N/s] the gripper's slew rate
   // Construction validates everything (rates included) and builds the contact tables: do it
   // before the loop. step() then never allocates, throws or blocks.
   lugrip::SlipControl control(lugrip::object_params("aluminium_can"), settings);

@@ -51,7 +51,7 @@ class FakeGripper:
 
 
 def main(params: str = "aluminium_can", realtime: bool = False) -> float:
-    control = lugrip.SlipControl(params, f_min=0.2, f_max=15.0, max_rate_up=100.0)
+    control = lugrip.SlipControl(params, f_min=0.2, f_max=15.0, max_rate=100.0)
     dt = control.settings.observer.dt
     gripper = FakeGripper()
     control.reset(gripper.force)  # start from the force the gripper holds now

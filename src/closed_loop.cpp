@@ -399,7 +399,7 @@ void ClosedLoop::cone_command() noexcept {
   double target = command_;
   if (u >= margin) target = std::max(command_, required);
   else if (cfg_.cone_release_rate > 0.0) target = std::max(required, command_ - cfg_.cone_release_rate * T);
-  const double f = clampd(target, command_ - s.max_rate_down * T, command_ + s.max_rate_up * T);
+  const double f = clampd(target, command_ - s.max_rate * T, command_ + s.max_rate * T);
   command_ = clampd(f, s.f_min, s.f_max);
   cone_fn_sum_ = {0.0, 0.0};
   cone_ft_sum_ = {0.0, 0.0};

@@ -6,6 +6,7 @@
 #include <stdexcept>
 
 #include "format.hpp"
+#include "lugrip/detail/fast_math.hpp"
 
 namespace lugrip {
 
@@ -49,6 +50,7 @@ constexpr double kPivotEndFilter = 0.2;       // [s] low-pass on mean |c~| of th
 constexpr double kPivotEndSlippage = 0.99;    // the test counts while max_i S_i is below this
 constexpr double kPivotFloorTime = 1.0;       // [s] pivoting ends after this long at the floor
 constexpr double kPivotTimeout = 10.0;        // [s] pivoting ends after this long
+constexpr double kPivotEndCTilde = 1.0;       // ... or when the low-passed mean |c~| exceeds this (the paper's end)
 
 // Shortest of %.15g / %.17g that reads back exactly.
 std::string fmt(double v) { return detail::format_number(v); }
@@ -87,7 +89,7 @@ bool validate(const GraspControllerSettings& s, std::string* message) {
   // |omega_hat| <= 1e6); derivation in docs/reliability.md §1.
   constexpr double kRateMin = 1.0e-3, kRateMax = 1.0e9;  // [Hz] sensor_rate
   constexpr int kRatioMax = 1000000;                     // command_ratio
-  constexpr double kGainMax = 1.0e9;                     // k_cd [N s/rad], k_p, k_f [N], k_i [N/s]
+  constexpr double kGainMax = 1.0e9;                     // k_cd [N s/rad], k_p [N], k_i [N/s]
   constexpr double kPoleMin = 1.0e-9, kCornerMax = 1.0e12;  // [rad/s] p_cd, z_cd
   constexpr double kForceMin = 1.0e-6, kForceMax = 1.0e6;   // [N] f_min, f_max, gain_force
   constexpr double kPivotMax = 1.0e3;                    // s_pivot (slippage inputs are <= 1e3)
@@ -112,8 +114,7 @@ bool validate(const GraspControllerSettings& s, std::string* message) {
   within("f_min", s.f_min, kForceMin, false, kForceMax, " [N]");
   if (!(std::isfinite(s.f_max) && s.f_max > s.f_min && s.f_max <= kForceMax))
     bad("f_max", s.f_max, "must be finite, > f_min and <= 1e+06 [N]");
-  positive_or_inf("max_rate_up", s.max_rate_up);
-  positive_or_inf("max_rate_down", s.max_rate_down);
+  positive_or_inf("max_rate", s.max_rate);
   if (!(std::isfinite(s.reaction_lag) && s.reaction_lag >= 0.0 && s.reaction_lag <= 1.0e3))
     bad("reaction_lag", s.reaction_lag, "must be finite, >= 0 and <= 1000 [s]");
   if (!(s.s_ref >= kSlippageMin && s.s_ref < 1.0)) bad("s_ref", s.s_ref, "must satisfy 1e-03 <= s_ref < 1");
@@ -136,8 +137,6 @@ bool validate(const GraspControllerSettings& s, std::string* message) {
   if (!(std::isfinite(s.s_pivot) && s.s_pivot > 1.0 && s.s_pivot <= kPivotMax))
     bad("s_pivot", s.s_pivot, "must be finite, > 1 and <= 1000");
   positive("tau_pivot", s.tau_pivot);
-  within("k_f", s.k_f, 0.0, true, kGainMax, " [N]");
-  positive("pivot_end_c_tilde", s.pivot_end_c_tilde);
   if (message) *message = msg;
   return msg.empty();
 }
@@ -147,24 +146,21 @@ std::string to_string(const GraspControllerSettings& s) {
   auto flag = [](bool b) { return std::string(b ? "True" : "False"); };
   return "GraspControllerSettings(sensor_rate=" + num(s.sensor_rate) +
          ", command_ratio=" + std::to_string(s.command_ratio) + ", f_min=" + num(s.f_min) +
-         ", f_max=" + num(s.f_max) + ", max_rate_up=" + num(s.max_rate_up) +
-         ", max_rate_down=" + num(s.max_rate_down) + ", reaction_lag=" + num(s.reaction_lag) +
+         ", f_max=" + num(s.f_max) + ", max_rate=" + num(s.max_rate) + ", reaction_lag=" + num(s.reaction_lag) +
          ", s_ref=" + num(s.s_ref) + ", k_p=" + num(s.k_p) + ", k_i=" + num(s.k_i) +
          ", gain_force=" + num(s.gain_force) +
-         ", dynamic_enabled=" + flag(s.dynamic_enabled) + ", k_cd=" + num(s.k_cd) + ", p_cd=" + num(s.p_cd) +
-         ", z_cd=" + num(s.z_cd) + ", feedforward=" + flag(s.feedforward) + ", slip_reflex=" + flag(s.slip_reflex) +
+         ", k_cd=" + num(s.k_cd) + ", p_cd=" + num(s.p_cd) +
+         ", z_cd=" + num(s.z_cd) + ", load_floors=" + flag(s.load_floors) +
          ", reserve_force=" + num(s.reserve_force) + ", reserve_torque=" + num(s.reserve_torque) +
          ", ceiling_factor=" + num(s.ceiling_factor) + ", mu_probe=" + num(s.mu_probe) +
-         ", s_pivot=" + num(s.s_pivot) + ", tau_pivot=" + num(s.tau_pivot) + ", k_f=" + num(s.k_f) +
-         ", pivot_end_c_tilde=" + num(s.pivot_end_c_tilde) + ")";
+         ", s_pivot=" + num(s.s_pivot) + ", tau_pivot=" + num(s.tau_pivot) + ")";
 }
 
 GraspControllerSettings paper_settings() noexcept {
   GraspControllerSettings s;
   s.k_i = 10.0;
   s.gain_force = 0.0;
-  s.feedforward = false;
-  s.slip_reflex = false;
+  s.load_floors = false;
   s.reaction_lag = 0.0;
   s.ceiling_factor = 0.0;
   s.mu_probe = 0.0;
@@ -270,8 +266,8 @@ void GraspController::request_pivoting() noexcept { request_ = Request::Pivot; }
 void GraspController::request_slipping_avoidance() noexcept { request_ = Request::Avoid; }
 
 void GraspController::set_dynamic_enabled(bool enabled) noexcept {
-  if (enabled && !s_.dynamic_enabled) reset_dynamic();
-  s_.dynamic_enabled = enabled;
+  if (enabled && !dynamic_) reset_dynamic();
+  dynamic_ = enabled;
 }
 
 void GraspController::set_settings(const GraspControllerSettings& settings) {
@@ -281,11 +277,7 @@ void GraspController::set_settings(const GraspControllerSettings& settings) {
     throw std::invalid_argument(
         "GraspController::set_settings: sensor_rate, command_ratio, k_cd, p_cd and z_cd are fixed "
         "at construction");
-  const bool dynamic = settings.dynamic_enabled;
-  GraspControllerSettings next = settings;
-  next.dynamic_enabled = s_.dynamic_enabled;
-  s_ = next;
-  set_dynamic_enabled(dynamic);
+  s_ = settings;
   pivot_decay_ = std::exp(-t_cmd_ / s_.tau_pivot);
   command_ = clamp(command_, s_.f_min, s_.f_max);
   last_.force = command_;
@@ -340,7 +332,7 @@ Status GraspController::step(const GraspControllerInput& in, GraspControllerOutp
   request_ = Request::None;
 
   // Per-finger checks, C_d at the sensor rate, combination (docs/model.md 9.8).
-  const bool dynamic = mode_ == ControllerMode::SlippingAvoidance && s_.dynamic_enabled;
+  const bool dynamic = mode_ == ControllerMode::SlippingAvoidance && dynamic_;
   bool any_present = false, valid = true;
   Status worst = Status::Ok;
   double slip = 0.0, c_sum = 0.0, f_t_max = 0.0;
@@ -423,7 +415,7 @@ Status GraspController::step(const GraspControllerInput& in, GraspControllerOutp
       pivot_c_init_ = false;
     }
     const bool settled = pivot_at_floor_ && slip < kPivotEndSlippage;
-    if (valid && settled && pivot_c_filtered_ > s_.pivot_end_c_tilde)
+    if (valid && settled && pivot_c_filtered_ > kPivotEndCTilde)
       pivot_count_ = pivot_count_ < kCountMax ? pivot_count_ + 1 : pivot_count_;
     else
       pivot_count_ = 0;
@@ -497,7 +489,7 @@ void GraspController::issue_command(bool valid, double slip) noexcept {
       double n_slope = 1.0;
       double lift = std::min(reaction_floor(n_slope, c), s_.f_max);
       if (lift > f_est_ && lag > 0.0) lift += (lift - f_est_) * lag / (1.0 - lag);
-      f = std::max(f, std::min(lift, command_ + s_.max_rate_up * t_cmd_));
+      f = std::max(f, std::min(lift, command_ + s_.max_rate * t_cmd_));
     }
     command_ = clamp(f, s_.f_min, s_.f_max);
     f_est_ = command_ + (f_est_ - command_) * lag;
@@ -587,7 +579,7 @@ void GraspController::issue_command(bool valid, double slip) noexcept {
     last_e_ = e;
     c.gain_p = k_p;
     c.gain_i = k_i;
-    if (s_.dynamic_enabled) {
+    if (dynamic_) {
       const double head_room = hi - f_ns;
       // With the ceiling on, the dynamic part adds at most kDynamicCap of the static part: it
       // answers a slip's speed, not the load, and a lift-off's transfer slip would otherwise
@@ -597,7 +589,8 @@ void GraspController::issue_command(bool valid, double slip) noexcept {
       if (peak_ > head_room) c.saturated = true;
     }
   } else {
-    // tau_p df/dt = -f + k_f (S - s_pivot), exact discretisation at the command rate; output is
+    // tau_p df/dt = -f + k_p (S - s_pivot) (the filter gain k_f = k_p, docs/model.md 9.6), exact
+    // discretisation at the command rate; output is
     // the state before the update, so the first pivoting command equals the last command.
     clear_period();
     c.probing = false;
@@ -609,7 +602,7 @@ void GraspController::issue_command(bool valid, double slip) noexcept {
     }
     pivot_state_ = clamp(pivot_state_, floor, s_.f_max);
     f_ns = pivot_state_;
-    pivot_state_ = pivot_decay_ * pivot_state_ + (1.0 - pivot_decay_) * s_.k_f * e;
+    pivot_state_ = pivot_decay_ * pivot_state_ + (1.0 - pivot_decay_) * s_.k_p * e;
     pivot_at_floor_ = pivot_state_ <= floor;  // the filter wants to go below the floor
     pivot_state_ = clamp(pivot_state_, floor, s_.f_max);
   }
@@ -619,7 +612,7 @@ void GraspController::issue_command(bool valid, double slip) noexcept {
   // Reaction through the gripper's lag: overshoot so the force reaches the target in one period.
   if (reacting && lag > 0.0 && target > f_est_)
     target = std::min(target + (std::min(target, s_.f_max) - f_est_) * lag / (1.0 - lag), hi);
-  double f = clamp(target, command_ - s_.max_rate_down * t_cmd_, command_ + s_.max_rate_up * t_cmd_);
+  double f = clamp(target, command_ - s_.max_rate * t_cmd_, command_ + s_.max_rate * t_cmd_);
   c.rate_limited = f != target;
   f = clamp(std::max(f, floor), s_.f_min, s_.f_max);
   command_ = f;
@@ -789,7 +782,7 @@ double GraspController::reaction_floor(double& slope_exponent, GraspControllerOu
   c.feedforward_force = lift;
   c.reserve_force = reserve_force_;
   c.reserve_torque = reserve_torque_;
-  if (s_.slip_reflex && reflex_armed_) {
+  if (s_.load_floors && reflex_armed_) {
     // On the grip the contact slid at: the static part (a transient f_nd would otherwise be
     // multiplied into f_ns), or the measured f_n when the gripper has not reached it yet (a
     // raise still on its way is not a grip that failed; compounding the command while the
@@ -813,11 +806,17 @@ double GraspController::static_floor(double& slope_exponent) noexcept {
   double force = 0.0, s_max = -1.0;
   slope_exponent = 1.0;
   // Mean-load force of each finger and the grasp's (the largest): the trend test's reference.
+  // Each finger's mean load: its map (one evaluation) serves the feed-forward, the ceiling and
+  // the slope.
   std::array<double, kMaxFingers> f_mean{};
+  std::array<StaticLoadMap, kMaxFingers> maps{};
   double f_grasp = 0.0;
   for (int i = 0; i < kMaxFingers; ++i) {
-    if (n_load_[i] == 0 || !s_.feedforward) continue;
-    f_mean[i] = solver_.solve(sum_f_t_[i] / n_load_[i], sum_tau_[i] / n_load_[i], kFeedforwardSlippage).force;
+    if (n_load_[i] == 0) continue;
+    const double ft = sum_f_t_[i] / n_load_[i], tau = sum_tau_[i] / n_load_[i];
+    if (s_.load_floors || s_.ceiling_factor > 0.0 || s_.gain_force > 0.0) maps[i] = solver_.map(ft, tau);
+    if (!s_.load_floors) continue;
+    f_mean[i] = solver_.solve(maps[i], ft, tau, kFeedforwardSlippage).force;
     if (std::isfinite(f_mean[i])) f_grasp = std::max(f_grasp, f_mean[i]);
   }
   floor_measured_ = f_grasp;
@@ -828,7 +827,8 @@ double GraspController::static_floor(double& slope_exponent) noexcept {
     const double n = n_load_[i];
     const double ft = sum_f_t_[i] / n, tau = sum_tau_[i] / n;
     double load_ft = ft, load_tau = tau;  // the load the feed-forward answers (mean or trend)
-    if (s_.feedforward) {
+    bool trend = false;
+    if (s_.load_floors) {
       double f = f_mean[i];
       const double f_ref = f_grasp;  // a light finger's extrapolated noise is no edge
       const double den = n * sum_kk_[i] - sum_k_[i] * sum_k_[i];
@@ -845,15 +845,17 @@ double GraspController::static_floor(double& slope_exponent) noexcept {
           f = fx;
           load_ft = std::max(0.0, ft + slope_f * ahead);
           load_tau = tau + slope_t * ahead;
+          trend = true;
         }
       }
       if (std::isfinite(f)) force = std::max(force, f);
     }
     if (s_.ceiling_factor > 0.0) {  // the grip this load needs at S = 1
-      const double f = solver_.solve(load_ft, load_tau, 1.0).force;
+      const double f = trend ? solver_.solve(load_ft, load_tau, 1.0).force
+                             : solver_.solve(maps[i], load_ft, load_tau, 1.0).force;
       if (std::isfinite(f)) ceiling_load_ = std::max(ceiling_load_, f);
     }
-    if (s_.feedforward) {  // the pushes seen: the part of the load that came and went
+    if (s_.load_floors) {  // the pushes seen: the part of the load that came and went
       const double at = std::fabs(tau);
       if (!peak_valid_[i]) {
         peak_ft_[i] = ft;
@@ -882,7 +884,12 @@ double GraspController::static_floor(double& slope_exponent) noexcept {
       if (std::isfinite(f)) ceiling_load_ = std::max(ceiling_load_, f);
     }
     if (s_.gain_force > 0.0) {
-      const double s0 = solver_.slippage(command_, ft, tau), s1 = solver_.slippage(kStep * command_, ft, tau);
+      // the map is exact at S <= 1 (inside the LS or at the clip); beyond, the estimator itself
+      double s0 = maps[i].slippage(command_), s1 = maps[i].slippage(kStep * command_);
+      if (!(s0 <= 1.0 && s1 <= 1.0)) {
+        s0 = solver_.slippage(command_, ft, tau);
+        s1 = solver_.slippage(kStep * command_, ft, tau);
+      }
       if (std::isfinite(s0) && std::isfinite(s1) && s0 > 0.0 && s1 > 0.0 && s0 > s_max) {
         s_max = s0;
         slope_exponent = clamp(std::log(s0 / s1) / std::log(kStep), 1.0, 1.0 + gamma_);
@@ -915,12 +922,68 @@ double StaticForceSolver::slippage(double f_n, double f_t, double tau, double* c
   est_.step(CorInput{f_n, std::fabs(f_t), tau}, o);
   if (!is_valid(o.status) || !(o.g > 0.0)) return nan;
   if (c_tilde) *c_tilde = std::fabs(o.c_tilde);
+  last_g_ = o.g;
+  last_rho_ = o.rho;
   // |tau - c f_t| = |tau| + |c| f_t (tau and c have opposite signs, docs/model.md 6). Equal to |y| of
   // the estimator except for a torque below its zero threshold, whose sign it holds from history.
   return (std::fabs(tau) + std::fabs(o.c) * std::fabs(f_t)) / o.g;
 }
 
+StaticLoadMap StaticForceSolver::map(double f_t, double tau) noexcept {
+  StaticLoadMap m;
+  const double ft = std::fabs(f_t);
+  if (!(std::isfinite(ft) && std::isfinite(tau)) || (ft == 0.0 && tau == 0.0)) return m;
+  const ContactParams& p = est_.model().params();
+  m.pw = 1.0 + p.gamma;
+  // 1.25 (f_tr + f_rot) at S = 1 puts the load inside the diamond |f~_t| + |tau~| <= 0.8, so
+  // inside the (convex) LS, where |c~| is the one of every root at S <= 1
+  const double f_tr = ft / p.mu;
+  const double f_rot = std::pow(std::fabs(tau) / (p.mu * est_.model().xi() * p.delta), 1.0 / m.pw);
+  m.f0 = 1.25 * (f_tr + f_rot);
+  double c0 = 0.0;
+  const double s0 = slippage(m.f0, ft, tau, &c0);
+  if (!(std::isfinite(s0) && s0 > 0.0)) return m;
+  m.a = std::fabs(tau) / last_g_;
+  m.b = c0 * last_rho_ * ft / last_g_;
+  m.valid = true;
+  return m;
+}
+
+double StaticLoadMap::slippage(double f_n) const noexcept {
+  if (!(valid && f_n > 0.0)) return std::numeric_limits<double>::quiet_NaN();
+  const double x = f0 / f_n;
+  return (a > 0.0 ? a * detail::fast_pow_pos(x, pw) : 0.0) + b * x;
+}
+
+double StaticLoadMap::root(double s_ref) const noexcept {
+  constexpr double nan = std::numeric_limits<double>::quiet_NaN();
+  if (!(valid && s_ref > 0.0)) return nan;
+  // x = f0 / f: each term alone reaches s_ref at or beyond the root; Newton's method on the
+  // convex, increasing A x^pw + B x - s_ref from there converges monotonically.
+  double x = std::numeric_limits<double>::infinity();
+  if (a > 0.0) x = detail::fast_pow_pos(s_ref / a, 1.0 / pw);
+  if (b > 0.0) x = std::min(x, s_ref / b);
+  if (!(std::isfinite(x) && x > 0.0)) return nan;
+  for (int i = 0; i < 60; ++i) {
+    const double ax = a > 0.0 ? a * detail::fast_pow_pos(x, pw) : 0.0;
+    const double dx = (ax + b * x - s_ref) * x / (pw * ax + b * x);
+    x -= dx;
+    if (!(x > 0.0) || std::fabs(dx) <= 1e-15 * x) break;
+  }
+  return std::isfinite(x) && x > 0.0 ? f0 / x : nan;
+}
+
 StaticForceResult StaticForceSolver::solve(double f_t, double tau, double s_ref) noexcept {
+  if (std::isfinite(f_t) && std::isfinite(tau) && s_ref > 0.0 && s_ref <= 1.0 && (f_t != 0.0 || tau != 0.0)) {
+    const StaticLoadMap m = map(f_t, tau);
+    StaticForceResult r = solve(m, f_t, tau, s_ref);
+    ++r.iterations;  // the map's evaluation
+    return r;
+  }
+  return solve(StaticLoadMap{}, f_t, tau, s_ref);
+}
+
+StaticForceResult StaticForceSolver::solve(const StaticLoadMap& map, double f_t, double tau, double s_ref) noexcept {
   constexpr double nan = std::numeric_limits<double>::quiet_NaN();
   constexpr int kMaxExpand = 120, kMaxRefine = 100;
   StaticForceResult r;
@@ -934,6 +997,36 @@ StaticForceResult StaticForceSolver::solve(double f_t, double tau, double s_ref)
     return r;
   }
   const ContactParams& p = est_.model().params();
+  // Guess: the larger of the pure-translation and pure-torsion forces at S = s_ref.
+  const double f_tr = ft / (p.mu * s_ref);
+  const double f_rot = std::pow(std::fabs(tau) / (p.mu * est_.model().xi() * p.delta * s_ref),
+                                1.0 / (1.0 + p.gamma));
+  double start = std::max(f_tr, f_rot);
+  // The map in closed form (the map's root), checked by one evaluation; a check that fails
+  // (a zero threshold of the estimator crossed, a degenerate load) gives a new map from that
+  // evaluation, twice at most, then the bracket below takes over from there.
+  StaticLoadMap m = map;
+  for (int pass = 0; pass < 3 && m.valid; ++pass) {
+    const double f = m.root(s_ref);
+    if (!(std::isfinite(f) && f > 0.0)) break;
+    ++r.iterations;
+    double c = 0.0;
+    const double s = slippage(f, ft, tau, &c);
+    if (!(std::isfinite(s) && s > 0.0)) break;
+    start = f;
+    // S at the LS itself (s_ref = 1) is computed by either branch of the estimator, which agree
+    // to its own tolerance: the check allows 1e-10 (the force to ~1e-10 relative)
+    if (std::fabs(s - s_ref) <= 1e-10 * s_ref) {
+      r.force = f;
+      r.slippage = s;
+      r.c_tilde = c;
+      r.converged = true;
+      return r;
+    }
+    m.f0 = f;
+    m.a = std::fabs(tau) / last_g_;
+    m.b = c * last_rho_ * ft / last_g_;
+  }
   // Residual in logs: S_static decreases with f_n, roughly as a power law.
   const double log_ref = std::log(s_ref);
   auto residual = [&](double x) {
@@ -941,11 +1034,7 @@ StaticForceResult StaticForceSolver::solve(double f_t, double tau, double s_ref)
     const double s = slippage(std::exp(x), ft, tau);
     return std::isfinite(s) && s > 0.0 ? std::log(s) - log_ref : nan;
   };
-  // Guess: the larger of the pure-translation and pure-torsion forces at S = s_ref.
-  const double f_tr = ft / (p.mu * s_ref);
-  const double f_rot = std::pow(std::fabs(tau) / (p.mu * est_.model().xi() * p.delta * s_ref),
-                                1.0 / (1.0 + p.gamma));
-  double lo = std::log(std::max(f_tr, f_rot)), hi = lo;
+  double lo = std::log(start), hi = lo;
   double r_lo = residual(lo), r_hi = r_lo;
   if (!std::isfinite(r_lo)) {
     r.force = r.c_tilde = r.slippage = nan;

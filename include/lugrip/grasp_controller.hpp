@@ -30,8 +30,7 @@ struct GraspControllerSettings {
   int command_ratio = 10;      //!< step() calls per force command (500 Hz / 50 Hz), >= 1
   double f_min = 0.1;   //!< [N] minimum force (keeps contact), > 0
   double f_max = 20.0;  //!< [N] maximum force (gripper limit), > f_min
-  double max_rate_up = 200.0;    //!< (*) [N/s] limit on command increase, > 0 (inf: off)
-  double max_rate_down = 200.0;  //!< (*) [N/s] limit on command decrease, > 0 (inf: off)
+  double max_rate = 200.0;  //!< (*) [N/s] the gripper's slew rate: limit on command changes, > 0 (inf: off)
   //! (*) [s] default 0.03; 0 = off (paper). The gripper's force time constant: when the
   //! feed-forward or the reflex lifts the static part above the force the gripper is estimated to
   //! apply (f_est: the commands through this first-order lag), the command overshoots the target
@@ -52,31 +51,31 @@ struct GraspControllerSettings {
   double gain_force = 6.4;
 
   // --- dynamic part f_nd = |C_d omega_hat|, C_d(s) = k_cd (s + z_cd)/(s + p_cd) (eqs. 35-36) --
-  bool dynamic_enabled = true;  //!< (*) dynamic part active in slipping avoidance
+  // (on at construction; GraspController::set_dynamic_enabled() switches it, as the paper's
+  // static and dynamic slipping avoidance are two operating modes)
   double k_cd = 10.0;   //!< [N s/rad] high-frequency gain, > 0
   double p_cd = 7.0;    //!< [rad/s] pole, > 0
   double z_cd = 250.0;  //!< [rad/s] zero, > p_cd (lag network, DC gain k_cd z_cd / p_cd)
 
   // --- floors and ceiling from the measured load (not in the paper; docs/controller.md) ------
-  //! (*) default true; false = paper. At each command the static part is raised to at least the
-  //! static grasp force (StaticForceSolver at S = 0.9) of the load measured over the last
-  //! command period (mean f_t and tau of each valid finger, the larger force), or of that load
-  //! extrapolated 30 ms ahead along its trend when that asks 50 % more (a load still rising at
-  //! the command); the integrator restarts there. It also learns a reserve from the pushes seen
-  //! (0.6 of the load's excursions below its peak, both forgetting over 10 s; the floor then
-  //! holds the load plus that reserve at S = 1, as reserve_force below). Not applied while
-  //! pivoting.
-  bool feedforward = true;
-  //! (*) default true; false = paper. Slip reflex: when S = max_i S_i is at or above 0.93 on 3
-  //! valid samples of one command period (anywhere in it: a chattering slide alternates S around
-  //! the bound), the next command raises the static part to at least 1.25 x the grip the contact
-  //! slid at (the last static part, or the measured f_n while the force lags). It acts whether
-  //! or not the slip speed is observable (with Coulomb-like pads C_d adds nothing).
-  bool slip_reflex = true;
+  //! (*) default true; false = paper. The floors of the static part, from the measured load
+  //! (the integrator restarts at a floor that lifts it; none while pivoting):
+  //! - feed-forward: the static grasp force (StaticForceSolver at S = 0.9) of the load measured
+  //!   over the last command period (mean f_t and tau of each valid finger, the larger force),
+  //!   or of that load extrapolated 30 ms ahead along its trend when that asks 50 % more (a
+  //!   load still rising at the command);
+  //! - a reserve learned from the pushes seen (0.6 of the load's excursions below its peak,
+  //!   both forgetting over 10 s): the load plus that reserve held at S = 1, as reserve_force;
+  //! - slip reflex: when S = max_i S_i is at or above 0.93 on 3 valid samples of one command
+  //!   period (anywhere in it: a chattering slide alternates S around the bound), 1.25 x the
+  //!   grip the contact slid at (the last static part, or the measured f_n while the force
+  //!   lags), whether or not the slip speed is observable (with Coulomb-like pads C_d adds
+  //!   nothing).
+  bool load_floors = true;
   //! (*) [N] default 0 = off. The task's envelope of pushes per finger: the static part is
   //! floored at the static grasp force at S = 1 of the measured load with reserve_force added
   //! to |f_t| and reserve_torque to |tau| (such a push then keeps the contact at its limit while
-  //! the reaction is on its way); where the reserve learned from the pushes (feedforward) is
+  //! the reaction is on its way); where the reserve learned from the pushes (load_floors) is
   //! larger, that one. >= 0, finite.
   double reserve_force = 0.0;
   double reserve_torque = 0.0;  //!< (*) [N m] default 0 = off; the twist to absorb. >= 0, finite.
@@ -101,10 +100,9 @@ struct GraspControllerSettings {
   double mu_probe = 0.0;
 
   // --- pivoting mode (docs/model.md 9.6) -----------------------------------------------------------
+  // (the filter's gain is k_p, docs/model.md 9.6; the manoeuvre ends at mean |c~_i| > 1, the paper's)
   double s_pivot = 1.3;      //!< (*) reference S-bar_p, > 1
   double tau_pivot = 2.0;    //!< (*) [s] time constant tau_p of the pivoting filter, > 0
-  double k_f = 4.0;          //!< (*) [N] gain of the pivoting filter (paper: k_f = k_p), > 0
-  double pivot_end_c_tilde = 1.0;   //!< (*) pivoting ends when mean |c~_i| exceeds this, > 0
 };
 
 //! The paper's law (eqs. 34-37): constant PI gains k_p = 4 N, k_i = 10 N/s, C_d as above, no
@@ -130,7 +128,7 @@ enum class ControllerMode : int {
 //! Why pivoting ended (reported in the call where it ends). Stable integer values.
 enum class PivotEnd : int {
   None = 0,          //!< pivoting did not end in this call
-  CorThreshold = 1,  //!< low-passed mean |c~| > pivot_end_c_tilde on 3 consecutive samples
+  CorThreshold = 1,  //!< low-passed mean |c~| > 1 on 3 consecutive samples
   Timeout = 2,       //!< 10 s of pivoting elapsed
   Requested = 3,     //!< request_slipping_avoidance() while pivoting
   AtFloor = 4,       //!< the pivoting filter was held at its floor for 1 s
@@ -247,13 +245,30 @@ class LagFilter {
 //! to in stick. (For a torque below the estimator's zero threshold, whose sign the estimator
 //! holds from history, the load-motion sign rule is applied instead: at most 1e-4 tau_max.)
 //! It decreases with f_n, so the force where the static controller settles, S_static = s_ref,
-//! is found by a bracket (doubling) and a safeguarded secant (Illinois) on log f_n.
+//! is one root: for a fixed load |c~| does not depend on f_n and S_static(f_n) = A f_n^-(1+gamma)
+//! + B f_n^-1, whose constants one evaluation gives (Newton's method on that, checked by a second
+//! evaluation); where the check fails, a bracket (doubling) and a safeguarded secant (Illinois)
+//! on log f_n.
 struct StaticForceResult {
   double force = 0.0;     //!< f_n [N] with S_static(f_n) = s_ref (0 for a zero load, NaN if invalid)
   double c_tilde = 0.0;   //!< |c~| estimated at that force [-]
   double slippage = 0.0;  //!< S_static at that force [-]
   int iterations = 0;     //!< S_static evaluations spent
   bool converged = false; //!< relative tolerance 1e-12 on f_n reached within the bound
+};
+
+//! S_static of one load as a function of f_n in closed form, S = a x^pw + b x with x = f0 / f_n
+//! and pw = 1 + gamma (one evaluation of the map gives a and b, StaticForceSolver::map): exact
+//! for every f_n where the load lies inside the LS or |c~| is at its clip, i.e. wherever S <= 1,
+//! up to the estimator's zero thresholds.
+struct StaticLoadMap {
+  double f0 = 0.0;  //!< [N] force of the evaluation
+  double a = 0.0;   //!< torsional term at f0, |tau| / g [-]
+  double b = 0.0;   //!< translational term at f0, |c| |f_t| / g [-]
+  double pw = 1.0;  //!< 1 + gamma
+  bool valid = false;
+  double slippage(double f_n) const noexcept;  //!< S_static at f_n (NaN unless valid, f_n > 0)
+  double root(double s_ref) const noexcept;    //!< f_n [N] with slippage(f_n) = s_ref (Newton)
 };
 
 class StaticForceSolver {
@@ -267,6 +282,12 @@ class StaticForceSolver {
   double slippage(double f_n, double f_t, double tau, double* c_tilde = nullptr) noexcept;
   //! Per-finger static grasp force for the load (f_t, tau) and reference s_ref in (0, 1].
   StaticForceResult solve(double f_t, double tau, double s_ref = 0.8) noexcept;
+  //! The closed form of S_static for the load (f_t, tau) from one evaluation (invalid for no
+  //! load or a non-finite one).
+  StaticLoadMap map(double f_t, double tau) noexcept;
+  //! solve() from that load's map (one evaluation checks the map's root): several references
+  //! of one load cost one evaluation each.
+  StaticForceResult solve(const StaticLoadMap& map, double f_t, double tau, double s_ref) noexcept;
 
   const ContactModel& model() const noexcept { return est_.model(); }
   //! ContactModel::set_mu on the solver's model (no allocation); false: mu out of range.
@@ -274,6 +295,7 @@ class StaticForceSolver {
 
  private:
   CorEstimator est_;
+  double last_g_ = 0.0, last_rho_ = 0.0;  // g and rho of the last slippage() evaluation
 };
 
 //! Two-mode grasp-force controller f_n = f_ns + f_nd (eq. 34, docs/model.md 9).
@@ -285,9 +307,9 @@ class StaticForceSolver {
 //! * Slipping avoidance: f_ns = k_p e + I, e = S - s_ref, forward-Euler integrator at the command
 //!   rate; f_ns clipped to [f_min, f_max] with back-calculation anti-windup; f_nd = the peak of
 //!   |C_d omega_hat| over the last command period clipped to [0, f_max - f_ns].
-//! * Pivoting: f_nd = 0; tau_p df/dt = -f + k_f (S - s_pivot), exact discretisation at the
+//! * Pivoting: f_nd = 0; tau_p df/dt = -f + k_p (S - s_pivot), exact discretisation at the
 //!   command rate, started from the last command; floor max(f_min, 1.1 max_i |f_t,i| / mu)
-//!   on the output and the filter state; ends on mean |c~_i| > pivot_end_c_tilde for
+//!   on the output and the filter state; ends on mean |c~_i| > 1 for
 //!   3 consecutive sensor samples (mean |c~_i| low-passed with a 0.2 s time constant; counted
 //!   only while the pivoting filter is held at the floor and max_i S_i < 0.99), after 1 s at
 //!   the floor, after 10 s, or on request, then returns to
@@ -299,8 +321,8 @@ class StaticForceSolver {
 //!   SensorFault, NoContact): its C_d state is held; a command due in such a call holds the last
 //!   command, never lower, and the static law restarts bumplessly.
 //! * Beyond the paper (each a setting, docs/controller.md): PI gains from the plant's slope
-//!   (gain_force), a floor on the static part from the static grasp force of the measured load
-//!   (feedforward, reserve), a ceiling from the same load (ceiling_factor) and a grip probe that
+//!   (gain_force), floors on the static part from the static grasp force of the measured load
+//!   and a slip reflex (load_floors, reserve), a ceiling from the same load (ceiling_factor) and a grip probe that
 //!   learns mu (mu_probe). They act in slipping avoidance only, on the static part, before the
 //!   force range and the rate limits.
 class GraspController {
@@ -325,8 +347,10 @@ class GraspController {
   void request_pivoting() noexcept;
   void request_slipping_avoidance() noexcept;
 
-  //! Enables/disables the dynamic part; re-enabling resets the C_d states.
+  //! Switches the dynamic part between the paper's dynamic (on, the state after construction)
+  //! and static slipping avoidance; re-enabling resets the C_d states. Kept by reset().
   void set_dynamic_enabled(bool enabled) noexcept;
+  bool dynamic_enabled() const noexcept { return dynamic_; }
   //! Replaces the settings marked (*) (rates, C_d and force range must not change); throws
   //! std::invalid_argument when invalid or when a fixed field differs.
   void set_settings(const GraspControllerSettings& settings);
@@ -379,6 +403,7 @@ class GraspController {
   std::array<LagFilter, kMaxFingers> cd_{};
   ControllerMode mode_ = ControllerMode::SlippingAvoidance;
   Request request_ = Request::None;
+  bool dynamic_ = true;       // the dynamic part is active in slipping avoidance
   bool init_static_ = true;   // bumpless (re)start of the static law at the next command
   int phase_ = 0;             // calls since the last command
   double command_ = 0.0;      // last command [N]
@@ -427,7 +452,7 @@ class GraspController {
   double probe_base_ = 0.0;   // static part when the probe started [N]
   bool probe_slip_ = false;   // the last evaluated probe found slip
 
-  // reserve learned from the pushes (feedforward): per finger, the decaying peak of the
+  // reserve learned from the pushes (load_floors): per finger, the decaying peak of the
   // period-mean load (|f_t| [N], |tau| [N m]) and the excursion learned from it
   std::array<double, kMaxFingers> peak_ft_{}, peak_tau_{}, learned_ft_{}, learned_tau_{};
   std::array<bool, kMaxFingers> peak_valid_{};

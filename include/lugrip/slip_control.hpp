@@ -102,10 +102,8 @@ class SlipControl {
 
   void request_pivoting() noexcept { ctrl_.request_pivoting(); }                      //!< at the next step()
   void request_slipping_avoidance() noexcept { ctrl_.request_slipping_avoidance(); }  //!< at the next step()
-  void set_dynamic_enabled(bool enabled) noexcept {
-    ctrl_.set_dynamic_enabled(enabled);
-    s_.controller.dynamic_enabled = enabled;
-  }
+  //! The paper's dynamic (on, after construction) or static slipping avoidance (off).
+  void set_dynamic_enabled(bool enabled) noexcept { ctrl_.set_dynamic_enabled(enabled); }
 
   //! Replaces the told friction coefficient of the observers and the controller (the
   //! per-object refit, docs/model.md §8.1); the controller's learned belief restarts from it.

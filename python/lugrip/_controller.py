@@ -66,7 +66,7 @@ class PivotEnd(enum.IntEnum):
     """Why pivoting ended; values equal the C++ lugrip::PivotEnd."""
 
     NONE = 0
-    COR_THRESHOLD = 1  #: low-passed mean |c~| > pivot_end_c_tilde on 3 consecutive samples
+    COR_THRESHOLD = 1  #: low-passed mean |c~| > 1 on 3 consecutive samples
     TIMEOUT = 2
     REQUESTED = 3
     AT_FLOOR = 4  #: the pivoting filter held at its floor for 1 s
@@ -166,7 +166,7 @@ class GraspController(NoCopy):
       is handed to the command; clipped to the head-room [0, f_max - f_ns].
     * Static part: PI on e = S - s_ref (e > 0 raises the force), forward Euler at the command
       rate, clipped to [f_min, f_max] with back-calculation anti-windup, bumpless starts.
-    * Pivoting: f_nd = 0, tau_p df/dt = -f + k_f (S - s_pivot) (exact discretisation), floor
+    * Pivoting: f_nd = 0, tau_p df/dt = -f + k_p (S - s_pivot) (exact discretisation), floor
       max(f_min, 1.1 f_t / mu); ends when a 0.2 s low-pass of the mean |c~_i| exceeds 1 on 3
       samples while the force sits at that floor and S < 0.99 (the paper: the sample's mean
       |c~_i| on 3 samples from the start), after 1 s at the floor, after 10 s or on request, then returns bumplessly to slipping avoidance.
@@ -180,12 +180,12 @@ class GraspController(NoCopy):
             contact model for the feed-forward and the slope).
         **settings: any GraspControllerSettings field (see :func:`controller_settings` for the
             names and defaults): the gripper (sensor_rate [Hz], command_ratio, f_min, f_max [N],
-            max_rate_up, max_rate_down [N/s], inf = off), the PI (s_ref, k_p [N], k_i [N/s],
+            max_rate [N/s], inf = off), the PI (s_ref, k_p [N], k_i [N/s],
             gain_force [N]: gains that follow the plant's slope dS/df_n, 0 = constant), C_d
-            (dynamic_enabled, k_cd [N s/rad], p_cd, z_cd [rad/s]), the floors and ceiling from
-            the measured load (feedforward, reserve_force [N], reserve_torque [N m],
-            ceiling_factor), mu_probe: the grip probe that learns mu (needs f_n; output
-            mu_belief), pivoting (s_pivot, tau_pivot [s], k_f [N], pivot_end_c_tilde). See
+            (k_cd [N s/rad], p_cd, z_cd [rad/s]; :meth:`set_dynamic_enabled` switches it), the
+            floors and ceiling from the measured load (load_floors, reserve_force [N],
+            reserve_torque [N m], ceiling_factor), mu_probe: the grip probe that learns mu
+            (needs f_n; output mu_belief), pivoting (s_pivot, tau_pivot [s]). See
             :data:`PAPER_SETTINGS` for the paper's law.
 
     Raises:
@@ -278,7 +278,7 @@ class GraspController(NoCopy):
             omega_resolution: the observer's speed resolution [rad/s] (``omega_resolution`` of
                 its output): the dead band of C_d's input.
             tau: measured torsional moment [N m] (signed), with f_t the load of the
-                feed-forward and of the slope (``feedforward``, ``gain_force``).
+                feed-forward and of the slope (``load_floors``, ``gain_force``).
             f_n: measured normal force [N] (the grip probe, ``mu_probe``; 0: unknown, no probe).
         """
         vals = [np.atleast_1d(np.asarray(v, dtype=np.float64))

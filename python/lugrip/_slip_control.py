@@ -86,7 +86,7 @@ class SlipControl(NoCopy):
             Its ``dt`` defaults to 1 / ``sensor_rate`` when neither the file nor this mapping
             gives one.
         **controller: GraspController settings (``lugrip.controller_settings()`` lists them):
-            f_min, f_max [N], max_rate_up, max_rate_down [N/s], s_ref, k_p, k_i, sensor_rate
+            f_min, f_max [N], max_rate [N/s], s_ref, k_p, k_i, sensor_rate
             [Hz], command_ratio, pivoting settings, ...
 
     The rates are checked once here: the observer's dt must equal 1 / sensor_rate.

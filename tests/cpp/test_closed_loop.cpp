@@ -243,19 +243,20 @@ TEST(ClosedLoop, CeilingKeepsTheLiftOffNearWhatTheLoadNeeds) {
 
 TEST(ClosedLoop, ScheduleSwitchesModesAtItsSamples) {
   ClosedLoopConfig c = lift_config();
-  c.controller.pivot_end_c_tilde = 10.0;  // above c_max: only the request ends pivoting
+  // the request ends the pivot 30 ms after it starts, before its own end test can (mean |c~| > 1
+  // low-passed over 0.2 s, at the floor: 85 ms on this lift)
   c.schedule.push_back(ModeEvent{2.0, ModeAction::Pivot});
-  c.schedule.push_back(ModeEvent{2.5, ModeAction::SlippingAvoidance});
+  c.schedule.push_back(ModeEvent{2.03, ModeAction::SlippingAvoidance});
   c.schedule.push_back(ModeEvent{1.0, ModeAction::DynamicOff});  // out of order: sorted
   ClosedLoop loop(c);
   const auto log = run(loop, 3.0);
   for (const auto& s : log) {
     if (s.t > 1.0 && s.t < 2.0) EXPECT_EQ(s.dynamic_force, 0.0) << s.t;
     if (s.t < 2.0 - 1e-9) EXPECT_EQ(s.mode, 0) << s.t;
-    if (s.t > 2.0 + 1e-9 && s.t < 2.5 - 1e-9) EXPECT_EQ(s.mode, 1) << s.t;
-    if (s.t > 2.5 + 1e-9) EXPECT_EQ(s.mode, 0) << s.t;
+    if (s.t > 2.0 + 1e-9 && s.t < 2.03 - 1e-9) EXPECT_EQ(s.mode, 1) << s.t;
+    if (s.t > 2.03 + 1e-9) EXPECT_EQ(s.mode, 0) << s.t;
   }
-  const auto& at = log[static_cast<size_t>(std::lround(2.5 / 0.002))];
+  const auto& at = log[static_cast<size_t>(std::lround(2.03 / 0.002))];
   EXPECT_TRUE(at.pivot_finished);
   EXPECT_EQ(at.pivot_end, static_cast<int>(PivotEnd::Requested));
 }

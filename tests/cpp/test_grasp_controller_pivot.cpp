@@ -33,7 +33,7 @@ GraspControllerInput one(double S, double c_tilde, double f_t) {
 // Default settings, unlimited rates (the filter's decay is then exact).
 GraspControllerSettings free_rates() {
   GraspControllerSettings s;
-  s.max_rate_up = s.max_rate_down = kInf;
+  s.max_rate = kInf;
   return s;
 }
 

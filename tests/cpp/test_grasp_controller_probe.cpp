@@ -177,7 +177,6 @@ TEST(ControllerCommandTiming, TheCallerSaysWhenACommandIsDue) {
   // PI's S is their mean), not from the batch's first sample as the clock would.
   GraspControllerSettings s;
   s.ceiling_factor = 0.0;
-  s.feedforward = false;
   GraspController clock(told(0.6), s), caller(told(0.6), s);
   clock.reset(2.0);
   caller.reset(2.0);

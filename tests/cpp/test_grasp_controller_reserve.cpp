@@ -42,11 +42,7 @@ double settle(GraspController& c, const GraspControllerInput& in, int periods = 
   return out.force;
 }
 
-GraspControllerSettings quiet() {
-  GraspControllerSettings s;
-  s.dynamic_enabled = false;
-  return s;
-}
+GraspControllerSettings quiet() { return {}; }  // the inputs have omega_hat = 0: C_d adds nothing
 
 }  // namespace
 

@@ -126,13 +126,13 @@ TEST(ParamFile, ReadsTheFrictionRatiosAndDefaultsThemToOne) {
 TEST(ParamFile, AnIdentificationResultWithAControllerBlockMakesTheSlipControl) {
   // the identify file above with the robot's controller settings added to it
   const std::string text = std::string(kIdentified) +
-                           "controller: {f_max: 15.0, max_rate_up: 100.0, command_ratio: 5, "
-                           "slip_reflex: false, reserve_force: 0.5, s_ref: 0.7}\n";
+                           "controller: {f_max: 15.0, max_rate: 100.0, command_ratio: 5, "
+                           "load_floors: false, reserve_force: 0.5, s_ref: 0.7}\n";
   const ParameterFile f = parse_parameter_file(text);
   ASSERT_TRUE(f.has_controller);
   EXPECT_EQ(f.controller.f_max, 15.0);
   EXPECT_EQ(f.controller.command_ratio, 5);
-  EXPECT_FALSE(f.controller.slip_reflex);
+  EXPECT_FALSE(f.controller.load_floors);
   EXPECT_EQ(f.controller.k_p, GraspControllerSettings().k_p);  // not given: the default
   SlipControl sc(f.params, slip_control_settings(f));
   EXPECT_EQ(sc.settings().controller.f_max, 15.0);
@@ -173,7 +173,7 @@ TEST(ParamFile, EveryControllerFieldOfTheTableIsRead) {
     const ParameterFile file = parse_parameter_file(base + "controller: {" + f.name + ": " + value.str() + "}\n");
     EXPECT_EQ(to_string(file.controller), to_string(want)) << f.name;
   });
-  EXPECT_EQ(n, 25);  // every setting of GraspControllerSettings (docs/controller.md)
+  EXPECT_EQ(n, 20);  // every setting of GraspControllerSettings (docs/controller.md)
 }
 
 TEST(ParamFile, BadControllerFieldsAreNamed) {
@@ -181,7 +181,7 @@ TEST(ParamFile, BadControllerFieldsAreNamed) {
   EXPECT_NE(error_of(base + "controller: {k_pp: 1}").find("controller.k_pp: unknown controller setting"), std::string::npos);
   EXPECT_NE(error_of(base + "controller: {k_p: -1}").find("controller: k_p = -1"), std::string::npos);
   EXPECT_NE(error_of(base + "controller: {command_ratio: 2.5}").find("controller.command_ratio: expected an integer"), std::string::npos);
-  EXPECT_NE(error_of(base + "controller: {feedforward: 3}").find("controller.feedforward: expected true or false"), std::string::npos);
+  EXPECT_NE(error_of(base + "controller: {load_floors: 3}").find("controller.load_floors: expected true or false"), std::string::npos);
   EXPECT_NE(error_of(base + "controller: 5").find("expected a mapping of controller settings"), std::string::npos);
   // the flat layout skips the block like the observer's
   EXPECT_TRUE(parse_parameter_file("mu: 0.5\nbeta_a: 1e7\nsigma0: 16\nsigma_z: 2\ndelta: 0.0018\ngamma: 0.25\ncontroller: {f_max: 12}\n").has_controller);

@@ -312,19 +312,17 @@ class Campaign {
     // controller settings
     using G = GraspControllerSettings;
     ctl_.reals = {LUGRIP_FUZZ_REAL(G, sensor_rate),   LUGRIP_FUZZ_REAL(G, f_min),
-                  LUGRIP_FUZZ_REAL(G, f_max),         LUGRIP_FUZZ_REAL(G, max_rate_up),
-                  LUGRIP_FUZZ_REAL(G, max_rate_down), LUGRIP_FUZZ_REAL(G, reaction_lag),
+                  LUGRIP_FUZZ_REAL(G, f_max),         LUGRIP_FUZZ_REAL(G, max_rate),
+                  LUGRIP_FUZZ_REAL(G, reaction_lag),
                   LUGRIP_FUZZ_REAL(G, s_ref),
                   LUGRIP_FUZZ_REAL(G, k_p),           LUGRIP_FUZZ_REAL(G, k_i),
                   LUGRIP_FUZZ_REAL(G, gain_force),    LUGRIP_FUZZ_REAL(G, k_cd),
                   LUGRIP_FUZZ_REAL(G, p_cd),          LUGRIP_FUZZ_REAL(G, z_cd),
                   LUGRIP_FUZZ_REAL(G, reserve_force), LUGRIP_FUZZ_REAL(G, reserve_torque),
                   LUGRIP_FUZZ_REAL(G, ceiling_factor), LUGRIP_FUZZ_REAL(G, mu_probe),
-                  LUGRIP_FUZZ_REAL(G, s_pivot),       LUGRIP_FUZZ_REAL(G, tau_pivot),
-                  LUGRIP_FUZZ_REAL(G, k_f),           LUGRIP_FUZZ_REAL(G, pivot_end_c_tilde)};
+                  LUGRIP_FUZZ_REAL(G, s_pivot),       LUGRIP_FUZZ_REAL(G, tau_pivot)};
     ctl_.ints = {LUGRIP_FUZZ_INT(G, command_ratio)};
-    ctl_.bools = {LUGRIP_FUZZ_BOOL(G, dynamic_enabled), LUGRIP_FUZZ_BOOL(G, feedforward),
-                  LUGRIP_FUZZ_BOOL(G, slip_reflex)};
+    ctl_.bools = {LUGRIP_FUZZ_BOOL(G, load_floors)};
     ctl_.init([](const G& s) { return validate(s, nullptr); });
   }
 

@@ -100,22 +100,23 @@ def test_steady_force_matches_static_grasp_force(contact, mass, cog):
 
 
 def test_schedule_forms_and_pivot_request():
-    """Schedules as pairs, dicts or a mapping; pivoting runs from its sample until requested."""
-    ctrl = {"pivot_end_c_tilde": 10.0}  # above c_max: only the request ends pivoting
+    """Schedules as pairs, dicts or a mapping; pivoting runs from its sample until requested
+    (30 ms later: before its own end test, on mean |c~| > 1 low-passed over 0.2 s, can end it)."""
+    ctrl: dict = {}
     forms = [
-        [(1.0, "pivot"), (1.5, "slipping_avoidance")],
-        [{"time": 1.0, "action": "pivot"}, {"time": 1.5, "action": "avoidance"}],
-        {1.0: "pivoting", 1.5: "slipping_avoidance"},
+        [(1.0, "pivot"), (1.03, "slipping_avoidance")],
+        [{"time": 1.0, "action": "pivot"}, {"time": 1.03, "action": "avoidance"}],
+        {1.0: "pivoting", 1.03: "slipping_avoidance"},
     ]
     runs = [run_closed_loop(plant(), ctrl, OBS, f, 2.0) for f in forms]
     for r in runs[1:]:
         np.testing.assert_array_equal(r.mode, runs[0].mode)
     r = runs[0]
     assert np.all(r.mode[r.window(0.0, 1.0)] == 0)
-    assert np.all(r.mode[r.window(1.002, 1.5)] == 1)
-    assert np.all(r.mode[r.window(1.502, 2.0)] == 0)
+    assert np.all(r.mode[r.window(1.002, 1.03)] == 1)
+    assert np.all(r.mode[r.window(1.032, 2.0)] == 0)
     fin = np.flatnonzero(r.pivot_finished)
-    assert r.t[fin].tolist() == pytest.approx([1.5])
+    assert r.t[fin].tolist() == pytest.approx([1.03])
     assert r.pivot_end[fin[0]] == int(lugrip.PivotEnd.REQUESTED)
 
 

@@ -14,7 +14,7 @@ from scipy import signal
 
 CAN = lugrip.ContactParams.preset("aluminium_can")
 #: The paper's static law (constant gains, no feed-forward, no reflex); the ceiling keeps its default here.
-PAPER_PI = {k: lugrip.PAPER_SETTINGS[k] for k in ("gain_force", "feedforward", "slip_reflex", "k_i")}
+PAPER_PI = {k: lugrip.PAPER_SETTINGS[k] for k in ("gain_force", "load_floors", "k_i")}
 T_SENSOR = 1.0 / 500.0
 T_CMD = 10 * T_SENSOR
 
@@ -65,7 +65,7 @@ def test_cd_step_response_through_the_controller():
 def test_peak_of_the_last_command_period_reaches_the_command():
     """A one-sample slip spike between commands is not lost: f_nd = max |C_d omega_hat|."""
     # the C_d layer alone (with the ceiling on, C_d adds at most one reflex step)
-    ctrl = GraspController(CAN, s_ref=0.8, max_rate_up=math.inf, max_rate_down=math.inf,
+    ctrl = GraspController(CAN, s_ref=0.8, max_rate=math.inf,
                            ceiling_factor=0.0)
     ctrl.reset(2.0)
     w = np.zeros(11)
@@ -95,7 +95,7 @@ def test_pi_direction(S, sign):
 def test_anti_windup_leaves_the_ceiling_at_once():
     """After 20 s at f_max the force leaves it at the first command after the error reverses
     (back-calculation; without it the integrator would have wound up by 40 N)."""
-    ctrl = GraspController(CAN, max_rate_up=math.inf, max_rate_down=math.inf, **PAPER_PI)
+    ctrl = GraspController(CAN, max_rate=math.inf, **PAPER_PI)
     ctrl.reset(5.0)
     hold = ctrl.run(np.zeros(10000), np.ones(10000), 0.5, 0.5)
     assert hold.force[-1] == 20.0
@@ -137,7 +137,7 @@ def test_zero_order_hold_at_the_command_rate():
 
 
 def test_two_fingers_combine_max_s_and_max_dynamic_part():
-    ctrl = GraspController(CAN, max_rate_up=math.inf, max_rate_down=math.inf, ceiling_factor=0.0)
+    ctrl = GraspController(CAN, max_rate=math.inf, ceiling_factor=0.0)
     ctrl.reset(5.0)
     n = 11
     w = np.tile([0.0, -0.05], (n, 1))
@@ -146,7 +146,7 @@ def test_two_fingers_combine_max_s_and_max_dynamic_part():
     assert run.slippage[0] == 0.9
     assert run.mean_c_tilde[0] == pytest.approx(0.8)
     assert run.dynamic_force[10] == pytest.approx(np.max(np.abs(run.dynamic_sample[1:11, 1])))
-    one = GraspController(CAN, max_rate_up=math.inf, max_rate_down=math.inf, ceiling_factor=0.0)
+    one = GraspController(CAN, max_rate=math.inf, ceiling_factor=0.0)
     one.reset(5.0)
     r1 = one.run(w[:, 1], S[:, 1], 1.4, 1.0)  # the dominant finger alone gives the same command
     np.testing.assert_array_equal(r1.force, run.force)
@@ -208,7 +208,7 @@ def test_step_and_run_agree():
 # --- pivoting -----------------------------------------------------------------------------------
 
 def test_pivoting_decay_floor_end_and_bumpless_return():
-    ctrl = GraspController(CAN, max_rate_up=math.inf, max_rate_down=math.inf, **PAPER_PI)
+    ctrl = GraspController(CAN, max_rate=math.inf, **PAPER_PI)
     ctrl.reset(8.0)
     ctrl.run(np.full(20, 0.01), np.full(20, 1.0), 0.3, 0.5)
     f0 = ctrl.command
@@ -302,7 +302,7 @@ def test_closed_loop_settles_at_the_static_force(obj, ft, tau):
 def test_feedforward_is_the_static_grasp_force_of_the_measured_load():
     """Consistency: the feed-forward force of a command is static_grasp_force of the mean load of
     the period at S = 0.9, and lifts the static part at that command."""
-    ctrl = GraspController(CAN, max_rate_up=math.inf)
+    ctrl = GraspController(CAN, max_rate=math.inf)
     ctrl.reset(0.1)
     ft, tau = 1.5, 2e-3
     run = ctrl.run(np.zeros(11), np.full(11, 0.3), 1.0, np.r_[0.0, np.full(10, ft)],
@@ -311,7 +311,7 @@ def test_feedforward_is_the_static_grasp_force_of_the_measured_load():
     assert run.command_issued[10]
     assert run.feedforward_force[10] == pytest.approx(expected, rel=1e-12)
     assert run.static_force[10] == pytest.approx(expected, rel=1e-12)
-    off = GraspController(CAN, max_rate_up=math.inf, feedforward=False)
+    off = GraspController(CAN, max_rate=math.inf, load_floors=False)
     off.reset(0.1)
     r_off = off.run(np.zeros(11), np.full(11, 0.3), 1.0, ft, tau=tau)
     assert r_off.force[10] < 0.2 < expected
@@ -319,11 +319,11 @@ def test_feedforward_is_the_static_grasp_force_of_the_measured_load():
 
 def test_slip_reflex_reacts_within_one_command_period_without_speed():
     """S at the projection bound for 3 samples, omega_hat = 0 (no speed information): the next
-    command raises the static part by 1.25."""
-    ctrl = GraspController(CAN, feedforward=False, max_rate_up=math.inf)
+    command raises the static part by 1.25 (no load in the input: the feed-forward adds nothing)."""
+    ctrl = GraspController(CAN, max_rate=math.inf)
     ctrl.reset(2.0)
     S = np.r_[np.full(11, 0.8), 0.8, 0.8, 1.0, 1.0, 1.0, np.full(5, 0.8)]
-    run = ctrl.run(np.zeros(S.size), S, 1.5, 1.0)
+    run = ctrl.run(np.zeros(S.size), S, 1.5, 0.0)
     cmd = np.flatnonzero(run.command_issued)
     assert cmd[-1] == 20 and run.reflex[20]
     assert run.force[20] >= 1.25 * run.force[10] - 1e-12

@@ -167,11 +167,11 @@ def test_lifecycle_transitions_and_parameter_changes(tmp_path):
     another process started with an identified YAML (its mu and observer become the
     parameters); descriptors carry the unit and whether a setting may change while active;
     fixed settings refused while active with the reason, invalid values refused with the
-    core's reason, mu accepted while active; the Trigger services (created at configure) refuse unless active. No
-    plant."""
+    core's reason, mu accepted while active; the Trigger and ~/dynamic (SetBool) services
+    (created at configure) refuse unless active. No plant."""
     from lugrip import ContactParams
     from rcl_interfaces.srv import DescribeParameters, GetParameters
-    from std_srvs.srv import Trigger
+    from std_srvs.srv import SetBool, Trigger
 
     fit = tmp_path / "fit.yaml"
     ContactParams.table1().replace(mu=0.31).to_yaml(fit, observer={"bandwidth": 1500.0})
@@ -197,7 +197,12 @@ def test_lifecycle_transitions_and_parameter_changes(tmp_path):
         pivot = d.node.create_client(Trigger, "/lugrip/pivot")
         r = d.call(pivot, Trigger.Request())
         assert not r.success and "not active" in r.message
+        dynamic = d.node.create_client(SetBool, "/lugrip/dynamic")
+        assert not d.call(dynamic, SetBool.Request(data=False)).success
         assert d.transition(Transition.TRANSITION_ACTIVATE) and d.state() == "active"
+        r = d.call(dynamic, SetBool.Request(data=False))
+        assert r.success and r.message == "dynamic part off", r.message
+        assert d.call(dynamic, SetBool.Request(data=True)).success
         r = d.set("controller.sensor_rate", 1000.0)
         assert not r.successful and "controller.sensor_rate" in r.reason and "active" in r.reason
         assert d.set("contact.mu", 0.4).successful
@@ -325,7 +330,7 @@ def test_bad_traffic_holds_the_command_and_names_the_cause():
     load under a high initial force, so the controller lowers the command between faults)."""
     domain = _DOMAIN_BASE + 3
     node = _lugrip("run", "--ros-args", "-p", "frame_ids:=['fingertip_0','fingertip_1']",
-                   "-p", "controller.max_rate_down:=5.0", "-p", "initial_force:=8.0",
+                   "-p", "controller.max_rate:=5.0", "-p", "initial_force:=8.0",
                    "-p", "qos_depth:=200", domain=domain)
     d = _Driver(domain)
     period = 2_000_000  # 500 Hz stamps [ns]

@@ -232,8 +232,8 @@ def test_set_mu_reset_and_settings_at_run_time():
     ctrl.reset(3.0)
     assert ctrl.command == 3.0
     assert ctrl.step(np.zeros((2, 4))).force == 3.0
-    ctrl.update_settings(f_min=0.5, max_rate_down=50.0)
-    assert ctrl.settings.controller.max_rate_down == 50.0
+    ctrl.update_settings(f_min=0.5, max_rate=50.0)
+    assert ctrl.settings.controller.max_rate == 50.0
     with pytest.raises(ValueError):
         ctrl.update_settings(sensor_rate=100.0)
 

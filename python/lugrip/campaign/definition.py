@@ -216,7 +216,7 @@ FRONTIER_DEFAULTS = {
     "low_fraction": 0.5,  # bottom of the bracket: this times the minimum static force
 }
 #: The gripper's range a campaign may set on top of the scenario's controller block.
-GRIPPER_KEYS = ("f_min", "f_max", "max_rate_up", "max_rate_down")
+GRIPPER_KEYS = ("f_min", "f_max", "max_rate")
 
 
 class CampaignError(ValueError):

@@ -179,7 +179,7 @@ def figure_15(result):
     with _stacked(2, 2.6, title, s.duration) as (fig, (ax_f, ax)):
         _force_panel(ax_f, s, run, tangential=False, torque=True)
         _line(ax, run, _c_tilde(run), RED, 1.4, label=r"estimated $\tilde c$")
-        thr = float(s.controller.get("pivot_end_c_tilde", 1.0))
+        thr = 1.0  # the pivot's end: mean |c~| > 1 (a constant of the law)
         ax.axhline(thr, color=BLACK, lw=0.8, ls=":", label="end of pivoting ($\\tilde c$ = 1)")
         ax.set_ylim(0.0, 1.65)
         ax.set_ylabel(plot.axis_label("CoR", r"\tilde c", "-"))

@@ -12,7 +12,8 @@ The node wraps one :class:`lugrip.SlipControl` (the C++ core, through the bindin
   (``sensor_msgs/JointState``, effort [N], stamped with the sample's stamp); every sample a
   status (``~/status``, ``diagnostic_msgs/DiagnosticArray``: per finger S, omega_hat, c~,
   status; the controller's command, mode, mu belief, held); and ``/diagnostics``;
-* services ``~/pivot``, ``~/slipping_avoidance``, ``~/reset`` (``std_srvs/Trigger``); mu and
+* services ``~/pivot``, ``~/slipping_avoidance``, ``~/reset`` (``std_srvs/Trigger``),
+  ``~/dynamic`` (``std_srvs/SetBool``: the paper's dynamic or static slipping avoidance); mu and
   every run-time setting through their parameters (:mod:`lugrip.ros._parameters`).
 
 Faults (docs/ros.md, "Time and faults"): a sample that is non-finite, from the wrong
@@ -41,7 +42,7 @@ from rclpy.lifecycle import LifecycleNode, LifecycleState, TransitionCallbackRet
 from rclpy.qos import HistoryPolicy, QoSProfile, ReliabilityPolicy
 from sensor_msgs.msg import JointState
 from std_msgs.msg import Float64
-from std_srvs.srv import Trigger
+from std_srvs.srv import SetBool, Trigger
 
 from .._contact import Status
 from .._controller import ControllerMode
@@ -215,6 +216,7 @@ class SlipControlNode(LifecycleNode):
             self.create_service(Trigger, "~/pivot", self._srv_pivot),
             self.create_service(Trigger, "~/slipping_avoidance", self._srv_avoid),
             self.create_service(Trigger, "~/reset", self._srv_reset),
+            self.create_service(SetBool, "~/dynamic", self._srv_dynamic),
         ]
         return TransitionCallbackReturn.SUCCESS
 
@@ -322,6 +324,11 @@ class SlipControlNode(LifecycleNode):
     def _srv_avoid(self, request, response):
         return self._trigger(response, self._sc.request_slipping_avoidance,
                              "slipping avoidance requested (pivoting ends at the next sample)")
+
+    def _srv_dynamic(self, request, response):
+        on = bool(request.data)
+        return self._trigger(response, lambda: self._sc.set_dynamic_enabled(on),
+                             "dynamic part " + ("on (C_d restarts from rest)" if on else "off"))
 
     def _srv_reset(self, request, response):
         return self._trigger(response, self._reset_controller,

@@ -8,8 +8,7 @@ frame ids ``fingertip_0``/``fingertip_1``), with the true slip rate of the objec
 as ``~/omega_true_k`` (``TwistStamped`` angular.z: ground truth for recordings); the gripper
 takes its command from the node's ``~/joint_command`` (effort [N]) and holds it between
 commands, and the scenario's schedule
-calls the node's ``~/pivot`` / ``~/slipping_avoidance`` services and sets
-``controller.dynamic_enabled``. Before the run the simulation gives the node the scenario's
+calls the node's ``~/pivot`` / ``~/slipping_avoidance`` / ``~/dynamic`` services. Before the run the simulation gives the node the scenario's
 settings (contact model, observer, controller: deactivate, set the parameters, activate),
 so both ends use what ``lugrip simulate`` uses in-process. The controller's start (both pads touching) sets
 ``initial_force`` to the closing force and calls ``~/reset``: bumpless, as in-process.
@@ -36,7 +35,7 @@ from rcl_interfaces.srv import SetParameters
 from rclpy.node import Node
 from rclpy.qos import HistoryPolicy, QoSProfile, ReliabilityPolicy
 from sensor_msgs.msg import JointState
-from std_srvs.srv import Trigger
+from std_srvs.srv import SetBool, Trigger
 
 from .. import _core
 from .._contact import _as_params
@@ -104,6 +103,7 @@ class GripperSimNode(Node):
         self.create_subscription(JointState, f"{ns}/joint_command", self._on_command, 100)
         self.clients_ = {name: self.create_client(Trigger, f"{ns}/{name}")
                          for name in ("pivot", "slipping_avoidance", "reset")}
+        self.dynamic_client = self.create_client(SetBool, f"{ns}/dynamic")
         self.param_client = self.create_client(SetParameters, f"{ns}/set_parameters")
         self.change_state = self.create_client(ChangeState, f"{ns}/change_state")
 
@@ -124,6 +124,7 @@ class GripperSimNode(Node):
         end = time.monotonic() + timeout
         while time.monotonic() < end:
             if (all(c.service_is_ready() for c in self.clients_.values())
+                    and self.dynamic_client.service_is_ready()
                     and self.param_client.service_is_ready()
                     and all(p.get_subscription_count() > 0 for p in self.wrench)):
                 return
@@ -142,6 +143,11 @@ class GripperSimNode(Node):
         result = self.call(self.clients_[name], Trigger.Request())
         if not result.success:
             raise RuntimeError(f"~/{name} refused: {result.message}")
+
+    def set_dynamic(self, enabled: bool) -> None:
+        result = self.call(self.dynamic_client, SetBool.Request(data=bool(enabled)))
+        if not result.success:
+            raise RuntimeError(f"~/dynamic refused: {result.message}")
 
     def set_parameters(self, values: dict[str, Any]) -> None:
         """Set the controller's parameters (bool, int, float or str values)."""
@@ -252,7 +258,7 @@ class RemoteSlipControl:
         self.node.trigger("slipping_avoidance")
 
     def set_dynamic_enabled(self, enabled: bool) -> None:
-        self.node.set_parameter("controller.dynamic_enabled", bool(enabled))
+        self.node.set_dynamic(bool(enabled))
 
     def ground_truth(self, omegas) -> None:
         """Publish the last sample's true slip rates (``~/omega_true_k``, stamped with it)."""

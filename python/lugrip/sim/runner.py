@@ -52,7 +52,7 @@ def cone_command(command, fn, ft, mu, margin, release, T, s) -> float:
         target = max(command, required)
     elif release > 0.0:
         target = max(required, command - release * T)
-    f = min(max(target, command - s["max_rate_down"] * T), command + s["max_rate_up"] * T)
+    f = min(max(target, command - s["max_rate"] * T), command + s["max_rate"] * T)
     return min(max(f, s["f_min"]), s["f_max"])
 
 
@@ -121,7 +121,7 @@ def run_plant_loop(
         healthy_finger_fallback=healthy_finger_fallback, **ctrl_s)
     injector = _core.FaultInjector(fault_specs(faults), T_s) if faults else None
     limits = {k: getattr(ctrl.settings.controller, k)
-              for k in ("f_min", "f_max", "max_rate_up", "max_rate_down")}
+              for k in ("f_min", "f_max", "max_rate")}
     events = sorted(_schedule(mode_schedule), key=lambda e: e[0]) if kind == "lugrip" else []
     event_samples = [(max(0, math.ceil((t - 1e-9) / T_s - 1e-12)), a) for t, a in events]
     n_samples = int(math.floor(float(duration) / T_s + 1e-9))

@@ -24,7 +24,7 @@ from .plant import plant_names, registered
 
 
 #: Controller settings every scenario states: the gripper's force range [N] and rate limits [N/s].
-GRIPPER_RANGE = ("f_min", "f_max", "max_rate_up", "max_rate_down")
+GRIPPER_RANGE = ("f_min", "f_max", "max_rate")
 
 
 #: Criteria a scenario may list, with their meaning (value compared with the YAML limit).
