@@ -331,7 +331,7 @@ def test_slip_reflex_reacts_within_one_command_period_without_speed():
 
 @given(
     name=st.sampled_from(["gain_force", "ceiling_factor", "mu_probe", "reserve_force",
-                          "reaction_lag"]),
+                          "reaction_lag", "max_rate"]),
     value=st.one_of(st.floats(max_value=0.0), st.just(math.nan), st.just(math.inf),
                     st.floats(min_value=1e-9, max_value=2e6),
                     st.sampled_from([1e-6, 9.99e-7, 0.5, 0.51, 1.0, 0.999, 1e3, 1000.5, 1e6, 1.01e6])),
@@ -346,6 +346,7 @@ def test_settings_beyond_the_paper_are_validated(name, value):
         "mu_probe": lambda v: 0 <= v <= 0.5,
         "reserve_force": lambda v: 0 <= v <= 1e6,
         "reaction_lag": lambda v: 0 <= v <= 1e3,
+        "max_rate": lambda v: v > 0,  # inf: no limit
     }[name]
     if valid(value):
         GraspController(CAN, **{name: value})
@@ -361,7 +362,9 @@ def test_removed_settings_are_refused_by_name():
                  "feedforward_trend_grasp", "feedforward_trend_check", "react_when_invalid",
                  "reflex_factor", "reflex_slippage", "omega_deadband", "slope_gain",
                  "loop_gain_p", "average_slippage", "anti_windup", "invalid_raise_step",
-                 "feedforward_horizon", "pivot_timeout", "pivot_end_filter"):
+                 "feedforward_horizon", "pivot_timeout", "pivot_end_filter", "k_f",
+                 "pivot_end_c_tilde", "max_rate_up", "max_rate_down", "dynamic_enabled",
+                 "feedforward", "slip_reflex"):
         with pytest.raises(ValueError, match=name):
             GraspController(CAN, **{name: 1.0})
 
