@@ -305,6 +305,15 @@ def _identify_recording_like_csv(tmp_path, rec_log: str) -> None:
     first = len(run["t"]) - k
     cols = {c: run[f"{c}_meas_0"][first:] for c in ("f_n", "f_t", "tau")}
     np.testing.assert_allclose(np.asarray(rec.f_n), cols["f_n"], rtol=1e-9, atol=1e-12)
+    # every column the identification reads, so that a mismatch of mu below names its cause: this
+    # one-maneuver recording identifies mu anywhere from 0.50 to 0.80 depending on the window, and
+    # a one-sample shift of omega moves it by up to 20 % (measured in-process on exp3's run)
+    np.testing.assert_allclose(np.asarray(rec.f_t), cols["f_t"], rtol=1e-9, atol=1e-12)
+    np.testing.assert_allclose(np.asarray(rec.tau), cols["tau"], rtol=1e-9, atol=1e-15)
+    om_rec, om_run = np.asarray(rec.omega), run["omega_true_0"][first:]
+    known = np.isfinite(om_rec)
+    assert known.sum() >= len(om_rec) - 2, (len(om_rec) - known.sum(), "omega samples missing")
+    np.testing.assert_allclose(om_rec[known], om_run[known], rtol=1e-9, atol=1e-12)
     n = len(cols["f_n"])
     csv_path = tmp_path / "run_finger0.csv"
     write_log(SlidingLog.from_arrays(run["t"][first:], cols["f_n"], cols["tau"],
