@@ -126,6 +126,21 @@ void def_param_table(Cls& cls) {
   cls.attr("rules") = nb::tuple(rules);
 }
 
+//! Read-only attributes of every field, plus `fields` on the class.
+template <class S, class... Opts>
+void def_fields_ro(nb::class_<S, Opts...>& cls) {
+  for_each_field<S>([&](const auto& f) {
+    using T = std::decay_t<decltype(std::declval<S>().*(f.member))>;
+    if constexpr (is_pair_v<T>) {
+      auto m = f.member;
+      cls.def_prop_ro(f.name, [m](const S& s) { return nb::make_tuple((s.*m)[0], (s.*m)[1]); }, doc_of(f));
+    } else {
+      cls.def_ro(f.name, f.member, doc_of(f));
+    }
+  });
+  cls.attr("fields") = field_tuple<S>();
+}
+
 //! Read-write attributes of every field, plus `fields` on the class; for a table of Param
 //! entries (lugrip/settings_fields.hpp) also `params`, `rules` and the repr (to_string).
 template <class S, class... Opts>
@@ -135,7 +150,8 @@ void def_fields_rw(nb::class_<S, Opts...>& cls) {
   using First = std::decay_t<decltype(std::get<0>(Table<S>::fields))>;
   if constexpr (is_param<First>::value) {
     def_param_table<S>(cls);
-    cls.def("__repr__", [](const S& s) { return lugrip::to_string(s); });
+    // lugrip::to_string, found by argument-dependent lookup
+    cls.def("__repr__", [](const S& s) { return to_string(s); });
   }
 }
 

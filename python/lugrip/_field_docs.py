@@ -47,7 +47,7 @@ def number(value: float) -> str:
             break
     mantissa, exponent = text.split("e")
     scientific = f"{mantissa}e{int(exponent)}"
-    return positional if "e" not in positional and len(positional) <= len(scientific) else scientific
+    return positional if 1e-3 <= abs(value) < 1e4 and "e" not in positional else scientific
 
 
 def _limit(limit: dict) -> str:
@@ -71,7 +71,6 @@ def range_text(param: dict, rules: list[str]) -> str:
     if param["also_text"]:
         text += f" or {param['also_text']}"
     for rule in rules:
-        rule = rule.removeprefix("must be ").replace(">=", "≥").replace("<=", "≤")
         text += f"; {rule}" if text else rule
     return text
 
@@ -80,7 +79,7 @@ def _value(param: dict, value) -> str:
     if param["kind"] == "bool":
         return "on" if value else "off"
     if param["kind"] == "enum":
-        return f"`{param['choices'][int(value)]}`"
+        return f"`{param['choices'][int(getattr(value, 'value', value))]}`"
     if param["kind"] == "struct":
         return f"`{type(value).__name__}()`"
     return number(value)
@@ -104,8 +103,9 @@ def markdown_table(struct: str, values: str = "default") -> str:
         raise ValueError(f"values={values!r}: expected default or table1")
     rules: dict[str, list[str]] = {}
     for field, text in cls.rules:
-        rules.setdefault(field, []).append(text if "." not in field
-                                           else f"{field.split('.', 1)[1]} {text}")
+        # "must be >= dt" -> "≥ dt"; a nested field's rule names it ("f_n_min ≥ 1e-06 [N] ...")
+        text = text.replace("must be ", "").replace("must equal ", "= ").replace(">=", "≥").replace("<=", "≤")
+        rules.setdefault(field, []).append(text if "." not in field else f"{field.split('.', 1)[1]} {text}")
     lines = [f"| field | meaning | unit | valid range | {header} |", "|---|---|---|---|---|"]
     for p in cls.params:
         unit = {"-": "–", "": ""}.get(p["unit"], p["unit"])
