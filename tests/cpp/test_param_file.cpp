@@ -146,37 +146,6 @@ TEST(ParamFile, AnIdentificationResultWithAControllerBlockMakesTheSlipControl) {
   EXPECT_FALSE(parse_parameter_file(kIdentified).has_controller);
 }
 
-TEST(ParamFile, EveryControllerFieldOfTheTableIsRead) {
-  // Each field of grasp_controller_fields, alone in a controller block with a value other than
-  // its default (that validate() accepts), reads back into its own member and nowhere else.
-  const std::string base = "contact: {mu: 0.5, beta_a: 1e7, sigma0: 16, sigma_z: 2, delta: 0.0018, gamma: 0.25}\n";
-  int n = 0;
-  detail::for_each_entry(grasp_controller_fields, [&](const auto& f) {
-    ++n;
-    GraspControllerSettings want;
-    using T = std::decay_t<decltype(want.*(f.member))>;
-    std::ostringstream value;
-    if constexpr (std::is_same_v<T, bool>) {
-      want.*(f.member) = !(want.*(f.member));
-      value << (want.*(f.member) ? "true" : "false");
-    } else if constexpr (std::is_integral_v<T>) {
-      want.*(f.member) = want.*(f.member) + 1;
-      value << want.*(f.member);
-    } else {
-      // 2x the default (or 0.5 where the default is 0 or the doubled value is refused)
-      const double d = want.*(f.member);
-      want.*(f.member) = d == 0.0 ? 0.5 : 1.1 * d;
-      if (!validate(want, nullptr)) want.*(f.member) = d == 0.0 ? 0.01 : 0.9 * d;
-      value.precision(17);
-      value << want.*(f.member);
-    }
-    ASSERT_TRUE(validate(want, nullptr)) << f.name;
-    const ParameterFile file = parse_parameter_file(base + "controller: {" + f.name + ": " + value.str() + "}\n");
-    EXPECT_EQ(to_string(file.controller), to_string(want)) << f.name;
-  });
-  EXPECT_EQ(n, 25);  // every setting of GraspControllerSettings (docs/controller.md)
-}
-
 namespace {
 // Sets the field of `s` to a value other than its default that validate() accepts (an
 // enumeration's next value, a switch flipped, a number moved by 10 % or to 0.5 from 0) and
@@ -205,7 +174,24 @@ std::string change(S& s, const F& f, const Whole& whole, bool (*valid)(const Who
   return value.str();
 }
 bool valid_observer(const ObserverSettings& s) { return validate(s, nullptr); }
+bool valid_controller(const GraspControllerSettings& s) { return validate(s, nullptr); }
 }  // namespace
+
+TEST(ParamFile, EveryControllerFieldOfTheTableIsRead) {
+  // Each field of grasp_controller_fields, alone in a controller block with a value other than
+  // its default (that validate() accepts), reads back into its own member and nowhere else.
+  const std::string base = "contact: {mu: 0.5, beta_a: 1e7, sigma0: 16, sigma_z: 2, delta: 0.0018, gamma: 0.25}\n";
+  int n = 0;
+  detail::for_each_entry(grasp_controller_fields, [&](const auto& f) {
+    ++n;
+    GraspControllerSettings want;
+    const std::string value = change(want, f, want, valid_controller);
+    ASSERT_TRUE(validate(want, nullptr)) << f.name;
+    const ParameterFile file = parse_parameter_file(base + "controller: {" + f.name + ": " + value + "}\n");
+    EXPECT_EQ(to_string(file.controller), to_string(want)) << f.name;
+  });
+  EXPECT_EQ(n, 25);  // every setting of GraspControllerSettings (docs/controller.md)
+}
 
 TEST(ParamFile, EveryObserverFieldOfTheTableIsRead) {
   // Each field of the observer's table (the CoR estimator's by their own names), set away from

@@ -187,3 +187,18 @@ def test_docs_controller_table_names_real_settings_with_their_defaults():
             assert first == ("on" if value else "off"), (name, text_default)
         else:
             assert float(first) == pytest.approx(value, rel=1e-12), (name, text_default)
+
+
+def test_python_contact_params_follow_the_table():
+    """The Python ContactParams dataclass has the fields of the C++ table in its order, and a
+    file must give exactly the fields a default-constructed C++ struct leaves out of range."""
+    import dataclasses
+
+    import lugrip
+    from lugrip import _params
+
+    names = [p["name"] for p in _core.ContactParams.params]
+    assert [f.name for f in dataclasses.fields(lugrip.ContactParams)] == names
+    assert _params._REQUIRED == ("mu", "beta_a", "sigma0", "sigma_z", "delta", "gamma")
+    with pytest.raises(ValueError, match="missing parameter"):
+        lugrip.ContactParams.from_dict({"mu": 0.5})
