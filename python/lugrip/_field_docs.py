@@ -10,7 +10,7 @@ defaults are the default-constructed struct's. A Markdown page holds a generated
     <!-- /field-table -->
 
 (``<!-- field-table: ContactParams values=table1 -->`` prints paper Table 1's values instead of
-the defaults). ``python -m lugrip._field_docs`` rewrites every such block of README.md and
+the defaults; a default the struct's validate() refuses reads "required"). ``python -m lugrip._field_docs`` rewrites every such block of README.md and
 docs/*.md; ``--check`` exits 1 naming the blocks that differ (tests/python/test_field_tables.py
 runs the check).
 """
@@ -30,6 +30,9 @@ __all__ = ["STRUCTS", "markdown_table", "render_blocks"]
 #: The structs whose tables the documentation may print.
 STRUCTS = ("ContactParams", "CorSettings", "ObserverSettings", "SliderSettings",
            "IdentificationSettings", "SlipControlSettings")
+
+_VALIDATORS = {"ContactParams": "validate_params", "CorSettings": "validate_cor_settings",
+               "ObserverSettings": "validate_observer_settings"}
 
 _BLOCK = re.compile(r"(<!-- field-table: (\w+)((?: \w+=\w+)*) -->\n)(.*?)(<!-- /field-table -->)", re.S)
 
@@ -106,13 +109,18 @@ def markdown_table(struct: str, values: str = "default") -> str:
         # "must be >= dt" -> "≥ dt"; a nested field's rule names it ("f_n_min ≥ 1e-06 [N] ...")
         text = text.replace("must be ", "").replace("must equal ", "= ").replace(">=", "≥").replace("<=", "≤")
         rules.setdefault(field, []).append(text if "." not in field else f"{field.split('.', 1)[1]} {text}")
+    # a default the struct's own validate() refuses is no default: a file must give the field
+    required = set()
+    if values == "default" and struct in _VALIDATORS:
+        message = getattr(_core, _VALIDATORS[struct])(source)
+        required = {line.split(" = ")[0] for line in message.splitlines()}
     lines = [f"| field | meaning | unit | valid range | {header} |", "|---|---|---|---|---|"]
     for p in cls.params:
         unit = {"-": "–", "": ""}.get(p["unit"], p["unit"])
         own = rules.get(p["name"], []) + [r for f, texts in rules.items() if f.split(".")[0] == p["name"]
                                           and f != p["name"] for r in texts]
         lines.append(f"| `{p['name']}` | {_cell(p['doc'])} | {unit} | {_cell(range_text(p, own))} | "
-                     f"{_value(p, getattr(source, p['name']))} |")
+                     f"{'required' if p['name'] in required else _value(p, getattr(source, p['name']))} |")
     return "\n".join(lines) + "\n"
 
 

@@ -36,6 +36,10 @@ def test_pages_print_the_field_tables_as_compiled():
             stale.append(page.name)
     assert not stale, f"regenerate with `python -m lugrip._field_docs`: {stale}"
     assert sorted(set(printed)) == sorted(_field_docs.STRUCTS)
+    assert _blocks((REPO / "README.md").read_text()) == ["ContactParams"]
+    # the fields a file must give read "required" (their defaults are refused by validate())
+    readme = _field_docs.markdown_table("ContactParams")
+    assert readme.count("| required |") == 6 and "| `k` |" in readme
 
 
 def test_a_changed_table_is_found():
