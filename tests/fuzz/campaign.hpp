@@ -267,6 +267,8 @@ void add_table(SettingsSpace<Root>& space, Get get, const std::string& prefix) {
       else space.bools.push_back(field);
     } else if constexpr (std::is_class_v<T>) {
       add_table<T>(space, [get, m](Root& r) -> T& { return get(r).*m; }, name + ".");
+    } else {
+      static_assert(std::is_enum_v<T>, "a field type the campaign cannot draw: add it to add_table");
     }
   });
 }
