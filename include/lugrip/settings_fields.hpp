@@ -39,7 +39,7 @@ struct FieldTable<ContactParams> {
       detail::param("beta_a", &S::beta_a, "N s/m^3", detail::ge(0.0), detail::none(),
                     "viscous friction per unit area and speed (the paper prints Ns/m)"),
       detail::param("sigma0", &S::sigma0, "N m/rad", detail::ge(1e-12), detail::none(),
-                    "micro-asperity (bristle) stiffness; >= 1e-12 keeps g / sigma0 finite"),
+                    "micro-asperity (bristle) stiffness; the lower bound keeps g / sigma0 finite"),
       detail::param("sigma_z", &S::sigma_z, "N m s/rad", detail::ge(0.0), detail::none(),
                     "micro-asperity (bristle) damping"),
       detail::param("delta", &S::delta, "m/N^gamma", detail::gt(0.0), detail::lt(1.0),
@@ -200,7 +200,8 @@ struct FieldTable<IdentificationSettings> {
       detail::param("threads", &S::threads, "-", detail::ge(0), detail::none(),
                     "worker threads over segments (0: all cores)"),
       detail::param("sensitivity_limit", &S::sensitivity_limit, "-", detail::gt(0.0), detail::none(),
-                    "chattering guard: a state sensitivity beyond this many times its scale restarts the "
+                    "chattering guard: a state sensitivity beyond this many times its scale (per unit "
+                    "log-parameter; omega: the segment's largest |omega|, z: g / sigma0) restarts the "
                     "sensitivities"));
   static constexpr auto rules = std::tuple<>();
 };
