@@ -11,7 +11,7 @@ MUJOCO_SPEC ?= mujoco>=3.12
 SOURCES := $(shell find src include bindings python -type f \( -name '*.cpp' -o -name '*.hpp' -o -name '*.py' \)) pyproject.toml CMakeLists.txt
 
 PHONY_DEMO := install-demo
-.PHONY: all install $(PHONY_DEMO) demo test test-cpp test-python test-install test-oldest docs deps-cpp validate identify-mujoco bench sanitize sanitize-campaign clean
+.PHONY: all install $(PHONY_DEMO) demo test test-cpp test-python test-install test-oldest docs field-tables deps-cpp validate identify-mujoco bench sanitize sanitize-campaign clean
 
 all: install
 
@@ -35,6 +35,12 @@ install: $(VENV)/.installed
 # (tests/python/test_docs_site.py), which is how `make test` and CI check it.
 docs: install
 	NO_MKDOCS_2_WARNING=1 $(VPY) -m mkdocs build --strict
+
+# The settings tables of README.md and docs/*.md, regenerated from the C++ field tables
+# (include/lugrip/settings_fields.hpp) of the installed package; tests/python/test_field_tables.py
+# fails while a page differs.
+field-tables: install
+	$(VPY) -m lugrip._field_docs .
 
 # `make demo` needs lugrip and its runtime dependencies only (no test extras: a smaller .venv);
 # a .venv that `make install`/`make test` set up already serves it as it is.

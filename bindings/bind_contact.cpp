@@ -24,7 +24,7 @@ void bind_contact(nb::module_& m) {
   m.def("shape_factor", &shape_factor, "k"_a, "Torsional shape factor xi(k) (tau_max = mu xi rho f_n).");
 
   nb::class_<ContactParams> params(m, "ContactParams");
-  params.def(nb::init<>()).def("__repr__", [](const ContactParams& p) { return to_string(p); });
+  params.def(nb::init<>());
   def_fields_rw(params);
   m.def("validate_params", &validation_message<ContactParams>, "Empty string when valid, else one line per bad field.");
   m.def("table1_params", &table1_params);

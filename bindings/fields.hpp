@@ -8,6 +8,7 @@
 
 #include <array>
 #include <cstdint>
+#include <deque>
 #include <string>
 #include <tuple>
 #include <type_traits>
@@ -56,13 +57,73 @@ template <class S, class T>
 constexpr const char* kind_of(const Field<S, T>&) {
   return kind_name<T>();
 }
+template <class S, class T>
+constexpr const char* kind_of(const lugrip::detail::Param<S, T>&) {
+  return kind_name<T>();
+}
+
+//! A text that lives as long as the module (nanobind keeps the pointer of a doc string).
+inline const char* kept(std::string text) {
+  static std::deque<std::string> store;
+  store.push_back(std::move(text));
+  return store.back().c_str();
+}
+
+//! The Python doc of a field: a Field's doc, or a Param's doc line with its unit ("... [N m]").
+template <class S, class T>
+const char* doc_of(const Field<S, T>& f) {
+  return f.doc;
+}
+template <class S, class T>
+const char* doc_of(const lugrip::detail::Param<S, T>& f) {
+  return *f.unit ? kept(std::string(f.doc) + " [" + f.unit + "]") : f.doc;
+}
 
 //! ((name, kind, doc), ...) of a table.
 template <class S>
 nb::tuple field_tuple() {
   nb::list out;
-  for_each_field<S>([&](const auto& f) { out.append(nb::make_tuple(f.name, kind_of(f), f.doc)); });
+  for_each_field<S>([&](const auto& f) { out.append(nb::make_tuple(f.name, kind_of(f), doc_of(f))); });
   return nb::tuple(out);
+}
+
+inline nb::dict limit_dict(const lugrip::detail::Limit& l) {
+  nb::dict d;
+  d["value"] = l.present() ? nb::cast(l.value) : nb::none();
+  d["open"] = l.open;
+  d["text"] = l.text ? nb::cast(std::string(l.text)) : nb::none();
+  return d;
+}
+
+template <class T>
+struct is_param : std::false_type {};
+template <class S, class T>
+struct is_param<lugrip::detail::Param<S, T>> : std::true_type {};
+
+//! A Param table as the documentation reads it: `params` (one dict per field: name, kind, unit,
+//! lo, hi, also, also_text, choices, doc) and `rules` ((field, text), ...).
+template <class S, class Cls>
+void def_param_table(Cls& cls) {
+  nb::list params;
+  for_each_field<S>([&](const auto& f) {
+    nb::dict d;
+    d["name"] = f.name;
+    d["kind"] = kind_of(f);
+    d["unit"] = f.unit;
+    d["lo"] = limit_dict(f.lo);
+    d["hi"] = limit_dict(f.hi);
+    d["also"] = f.also == f.also ? nb::cast(f.also) : nb::none();
+    d["also_text"] = f.also_text ? nb::cast(std::string(f.also_text)) : nb::none();
+    nb::list choices;
+    for (int k = 0; k < f.n_choices; ++k) choices.append(f.choices[k]);
+    d["choices"] = nb::tuple(choices);
+    d["doc"] = f.doc;
+    params.append(d);
+  });
+  cls.attr("params") = nb::tuple(params);
+  nb::list rules;
+  lugrip::detail::for_each_entry(Table<S>::rules, [&](const auto& r) { rules.append(nb::make_tuple(r.field, r.text)); });
+  cls.attr("rules") = nb::tuple(rules);
 }
 
 //! Read-only attributes of every field, plus `fields` on the class.
@@ -72,19 +133,26 @@ void def_fields_ro(nb::class_<S, Opts...>& cls) {
     using T = std::decay_t<decltype(std::declval<S>().*(f.member))>;
     if constexpr (is_pair_v<T>) {
       auto m = f.member;
-      cls.def_prop_ro(f.name, [m](const S& s) { return nb::make_tuple((s.*m)[0], (s.*m)[1]); }, f.doc);
+      cls.def_prop_ro(f.name, [m](const S& s) { return nb::make_tuple((s.*m)[0], (s.*m)[1]); }, doc_of(f));
     } else {
-      cls.def_ro(f.name, f.member, f.doc);
+      cls.def_ro(f.name, f.member, doc_of(f));
     }
   });
   cls.attr("fields") = field_tuple<S>();
 }
 
-//! Read-write attributes of every field, plus `fields` on the class.
+//! Read-write attributes of every field, plus `fields` on the class; for a table of Param
+//! entries (lugrip/settings_fields.hpp) also `params`, `rules` and the repr (to_string).
 template <class S, class... Opts>
 void def_fields_rw(nb::class_<S, Opts...>& cls) {
-  for_each_field<S>([&](const auto& f) { cls.def_rw(f.name, f.member, f.doc); });
+  for_each_field<S>([&](const auto& f) { cls.def_rw(f.name, f.member, doc_of(f)); });
   cls.attr("fields") = field_tuple<S>();
+  using First = std::decay_t<decltype(std::get<0>(Table<S>::fields))>;
+  if constexpr (is_param<First>::value) {
+    def_param_table<S>(cls);
+    // lugrip::to_string, found by argument-dependent lookup
+    cls.def("__repr__", [](const S& s) { return to_string(s); });
+  }
 }
 
 //! One numpy array per scalar field of S (two for a pair, none for a nested struct), named

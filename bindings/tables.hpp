@@ -1,7 +1,9 @@
 // The one description of every struct the Python module exposes: field name, member and a
-// short doc with the unit. The nanobind attributes, the `fields` tuples (from which the Python
-// dataclasses, settings conversions and batch outputs are built) and the batch columns all
-// come from these tables, so a field added here appears everywhere at once.
+// short doc with the unit; the settings users set are the core's own tables
+// (lugrip/settings_fields.hpp, lugrip/grasp_controller_fields.hpp). The nanobind attributes,
+// the `fields` tuples (from which the Python dataclasses, settings conversions and batch outputs
+// are built) and the batch columns all come from these tables, so a field added to a table
+// appears everywhere at once.
 #pragma once
 
 #include <tuple>
@@ -11,6 +13,7 @@
 #include "lugrip/contact.hpp"
 #include "lugrip/grasp_controller.hpp"
 #include "lugrip/grasp_controller_fields.hpp"
+#include "lugrip/settings_fields.hpp"
 #include "lugrip/grasp_plant.hpp"
 #include "lugrip/identification.hpp"
 #include "lugrip/observer.hpp"
@@ -25,66 +28,16 @@ using namespace lugrip;
 // --- parameters and settings ----------------------------------------------------------------
 
 template <>
-struct Table<ContactParams> {
-  using S = ContactParams;
-  static constexpr auto fields = std::make_tuple(
-      field("mu", &S::mu, "friction coefficient of the limit surface [-]"),
-      field("beta_a", &S::beta_a, "viscous friction per unit area and speed [N s/m^3]"),
-      field("sigma0", &S::sigma0, "bristle stiffness [N m/rad]"),
-      field("sigma_z", &S::sigma_z, "bristle damping [N m s/rad]"),
-      field("delta", &S::delta, "contact-radius law rho = delta f_n^gamma [m/N^gamma]"),
-      field("gamma", &S::gamma, "contact-radius exponent [-]"),
-      field("k", &S::k, "pressure exponent [-]; 0 selects the elliptic limit surface"),
-      field("c_max", &S::c_max, "saturation of the normalized CoR |c~| [-]"),
-      field("static_ratio", &S::static_ratio, "break-away friction over mu, mu_s / mu [-] (S's capacity in stick)"),
-      field("kinetic_ratio", &S::kinetic_ratio, "sliding friction level over mu, mu_k / mu [-] (S's capacity once sliding)"));
-};
+struct Table<ContactParams> : lugrip::FieldTable<ContactParams> {};  // lugrip/settings_fields.hpp
 
 template <>
-struct Table<CorSettings> {
-  using S = CorSettings;
-  static constexpr auto fields = std::make_tuple(
-      field("f_n_min", &S::f_n_min, "below this normal force: NoContact [N]"),
-      field("force_limit", &S::force_limit, "|f_n| or |f_t| above: InvalidSample [N]"),
-      field("torque_limit", &S::torque_limit, "|tau| above: InvalidSample [N m]"),
-      field("zero_force", &S::zero_force, "normalized f_t below this counts as zero [-]"),
-      field("zero_torque", &S::zero_torque, "normalized |tau| below this counts as zero [-]"));
-};
+struct Table<CorSettings> : lugrip::FieldTable<CorSettings> {};  // lugrip/settings_fields.hpp
 
 template <>
-struct Table<SliderSettings> {
-  using S = SliderSettings;
-  static constexpr auto fields = std::make_tuple(
-      field("integrator", &S::integrator, "discretisation of the slider"),
-      field("max_substep", &S::max_substep, "longest internal step [s]"),
-      field("max_substeps", &S::max_substeps, "cap on substeps per step"),
-      field("g_floor", &S::g_floor, "lower bound on g [N m]"));
-};
+struct Table<SliderSettings> : lugrip::FieldTable<SliderSettings> {};  // lugrip/settings_fields.hpp
 
 template <>
-struct Table<ObserverSettings> {
-  using S = ObserverSettings;
-  static constexpr auto fields = std::make_tuple(
-      field("dt", &S::dt, "nominal sample period [s]"),
-      field("integrator", &S::integrator, "discretisation (Integrator)"),
-      field("gain_mode", &S::gain_mode, "Fixed or Bandwidth (GainMode)"),
-      field("gain", &S::gain, "l in Fixed mode [1/(kg m^2)]"),
-      field("bandwidth", &S::bandwidth, "l sigma_1 in Bandwidth mode [1/s]"),
-      field("gain_min", &S::gain_min, "lower clip of l in Bandwidth mode [1/(kg m^2)]"),
-      field("gain_max", &S::gain_max, "upper clip of l in Bandwidth mode [1/(kg m^2)]"),
-      field("g_floor", &S::g_floor, "lower bound on g [N m]"),
-      field("torque_cutoff", &S::torque_cutoff, "low-pass of the CoR torque (0: off) [Hz]"),
-      field("filter_force", &S::filter_force, "also low-pass f_t for the CoR"),
-      field("cor_sign_sigmas", &S::cor_sign_sigmas, "CoR side hysteresis in noise standard deviations [-]"),
-      field("max_invalid", &S::max_invalid, "consecutive invalid samples before SensorFault"),
-      field("max_dt_gap", &S::max_dt_gap, "longer gaps re-initialise [s]"),
-      field("torque_noise", &S::torque_noise, "torque noise std of the sensor [N m]"),
-      field("resolution_max", &S::resolution_max, "speed_observable below this resolution [rad/s]"),
-      field("omega_limit", &S::omega_limit, "divergence guard on |omega_hat| [rad/s]"),
-      field("substeps", &S::substeps, "minimum substeps per sample"),
-      field("max_substeps", &S::max_substeps, "cap of adaptive substeps per sample"),
-      field("cor", &S::cor, "CoR estimator settings (CorSettings)"));
-};
+struct Table<ObserverSettings> : lugrip::FieldTable<ObserverSettings> {};  // lugrip/settings_fields.hpp
 
 template <>
 struct Table<GraspControllerSettings> {
@@ -93,26 +46,10 @@ struct Table<GraspControllerSettings> {
 };
 
 template <>
-struct Table<SlipControlSettings> {
-  using S = SlipControlSettings;
-  static constexpr auto fields = std::make_tuple(
-      field("observer", &S::observer, "settings of each finger's observer (ObserverSettings)"),
-      field("controller", &S::controller, "controller settings (GraspControllerSettings)"),
-      field("fingers", &S::fingers, "fingertips measured: 1 or 2"),
-      field("stuck_samples", &S::stuck_samples, "exact repeats of a wrench reported SensorFault [samples] (0: off)"),
-      field("healthy_finger_fallback", &S::healthy_finger_fallback, "one faulty finger: the other drives the command"));
-};
+struct Table<SlipControlSettings> : lugrip::FieldTable<SlipControlSettings> {};  // lugrip/settings_fields.hpp
 
 template <>
-struct Table<IdentificationSettings> {
-  using S = IdentificationSettings;
-  static constexpr auto fields = std::make_tuple(
-      field("observer", &S::observer, "observer inside the cost (ObserverSettings)"),
-      field("loss", &S::loss, "loss of the residuals (IdLoss)"),
-      field("huber_scale", &S::huber_scale, "Huber transition [rad/s]"),
-      field("threads", &S::threads, "worker threads (0: hardware)"),
-      field("sensitivity_limit", &S::sensitivity_limit, "bound of the sensitivity states"));
-};
+struct Table<IdentificationSettings> : lugrip::FieldTable<IdentificationSettings> {};  // lugrip/settings_fields.hpp
 
 // --- per-sample outputs ---------------------------------------------------------------------
 

@@ -6,6 +6,7 @@
 #include <stdexcept>
 #include <string>
 
+#include "field_checks.hpp"
 #include "format.hpp"
 #include "lugrip/detail/fast_math.hpp"
 
@@ -227,20 +228,9 @@ void ContactModel::wrench_at(double f_n, double c_tilde, double y, double& f_t, 
   tau = sign * p_.mu * xi * rho_n * f_n * std::pow(u, p_.gamma + 1.0) * q.T;
 }
 
-bool validate(const CorSettings& s, std::string* message) {
-  std::string msg;
-  auto positive = [&](const char* name, double v) {
-    if (!(std::isfinite(v) && v > 0.0))
-      msg += std::string(name) + " = " + detail::format_number(v) + ": must be finite and > 0\n";
-  };
-  positive("f_n_min", s.f_n_min);
-  positive("force_limit", s.force_limit);
-  positive("torque_limit", s.torque_limit);
-  positive("zero_force", s.zero_force);
-  positive("zero_torque", s.zero_torque);
-  if (message) *message = msg;
-  return msg.empty();
-}
+bool validate(const CorSettings& s, std::string* message) { return detail::validate_fields(s, message); }
+
+std::string to_string(const CorSettings& s) { return detail::print_fields(s); }
 
 namespace {
 const CorSettings& checked(const CorSettings& s) {

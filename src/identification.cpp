@@ -11,6 +11,7 @@
 
 #include "lugrip/detail/rotor_steps.hpp"
 
+#include "field_checks.hpp"
 #include "format.hpp"
 
 namespace lugrip {
@@ -354,28 +355,9 @@ void run_segment(Observer& obs, const SegmentWork& w, int64_t begin, int64_t end
 
 }  // namespace
 
-bool validate(const IdentificationSettings& s, std::string* message) {
-  std::string msg;
-  if (!(s.loss == IdLoss::Squared || s.loss == IdLoss::Huber))
-    msg += "loss = " + std::to_string(static_cast<int>(s.loss)) + ": unknown loss (squared, huber)\n";
-  if (!(std::isfinite(s.huber_scale) && s.huber_scale > 0.0))
-    msg += "huber_scale = " + fmt(s.huber_scale) + ": must be finite and > 0 [rad/s]\n";
-  if (!(std::isfinite(s.sensitivity_limit) && s.sensitivity_limit > 0.0))
-    msg += "sensitivity_limit = " + fmt(s.sensitivity_limit) + ": must be finite and > 0\n";
-  if (!(s.threads >= 0)) msg += "threads = " + std::to_string(s.threads) + ": must be >= 0 (0: all cores)\n";
-  std::string obs;
-  if (!validate(s.observer, &obs)) {
-    size_t start = 0;
-    while (start < obs.size()) {
-      const size_t end = obs.find('\n', start);
-      msg += "observer." + obs.substr(start, end == std::string::npos ? std::string::npos : end - start) + "\n";
-      if (end == std::string::npos) break;
-      start = end + 1;
-    }
-  }
-  if (message) *message = msg;
-  return msg.empty();
-}
+bool validate(const IdentificationSettings& s, std::string* message) { return detail::validate_fields(s, message); }
+
+std::string to_string(const IdentificationSettings& s) { return detail::print_fields(s); }
 
 bool validate(const IdentificationData& d, std::string* message) {
   std::string msg;

@@ -2,18 +2,18 @@
 
 #include <algorithm>
 #include <cmath>
+#include <iterator>
 #include <limits>
 #include <stdexcept>
 #include <string>
 
+#include "field_checks.hpp"
 #include "format.hpp"
 
 namespace lugrip {
 
 namespace {
 constexpr double kTwoPi = 6.28318530717958647692;
-
-std::string fmt(double v) { return detail::format_number(v); }
 
 const ObserverSettings& checked(const ObserverSettings& s) {
   std::string msg;
@@ -25,79 +25,13 @@ inline double clip(double v, double bound) noexcept { return v > bound ? bound :
 }  // namespace
 
 const char* to_string(GainMode m) noexcept {
-  switch (m) {
-    case GainMode::Fixed: return "fixed";
-    case GainMode::Bandwidth: return "bandwidth";
-  }
-  return "unknown";
+  const int k = static_cast<int>(m);
+  return k >= 0 && k < static_cast<int>(std::size(kGainModeNames)) ? kGainModeNames[k] : "unknown";
 }
 
-bool validate(const ObserverSettings& s, std::string* message) {
-  std::string msg;
-  auto bad = [&](const char* name, const std::string& value, const char* rule) {
-    msg += std::string(name) + " = " + value + ": " + rule + "\n";
-  };
-  // v finite and in [lo, hi] (lo_open: v > lo)
-  auto within = [&](const char* name, double v, double lo, bool lo_open, double hi, const char* unit) {
-    if (!(std::isfinite(v) && (lo_open ? v > lo : v >= lo) && v <= hi))
-      bad(name, fmt(v), (std::string("must be finite, ") + (lo_open ? "> " : ">= ") + fmt(lo) + " and <= " +
-                         fmt(hi) + " " + unit).c_str());
-  };
-  within("dt", s.dt, 1e-9, false, 10.0, "[s]");
-  if (!(s.integrator == Integrator::Implicit || s.integrator == Integrator::Rk4 ||
-        s.integrator == Integrator::Rk4Adaptive || s.integrator == Integrator::Rosenbrock))
-    bad("integrator", std::to_string(static_cast<int>(s.integrator)), "unknown scheme (implicit, rk4, rk4_adaptive, rosenbrock)");
-  if (!(s.gain_mode == GainMode::Fixed || s.gain_mode == GainMode::Bandwidth))
-    bad("gain_mode", std::to_string(static_cast<int>(s.gain_mode)), "unknown mode (fixed, bandwidth)");
-  within("gain", s.gain, 0.0, true, 1e15, "[1/(kg m^2)]");
-  within("bandwidth", s.bandwidth, 0.0, true, 1e9, "[1/s]");
-  within("gain_min", s.gain_min, 0.0, true, 1e15, "[1/(kg m^2)]");
-  within("gain_max", s.gain_max, 0.0, true, 1e15, "[1/(kg m^2)]");
-  if (std::isfinite(s.gain_min) && std::isfinite(s.gain_max) && s.gain_min > 0.0 && s.gain_max <= 1e15 &&
-      s.gain_min > s.gain_max)
-    bad("gain_max", fmt(s.gain_max), "must be >= gain_min");
-  within("g_floor", s.g_floor, 0.0, true, 1.0, "[N m]");
-  within("torque_cutoff", s.torque_cutoff, 0.0, false, 1e9, "[Hz] (0: no filter)");
-  within("cor_sign_sigmas", s.cor_sign_sigmas, 0.0, false, 1e3, "[-]");
-  if (!(s.max_invalid >= 1 && s.max_invalid <= 1000000))
-    bad("max_invalid", std::to_string(s.max_invalid), "must be >= 1 and <= 1000000");
-  if (!(std::isfinite(s.max_dt_gap) && s.max_dt_gap > 0.0 && !(s.max_dt_gap < s.dt) && s.max_dt_gap <= 10.0))
-    bad("max_dt_gap", fmt(s.max_dt_gap), "must be finite, >= dt and <= 10 [s]");
-  const double torque_range = std::isfinite(s.cor.torque_limit) && s.cor.torque_limit > 0.0 ? s.cor.torque_limit : 0.0;
-  if (!(std::isfinite(s.torque_noise) && s.torque_noise >= 0.0 && s.torque_noise <= torque_range))
-    bad("torque_noise", fmt(s.torque_noise), "must be finite, >= 0 and <= cor.torque_limit [N m]");
-  within("omega_limit", s.omega_limit, 0.0, true, 1e6, "[rad/s]");
-  const double omega_range = std::isfinite(s.omega_limit) && s.omega_limit > 0.0 ? std::min(s.omega_limit, 1e6) : 1e6;
-  if (!(std::isfinite(s.resolution_max) && s.resolution_max > 0.0 && s.resolution_max <= omega_range))
-    bad("resolution_max", fmt(s.resolution_max), "must be finite, > 0 and <= omega_limit [rad/s]");
-  if (!(s.substeps >= 1)) bad("substeps", std::to_string(s.substeps), "must be >= 1");
-  if (!(s.max_substeps >= 1 && s.max_substeps <= kMaxObserverSubsteps))
-    bad("max_substeps", std::to_string(s.max_substeps), "must be >= 1 and <= 5000");
-  else if (s.substeps >= 1 && s.substeps > s.max_substeps)
-    bad("max_substeps", std::to_string(s.max_substeps), "must be >= substeps");
-  std::string cor_msg;
-  if (!validate(s.cor, &cor_msg)) {
-    size_t start = 0;
-    while (start < cor_msg.size()) {
-      const size_t end = cor_msg.find('\n', start);
-      msg += "cor." + cor_msg.substr(start, end == std::string::npos ? std::string::npos : end - start) + "\n";
-      if (end == std::string::npos) break;
-      start = end + 1;
-    }
-  } else {
-    // Narrower than the estimator alone accepts: keeps |y|, g / sigma0 and v_slip finite.
-    if (!(s.cor.f_n_min >= kMinContactForce))
-      bad("cor.f_n_min", fmt(s.cor.f_n_min), "must be >= 1e-06 [N] in an observer");
-    if (!(s.cor.force_limit <= kMaxForceLimit))
-      bad("cor.force_limit", fmt(s.cor.force_limit), "must be <= 1e+09 [N] in an observer");
-    if (!(s.cor.torque_limit <= kMaxForceLimit))
-      bad("cor.torque_limit", fmt(s.cor.torque_limit), "must be <= 1e+09 [N m] in an observer");
-    if (s.cor.f_n_min >= kMinContactForce && s.cor.force_limit <= kMaxForceLimit && !(s.cor.f_n_min < s.cor.force_limit))
-      bad("cor.f_n_min", fmt(s.cor.f_n_min), "must be < cor.force_limit");
-  }
-  if (message) *message = msg;
-  return msg.empty();
-}
+bool validate(const ObserverSettings& s, std::string* message) { return detail::validate_fields(s, message); }
+
+std::string to_string(const ObserverSettings& s) { return detail::print_fields(s); }
 
 namespace {
 // Hysteresis band: cor_sign_sigmas standard deviations of white torque noise after the

@@ -9,8 +9,11 @@
 #include <sstream>
 #include <stdexcept>
 #include <type_traits>
+#include <vector>
 
-#include "lugrip/grasp_controller_fields.hpp"
+#include "lugrip/settings_fields.hpp"
+
+#include "field_checks.hpp"
 
 namespace lugrip {
 
@@ -66,10 +69,73 @@ void validated(const T& value, const std::string& where) {
   }
 }
 
+// Sets one field from a scalar, by the field's type (an enumeration by its values' names).
+template <class S, class F>
+void read_value(S& s, const F& f, const YAML::Node& v, const std::string& at) {
+  using T = std::decay_t<decltype(s.*(f.member))>;
+  if constexpr (std::is_same_v<T, bool>) {
+    s.*(f.member) = boolean(v, at);
+  } else if constexpr (std::is_enum_v<T>) {
+    const std::string name = text(v, at);
+    std::string names;
+    for (int k = 0; k < f.n_choices; ++k) {
+      if (name == f.choices[k]) {
+        s.*(f.member) = static_cast<T>(k);
+        return;
+      }
+      names += (k ? (k + 1 == f.n_choices ? " or " : ", ") : "") + std::string(f.choices[k]);
+    }
+    fail(at, "expected " + names);
+  } else if constexpr (std::is_integral_v<T>) {
+    s.*(f.member) = integer(v, at);
+  } else {
+    s.*(f.member) = number(v, at);
+  }
+}
+
+// Sets the field named `key` (a nested struct's fields by their own names: the observer block's
+// f_n_min is cor.f_n_min); false when the table has no such field.
+template <class S>
+bool read_key(S& s, const std::string& key, const YAML::Node& v, const std::string& at) {
+  bool known = false;
+  detail::for_each_entry(FieldTable<S>::fields, [&](const auto& f) {
+    using T = std::decay_t<decltype(s.*(f.member))>;
+    if (known) return;
+    if constexpr (std::is_class_v<T>) {
+      known = read_key(s.*(f.member), key, v, at);
+    } else if (key == f.name) {
+      known = true;
+      read_value(s, f, v, at);
+    }
+  });
+  return known;
+}
+
+// The table's fields a default-constructed struct leaves out of range: a file must give them.
+template <class S>
+std::vector<const char*> required_fields() {
+  std::vector<const char*> out;
+  const S s{};
+  detail::for_each_entry(FieldTable<S>::fields, [&](const auto& f) {
+    using T = std::decay_t<decltype(s.*(f.member))>;
+    if constexpr (std::is_arithmetic_v<T> && !std::is_same_v<T, bool>)
+      if (!detail::in_range(f, static_cast<double>(s.*(f.member)))) out.push_back(f.name);
+  });
+  return out;
+}
+
+std::string name_list(const std::vector<const char*>& names, const char* last) {
+  std::string out;
+  for (size_t k = 0; k < names.size(); ++k)
+    out += (k ? (k + 1 == names.size() ? std::string(" ") + last + " " : ", ") : "") + std::string(names[k]);
+  return out;
+}
+
 ContactParams read_contact(const YAML::Node& block, const std::string& where) {
   if (!block.IsMap()) fail(where, "expected a mapping of contact parameters");
   ContactParams p;
-  int required = 0;
+  const std::vector<const char*> required = required_fields<ContactParams>();
+  size_t given = 0;
   for (const auto& kv : block) {
     const std::string key = kv.first.as<std::string>();
     if (key == "observer" || key == "controller") continue;  // flat layout: blocks of their own
@@ -79,22 +145,14 @@ ContactParams read_contact(const YAML::Node& block, const std::string& where) {
       if (!v["value"]) fail(at, "a mapping needs a value");
       v = v["value"];
     }
-    double* field = nullptr;
-    if (key == "mu") field = &p.mu;
-    else if (key == "beta_a") field = &p.beta_a;
-    else if (key == "sigma0") field = &p.sigma0;
-    else if (key == "sigma_z") field = &p.sigma_z;
-    else if (key == "delta") field = &p.delta;
-    else if (key == "gamma") field = &p.gamma;
-    else if (key == "k") field = &p.k;
-    else if (key == "c_max") field = &p.c_max;
-    else if (key == "static_ratio") field = &p.static_ratio;
-    else if (key == "kinetic_ratio") field = &p.kinetic_ratio;
-    else fail(at, "unknown parameter (expected mu, beta_a, sigma0, sigma_z, delta, gamma, k, c_max, static_ratio, kinetic_ratio)");
-    *field = number(v, at);
-    if (key != "k" && key != "c_max" && key != "static_ratio" && key != "kinetic_ratio") ++required;
+    if (!read_key(p, key, v, at)) {
+      std::vector<const char*> names;
+      detail::for_each_entry(FieldTable<ContactParams>::fields, [&](const auto& f) { names.push_back(f.name); });
+      fail(at, "unknown parameter (expected " + name_list(names, "or") + ")");
+    }
+    for (const char* r : required) given += key == r;
   }
-  if (required < 6) fail(where, "needs mu, beta_a, sigma0, sigma_z, delta and gamma");
+  if (given < required.size()) fail(where, "needs " + name_list(required, "and"));
   validated(p, where);
   return p;
 }
@@ -108,41 +166,10 @@ ObserverSettings read_observer(const YAML::Node& block, const std::string& where
     const YAML::Node& v = kv.second;
     const std::string at = where + "." + key;
     if (v.IsNull()) continue;  // "not given"
-    if (key == "dt") s.dt = number(v, at);
-    else if (key == "integrator") {
-      const std::string name = text(v, at);
-      if (name == "implicit") s.integrator = Integrator::Implicit;
-      else if (name == "rk4") s.integrator = Integrator::Rk4;
-      else if (name == "rk4_adaptive") s.integrator = Integrator::Rk4Adaptive;
-      else if (name == "rosenbrock") s.integrator = Integrator::Rosenbrock;
-      else fail(at, "expected implicit, rk4, rk4_adaptive or rosenbrock");
-    } else if (key == "gain_mode") {
-      const std::string name = text(v, at);
-      if (name == "fixed") s.gain_mode = GainMode::Fixed;
-      else if (name == "bandwidth") s.gain_mode = GainMode::Bandwidth;
-      else fail(at, "expected fixed or bandwidth");
-      mode = true;
-    } else if (key == "gain") { s.gain = number(v, at); gain = true; }
-    else if (key == "bandwidth") { s.bandwidth = number(v, at); bandwidth = true; }
-    else if (key == "gain_min") s.gain_min = number(v, at);
-    else if (key == "gain_max") s.gain_max = number(v, at);
-    else if (key == "g_floor") s.g_floor = number(v, at);
-    else if (key == "torque_cutoff") s.torque_cutoff = number(v, at);
-    else if (key == "filter_force") s.filter_force = boolean(v, at);
-    else if (key == "cor_sign_sigmas") s.cor_sign_sigmas = number(v, at);
-    else if (key == "max_invalid") s.max_invalid = integer(v, at);
-    else if (key == "max_dt_gap") s.max_dt_gap = number(v, at);
-    else if (key == "torque_noise") s.torque_noise = number(v, at);
-    else if (key == "resolution_max") s.resolution_max = number(v, at);
-    else if (key == "omega_limit") s.omega_limit = number(v, at);
-    else if (key == "substeps") s.substeps = integer(v, at);
-    else if (key == "max_substeps") s.max_substeps = integer(v, at);
-    else if (key == "f_n_min") s.cor.f_n_min = number(v, at);
-    else if (key == "force_limit") s.cor.force_limit = number(v, at);
-    else if (key == "torque_limit") s.cor.torque_limit = number(v, at);
-    else if (key == "zero_force") s.cor.zero_force = number(v, at);
-    else if (key == "zero_torque") s.cor.zero_torque = number(v, at);
-    else fail(at, "unknown observer setting");
+    if (!read_key(s, key, v, at)) fail(at, "unknown observer setting");
+    gain |= key == "gain";
+    bandwidth |= key == "bandwidth";
+    mode |= key == "gain_mode";
   }
   // The Python Observer's rule: a gain alone means a fixed gain.
   if (!mode) s.gain_mode = gain && !bandwidth ? GainMode::Fixed : GainMode::Bandwidth;
@@ -158,16 +185,7 @@ GraspControllerSettings read_controller(const YAML::Node& block, const std::stri
     const YAML::Node& v = kv.second;
     const std::string at = where + "." + key;
     if (v.IsNull()) continue;  // "not given"
-    bool known = false;
-    detail::for_each_entry(grasp_controller_fields, [&](const auto& f) {
-      if (known || key != f.name) return;
-      known = true;
-      using T = std::decay_t<decltype(s.*(f.member))>;
-      if constexpr (std::is_same_v<T, bool>) s.*(f.member) = boolean(v, at);
-      else if constexpr (std::is_integral_v<T>) s.*(f.member) = integer(v, at);
-      else s.*(f.member) = number(v, at);
-    });
-    if (!known) fail(at, "unknown controller setting");
+    if (!read_key(s, key, v, at)) fail(at, "unknown controller setting");
   }
   validated(s, where);
   return s;

@@ -2,21 +2,19 @@
 
 #include <algorithm>
 #include <cmath>
+#include <iterator>
 #include <stdexcept>
 #include <string>
 
 #include "lugrip/detail/rotor_steps.hpp"
 
+#include "field_checks.hpp"
+
 namespace lugrip {
 
 const char* to_string(Integrator i) noexcept {
-  switch (i) {
-    case Integrator::Implicit: return "implicit";
-    case Integrator::Rk4: return "rk4";
-    case Integrator::Rk4Adaptive: return "rk4_adaptive";
-    case Integrator::Rosenbrock: return "rosenbrock";
-  }
-  return "unknown";
+  const int k = static_cast<int>(i);
+  return k >= 0 && k < static_cast<int>(std::size(kIntegratorNames)) ? kIntegratorNames[k] : "unknown";
 }
 
 // The integrators themselves: lugrip/detail/rotor_steps.hpp (shared with the identification's
@@ -127,20 +125,9 @@ bool rotor_advance(double& z, double& omega, double h, const RotorCoefficients& 
   return projected;
 }
 
-bool validate(const SliderSettings& s, std::string* message) {
-  std::string msg;
-  if (!(s.integrator == Integrator::Implicit || s.integrator == Integrator::Rk4 ||
-        s.integrator == Integrator::Rk4Adaptive || s.integrator == Integrator::Rosenbrock))
-    msg += "integrator = " + std::to_string(static_cast<int>(s.integrator)) + ": unknown scheme\n";
-  if (!(std::isfinite(s.max_substep) && s.max_substep > 0.0))
-    msg += "max_substep = " + std::to_string(s.max_substep) + ": must be finite and > 0 [s]\n";
-  if (!(s.max_substeps >= 1))
-    msg += "max_substeps = " + std::to_string(s.max_substeps) + ": must be >= 1\n";
-  if (!(std::isfinite(s.g_floor) && s.g_floor > 0.0))
-    msg += "g_floor = " + std::to_string(s.g_floor) + ": must be finite and > 0 [N m]\n";
-  if (message) *message = msg;
-  return msg.empty();
-}
+bool validate(const SliderSettings& s, std::string* message) { return detail::validate_fields(s, message); }
+
+std::string to_string(const SliderSettings& s) { return detail::print_fields(s); }
 
 namespace {
 const SliderSettings& checked(const SliderSettings& s) {

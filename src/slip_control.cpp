@@ -5,17 +5,12 @@
 #include <sstream>
 #include <stdexcept>
 
+#include "field_checks.hpp"
 #include "format.hpp"
 
 namespace lugrip {
 
 namespace {
-
-void append_prefixed(std::string& msg, const std::string& sub, const char* prefix) {
-  std::istringstream lines(sub);
-  for (std::string line; std::getline(lines, line);)
-    if (!line.empty()) msg += std::string(prefix) + line + "\n";
-}
 
 const SlipControlSettings& checked(const SlipControlSettings& s) {
   std::string msg;
@@ -30,22 +25,9 @@ const ContactParams& checked(const ContactParams& p) {
 
 }  // namespace
 
-bool validate(const SlipControlSettings& s, std::string* message) {
-  std::string msg, sub;
-  if (!validate(s.observer, &sub)) append_prefixed(msg, sub, "observer.");
-  if (!validate(s.controller, &sub)) append_prefixed(msg, sub, "controller.");
-  if (s.fingers != 1 && s.fingers != 2)
-    msg += "fingers = " + std::to_string(s.fingers) + ": must be 1 or 2\n";
-  if (s.stuck_samples < 0)
-    msg += "stuck_samples = " + std::to_string(s.stuck_samples) + ": must be >= 0 (0: off) [samples]\n";
-  const double fs = s.controller.sensor_rate, dt = s.observer.dt;
-  if (std::isfinite(fs) && fs > 0.0 && std::isfinite(dt) && dt > 0.0 &&
-      !(std::fabs(dt * fs - 1.0) <= 1e-9))
-    msg += "observer.dt = " + detail::format_number(dt) + ": must equal 1 / controller.sensor_rate = " +
-           detail::format_number(1.0 / fs) + " [s]\n";
-  if (message) *message = msg;
-  return msg.empty();
-}
+bool validate(const SlipControlSettings& s, std::string* message) { return detail::validate_fields(s, message); }
+
+std::string to_string(const SlipControlSettings& s) { return detail::print_fields(s); }
 
 SlipControl::SlipControl(const ContactParams& params, const SlipControlSettings& settings)
     : SlipControl(ContactModel(checked(params)), settings) {}

@@ -1,6 +1,7 @@
 // lugrip — contact quantities (paper eqs. 3-4, 7-10, 16-18) and CoR estimation (eqs. 13-15).
 #pragma once
 
+#include <string>
 #include <vector>
 
 #include "lugrip/limit_surface.hpp"
@@ -75,15 +76,8 @@ constexpr double kCTildeUnclippedMax = 1.0e6;
 //! Per-sample settings of the CoR estimator (defaults in one place). Every field must be finite
 //! and > 0; a sample whose normalisation or CoR quantities overflow (forces near the largest
 //! double, mu or delta near 0) is InvalidSample. Inside an Observer the sensor range and the
-//! contact threshold are narrower (ObserverSettings).
-//!
-//! | field | meaning | unit | range | default |
-//! |---|---|---|---|---|
-//! | f_n_min | below this normal force: NoContact (paper's code: 0.03) | N | > 0 | 0.03 |
-//! | force_limit | |f_n| or |f_t| above: InvalidSample (sensor range) | N | > 0 | 1e4 |
-//! | torque_limit | |tau| above: InvalidSample (sensor range) | N m | > 0 | 1e3 |
-//! | zero_force | f~_t below this counts as zero (pure rotation) | - | > 0 | 1e-4 |
-//! | zero_torque | |tau~| below this counts as zero: |c~| = c_max, sign held | - | > 0 | 1e-4 |
+//! contact threshold are narrower (ObserverSettings). Units, ranges and meanings: the field
+//! table, lugrip/settings_fields.hpp (docs/conventions.md prints it).
 struct CorSettings {
   double f_n_min = 0.03;         //!< [N] below this normal force: NoContact (paper's code: 0.03)
   double force_limit = 1.0e4;    //!< [N] |f_n| or |f_t| above: InvalidSample (sensor range)
@@ -100,6 +94,8 @@ constexpr double kMinContactForce = 1.0e-6;
 
 //! Checks the settings; one line per bad field in *message. Returns true when valid.
 bool validate(const CorSettings& s, std::string* message);
+//! "CorSettings(f_n_min=0.03, ...)" at full precision (for bug reports).
+std::string to_string(const CorSettings& s);
 
 //! One fingertip sample as the sensor gives it.
 struct CorInput {

@@ -26,13 +26,7 @@ enum class IdLoss : int {
 
 //! Settings of the identification cost (defaults in one place).
 //!
-//! | field | meaning | unit | range | default |
-//! |---|---|---|---|---|
-//! | observer | the ONLINE observer settings: the cost runs exactly this observer | | valid | ObserverSettings() |
-//! | loss | Squared or Huber | - | | Squared |
-//! | huber_scale | residual where the Huber loss turns linear | rad/s | > 0 | 0.05 |
-//! | threads | worker threads over segments (0: hardware concurrency) | - | >= 0 | 0 |
-//! | sensitivity_limit | chattering guard: a state sensitivity beyond this many times its scale (per unit log-parameter; omega: the segment's largest |omega|, z: g/sigma0) restarts the sensitivities | - | > 0 | 100 |
+//! Units, ranges and meanings: the field table, lugrip/settings_fields.hpp.
 struct IdentificationSettings {
   ObserverSettings observer;
   IdLoss loss = IdLoss::Squared;
@@ -43,6 +37,8 @@ struct IdentificationSettings {
 
 //! Checks every field (and the nested observer settings); one line per bad field in *message.
 bool validate(const IdentificationSettings& s, std::string* message);
+//! "IdentificationSettings(observer=ObserverSettings(...), ...)" at full precision.
+std::string to_string(const IdentificationSettings& s);
 
 //! Samples of many independent segments (maneuvers, or the gap-free stretches of a maneuver),
 //! concatenated. The observer restarts at every segment start and is never integrated across

@@ -33,26 +33,8 @@ const char* to_string(GainMode m) noexcept;
 //! behind slip ramps is absorbed by sigma0 (x2) and beta_A (-14 %); BENCHMARKS.md, section
 //! Identification.
 //!
-//! | field | meaning | unit | range | default |
-//! |---|---|---|---|---|
-//! | dt | nominal sample period, used when ObserverInput::dt == 0 | s | [1e-9, 10] | 0.002 |
-//! | integrator | discretisation (Integrator) | - | | Rosenbrock |
-//! | gain_mode | Fixed or Bandwidth | - | | Bandwidth |
-//! | gain | l in Fixed mode | 1/(kg m^2) | (0, 1e15] | 200 |
-//! | bandwidth | B = l sigma_1 in Bandwidth mode (sliding convergence rate) | 1/s | (0, 1e9] | 3000 |
-//! | gain_min, gain_max | clip of l in Bandwidth mode | 1/(kg m^2) | 0 < min <= max <= 1e15 | 1, 1e7 |
-//! | g_floor | lower bound on g | N m | (0, 1] | 1e-7 |
-//! | torque_cutoff | first-order low-pass of the torque used for the CoR only (0: off); y uses the raw torque | Hz | [0, 1e9] | 2 |
-//! | filter_force | also low-pass f_t (same filter) for the CoR, so a proportional load ramp keeps its CoR | - | | true |
-//! | cor_sign_sigmas | CoR sign hysteresis: the side changes only when the filtered torque exceeds this many standard deviations of the filtered torque noise (torque_noise through the low-pass at dt) with the other sign | - | [0, 1e3] | 5 |
-//! | max_invalid | consecutive invalid samples before SensorFault | - | [1, 1e6] | 10 |
-//! | max_dt_gap | longer gaps re-initialise instead of being integrated across | s | [dt, 10] | 0.05 |
-//! | torque_noise | torque noise std of the sensor (omega_resolution, sign hysteresis) | N m | [0, cor.torque_limit] | 1e-5 |
-//! | resolution_max | speed_observable when omega_resolution <= this | rad/s | (0, omega_limit] | 0.02 |
-//! | omega_limit | divergence guard: larger |omega_hat| re-initialises | rad/s | (0, 1e6] | 1000 |
-//! | substeps | (minimum) equal substeps per sample, every scheme | - | [1, max_substeps] | 1 |
-//! | max_substeps | cap of adaptive substeps (Rk4Adaptive, Rosenbrock) per sample | - | [substeps, 5000] | 500 |
-//! | cor | CoR estimator settings (contact threshold, sensor range, zero thresholds); here cor.f_n_min >= 1e-6 N (kMinContactForce) and cor.force_limit, cor.torque_limit <= 1e9 N, N m (kMaxForceLimit) | | | CorSettings() |
+//! Units, ranges and meanings of the fields: the field table, lugrip/settings_fields.hpp (its
+//! ranges are what validate() enforces; docs/conventions.md prints it).
 //!
 //! What the ranges guarantee, with ContactParams inside theirs (sigma0 >= 1e-12 among them):
 //! * finite outputs: rho = delta f_n^gamma < max(1, f_n^(1/3)) and |c| <= c_max rho (c_max <=
@@ -94,6 +76,9 @@ constexpr int kMaxObserverSubsteps = 5000;
 //! Checks every field (and the nested CorSettings); one line per bad field in *message,
 //! naming field and value. Returns true when valid.
 bool validate(const ObserverSettings& s, std::string* message);
+//! "ObserverSettings(dt=0.002, integrator='rosenbrock', ..., cor=CorSettings(...))" at full
+//! precision (for bug reports).
+std::string to_string(const ObserverSettings& s);
 
 //! sqrt(x^2 + y^2), within an ulp of std::hypot (which is several times slower), falling back
 //! to std::hypot where the squares would overflow or underflow; NaN and Inf as std::hypot.

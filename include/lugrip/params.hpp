@@ -9,29 +9,31 @@ namespace lugrip {
 constexpr double kMinFrictionRatio = 0.5;
 constexpr double kMaxFrictionRatio = 3.0;
 
-//! Physical parameters of one fingertip/object contact (SI units).
+//! Physical parameters of one fingertip/object contact (SI units). Units, valid ranges and
+//! meanings: the field table, lugrip/settings_fields.hpp (docs/conventions.md prints it).
 //! No silent defaults for the physical fields: a default-constructed struct fails validation.
 struct ContactParams {
-  double mu = 0.0;       //!< friction coefficient of the limit surface [-], (0, 10] (fitted to gross sliding)
-  double beta_a = -1.0;  //!< viscous friction per unit area and speed [N s/m^3], >= 0 (paper prints "Ns/m")
-  double sigma0 = 0.0;   //!< micro-asperity (bristle) stiffness [N m/rad], >= 1e-12
-  double sigma_z = -1.0; //!< micro-asperity damping [N m s/rad], >= 0
-  double delta = 0.0;    //!< contact-radius law rho = delta f_n^gamma [m/N^gamma], > 0
-  double gamma = 0.0;    //!< contact-radius exponent [-], 0 < gamma < 1/3
-  double k = 4.0;        //!< pressure exponent p ~ (1-(r/rho)^k)^(1/k) [-], [0.5, inf]; 4 gives xi = 0.6354;
+  double mu = 0.0;       //!< friction coefficient of the limit surface [-] (fitted to gross sliding)
+  double beta_a = -1.0;  //!< viscous friction per unit area and speed [N s/m^3] (paper prints "Ns/m")
+  double sigma0 = 0.0;   //!< micro-asperity (bristle) stiffness [N m/rad]
+  double sigma_z = -1.0; //!< micro-asperity damping [N m s/rad]
+  double delta = 0.0;    //!< contact-radius law rho = delta f_n^gamma [m/N^gamma]
+  double gamma = 0.0;    //!< contact-radius exponent [-]
+  double k = 4.0;        //!< pressure exponent p ~ (1-(r/rho)^k)^(1/k) [-]; 4 gives xi = 0.6354;
                          //!< 0 (kEllipticLimitSurface) selects the elliptic limit surface
-  double c_max = 1.5;    //!< saturation of the normalized CoR |c~| [-], > 0 (paper: 1.5)
-  //! Break-away (static) friction over mu, mu_s / mu [-], [0.5, 3]: the capacity S is judged against
-  //! in stick (Stribeck term when > kinetic_ratio). 1 (default, the paper's model) = mu.
+  double c_max = 1.5;    //!< saturation of the normalized CoR |c~| [-] (paper: 1.5)
+  //! Break-away (static) friction over mu, mu_s / mu [-]: the capacity S is judged against in
+  //! stick (Stribeck term when > kinetic_ratio). 1 (default, the paper's model) = mu.
   double static_ratio = 1.0;
-  //! Sliding (kinetic) friction level over mu, mu_k / mu [-], [0.5, 3]: the capacity S is judged
-  //! against once sliding has started (the lower envelope of the sliding loads in identification).
+  //! Sliding (kinetic) friction level over mu, mu_k / mu [-]: the capacity S is judged against
+  //! once sliding has started (the lower envelope of the sliding loads in identification).
   //! 1 (default) = mu. With both ratios 1 the observer is the paper's (docs/model.md 7.5).
   double kinetic_ratio = 1.0;
 };
 
-//! Checks every field. Returns true when valid; otherwise writes one line per bad field
-//! ("mu = -1: must be finite and > 0") into *message (if not null) and returns false.
+//! Checks every field against its range in the field table. Returns true when valid; otherwise
+//! writes one line per bad field ("mu = -1: must be finite, > 0 and <= 10 [-]") into *message
+//! (if not null) and returns false.
 bool validate(const ContactParams& p, std::string* message);
 
 //! Throws std::invalid_argument with the message of validate() when invalid.

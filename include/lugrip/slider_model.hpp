@@ -138,6 +138,8 @@ struct SliderSettings {
 
 //! Checks the settings; one line per bad field in *message. Returns true when valid.
 bool validate(const SliderSettings& s, std::string* message);
+//! "SliderSettings(integrator='rosenbrock', ...)" at full precision (for bug reports).
+std::string to_string(const SliderSettings& s);
 
 //! One plant sample. f_n, c_tilde and tau_e are held over [t, t + dt].
 struct SliderInput {

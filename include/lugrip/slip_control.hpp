@@ -34,6 +34,8 @@ struct SlipControlSettings {
 //! Checks both nested settings, the finger count and the rate consistency; one line per problem
 //! in *message ("observer.dt = ...", "controller.k_p = ..."). Returns true when valid.
 bool validate(const SlipControlSettings& s, std::string* message);
+//! "SlipControlSettings(observer=..., controller=..., fingers=2, ...)" at full precision.
+std::string to_string(const SlipControlSettings& s);
 
 //! One fingertip wrench as a force/torque sensor reads it (object on fingertip, z along the
 //! contact normal; docs/model.md §7.2).

@@ -13,20 +13,12 @@ from ._yaml import describe_kind, field_path, load_yaml, to_number
 
 __all__ = ["PRESETS", "ContactParams"]
 
-_FIELDS = ("mu", "beta_a", "sigma0", "sigma_z", "delta", "gamma", "k", "c_max", "static_ratio",
-           "kinetic_ratio")
-_UNITS = {
-    "mu": "-",
-    "beta_a": "N s/m^3",
-    "sigma0": "N m/rad",
-    "sigma_z": "N m s/rad",
-    "delta": "m/N^gamma",
-    "gamma": "-",
-    "k": "-",
-    "c_max": "-",
-    "static_ratio": "-",
-    "kinetic_ratio": "-",
-}
+# Names, units and the fields a file must give, from the C++ field table
+# (include/lugrip/settings_fields.hpp): required are those a default-constructed struct leaves
+# out of range (its validate() names them, in the table's order).
+_FIELDS = tuple(p["name"] for p in _core.ContactParams.params)
+_UNITS = {p["name"]: p["unit"] for p in _core.ContactParams.params}
+_REQUIRED = tuple(line.split(" = ")[0] for line in _core.validate_params(_core.ContactParams()).splitlines())
 
 
 @dataclasses.dataclass(frozen=True)
@@ -146,7 +138,7 @@ class ContactParams:
                     raise ValueError(f"{where}: a mapping needs a 'value' entry")
                 value, where = value["value"], where + ".value"
             values[name] = to_number(value, where)
-        missing = [n for n in _FIELDS[:6] if n not in values]
+        missing = [n for n in _REQUIRED if n not in values]
         if missing:
             raise ValueError(f"missing parameter(s): {', '.join(prefix + m for m in missing)}")
         try:

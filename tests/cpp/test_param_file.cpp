@@ -12,6 +12,7 @@
 
 #include "lugrip/grasp_controller_fields.hpp"
 #include "lugrip/param_file.hpp"
+#include "lugrip/settings_fields.hpp"
 
 using namespace lugrip;
 
@@ -145,6 +146,37 @@ TEST(ParamFile, AnIdentificationResultWithAControllerBlockMakesTheSlipControl) {
   EXPECT_FALSE(parse_parameter_file(kIdentified).has_controller);
 }
 
+namespace {
+// Sets the field of `s` to a value other than its default that validate() accepts (an
+// enumeration's next value, a switch flipped, a number moved by 10 % or to 0.5 from 0) and
+// returns it as the file spells it.
+template <class S, class Whole, class F>
+std::string change(S& s, const F& f, const Whole& whole, bool (*valid)(const Whole&)) {
+  using T = std::decay_t<decltype(s.*(f.member))>;
+  std::ostringstream value;
+  value.precision(17);
+  if constexpr (std::is_same_v<T, bool>) {
+    s.*(f.member) = !(s.*(f.member));
+    value << (s.*(f.member) ? "true" : "false");
+  } else if constexpr (std::is_enum_v<T>) {
+    const int next = (static_cast<int>(s.*(f.member)) + 1) % f.n_choices;
+    s.*(f.member) = static_cast<T>(next);
+    value << f.choices[next];
+  } else if constexpr (std::is_integral_v<T>) {
+    s.*(f.member) = s.*(f.member) + 1;
+    value << s.*(f.member);
+  } else {
+    const double d = s.*(f.member);
+    s.*(f.member) = d == 0.0 ? 0.5 : 1.1 * d;
+    if (!valid(whole)) s.*(f.member) = d == 0.0 ? 0.01 : 0.9 * d;
+    value << s.*(f.member);
+  }
+  return value.str();
+}
+bool valid_observer(const ObserverSettings& s) { return validate(s, nullptr); }
+bool valid_controller(const GraspControllerSettings& s) { return validate(s, nullptr); }
+}  // namespace
+
 TEST(ParamFile, EveryControllerFieldOfTheTableIsRead) {
   // Each field of grasp_controller_fields, alone in a controller block with a value other than
   // its default (that validate() accepts), reads back into its own member and nowhere else.
@@ -153,27 +185,42 @@ TEST(ParamFile, EveryControllerFieldOfTheTableIsRead) {
   detail::for_each_entry(grasp_controller_fields, [&](const auto& f) {
     ++n;
     GraspControllerSettings want;
-    using T = std::decay_t<decltype(want.*(f.member))>;
-    std::ostringstream value;
-    if constexpr (std::is_same_v<T, bool>) {
-      want.*(f.member) = !(want.*(f.member));
-      value << (want.*(f.member) ? "true" : "false");
-    } else if constexpr (std::is_integral_v<T>) {
-      want.*(f.member) = want.*(f.member) + 1;
-      value << want.*(f.member);
-    } else {
-      // 2x the default (or 0.5 where the default is 0 or the doubled value is refused)
-      const double d = want.*(f.member);
-      want.*(f.member) = d == 0.0 ? 0.5 : 1.1 * d;
-      if (!validate(want, nullptr)) want.*(f.member) = d == 0.0 ? 0.01 : 0.9 * d;
-      value.precision(17);
-      value << want.*(f.member);
-    }
+    const std::string value = change(want, f, want, valid_controller);
     ASSERT_TRUE(validate(want, nullptr)) << f.name;
-    const ParameterFile file = parse_parameter_file(base + "controller: {" + f.name + ": " + value.str() + "}\n");
+    const ParameterFile file = parse_parameter_file(base + "controller: {" + f.name + ": " + value + "}\n");
     EXPECT_EQ(to_string(file.controller), to_string(want)) << f.name;
   });
   EXPECT_EQ(n, 20);  // every setting of GraspControllerSettings (docs/controller.md)
+}
+
+TEST(ParamFile, EveryObserverFieldOfTheTableIsRead) {
+  // Each field of the observer's table (the CoR estimator's by their own names), set away from
+  // its default, reads back into its own member and nowhere else (to_string compares them all).
+  const std::string base = "contact: {mu: 0.5, beta_a: 1e7, sigma0: 16, sigma_z: 2, delta: 0.0018, gamma: 0.25}\n";
+  int n = 0;
+  auto check = [&](const char* name, ObserverSettings& want, const std::string& value) {
+    ++n;
+    ASSERT_TRUE(validate(want, nullptr)) << name;
+    // gain_mode given: a gain alone would otherwise mean a fixed gain
+    const std::string mode = std::string(name) == "gain_mode" ? "" : std::string(", gain_mode: ") + to_string(want.gain_mode);
+    const ParameterFile file = parse_parameter_file(base + "observer: {" + name + ": " + value + mode + "}\n");
+    EXPECT_EQ(to_string(file.observer), to_string(want)) << name;
+  };
+  detail::for_each_entry(FieldTable<ObserverSettings>::fields, [&](const auto& f) {
+    using T = std::decay_t<decltype(std::declval<ObserverSettings&>().*(f.member))>;
+    if constexpr (std::is_same_v<T, CorSettings>) {
+      detail::for_each_entry(FieldTable<CorSettings>::fields, [&](const auto& g) {
+        ObserverSettings want;
+        const std::string value = change(want.cor, g, want, valid_observer);
+        check(g.name, want, value);
+      });
+    } else {
+      ObserverSettings want;
+      const std::string value = change(want, f, want, valid_observer);
+      check(f.name, want, value);
+    }
+  });
+  EXPECT_EQ(n, 18 + 5);  // every field of ObserverSettings and CorSettings
 }
 
 TEST(ParamFile, BadControllerFieldsAreNamed) {

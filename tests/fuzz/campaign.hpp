@@ -23,11 +23,13 @@
 #include <random>
 #include <stdexcept>
 #include <string>
+#include <type_traits>
 #include <vector>
 
 #include "lugrip/contact.hpp"
 #include "lugrip/grasp_controller.hpp"
 #include "lugrip/observer.hpp"
+#include "lugrip/settings_fields.hpp"
 #include "lugrip/params.hpp"
 #include "lugrip/slip_control.hpp"
 
@@ -89,21 +91,19 @@ inline double sample(Source& src, double typical, double p_bad, bool positive = 
 // A double field of a settings struct S; its accepted interval around the default is found by
 // bisection on the ordered bit patterns of the doubles, so the campaign follows validate()
 // wherever its bounds are.
-template <class S>
-struct RealField {
-  const char* name;
-  double* (*ref)(S&);
+// The fields come from the core's tables (lugrip/settings_fields.hpp, grasp_controller_fields.hpp):
+// every number and switch of a table is drawn, a nested struct's as "cor.f_n_min".
+template <class S, class T>
+struct NumberField {
+  std::string name;
+  std::function<T*(S&)> ref;
 };
 template <class S>
-struct IntField {
-  const char* name;
-  int* (*ref)(S&);
-};
+using RealField = NumberField<S, double>;
 template <class S>
-struct BoolField {
-  const char* name;
-  bool* (*ref)(S&);
-};
+using IntField = NumberField<S, int>;
+template <class S>
+using BoolField = NumberField<S, bool>;
 
 // Total order of doubles as integers (negative values mapped below positive ones).
 inline int64_t order_key(double v) {
@@ -129,7 +129,7 @@ struct Edges {
 };
 
 template <class S, class Valid>
-Edges find_edges(const S& base, double* (*ref)(S&), Valid valid) {
+Edges find_edges(const S& base, const std::function<double*(S&)>& ref, Valid valid) {
   S s = base;
   const double d = *ref(s);
   auto ok = [&](int64_t key) {
@@ -167,7 +167,7 @@ Edges find_edges(const S& base, double* (*ref)(S&), Valid valid) {
 }
 
 template <class S, class Valid>
-Edges find_int_edges(const S& base, int* (*ref)(S&), Valid valid) {
+Edges find_int_edges(const S& base, const std::function<int*(S&)>& ref, Valid valid) {
   S s = base;
   const int d = *ref(s);
   auto ok = [&](int64_t v) {
@@ -251,12 +251,33 @@ struct SettingsSpace {
   }
 };
 
-#define LUGRIP_FUZZ_REAL(S, field) \
-  RealField<S> { #field, [](S& s) -> double* { return &s.field; } }
-#define LUGRIP_FUZZ_INT(S, field) \
-  IntField<S> { #field, [](S& s) -> int* { return &s.field; } }
-#define LUGRIP_FUZZ_BOOL(S, field) \
-  BoolField<S> { #field, [](S& s) -> bool* { return &s.field; } }
+// Adds every double, int and bool field of S's table to the space of Root (get: Root -> S);
+// a nested struct's fields with its name as prefix. Enumerations are drawn by the cases
+// themselves (valid and out-of-range values).
+template <class S, class Root, class Get>
+void add_table(SettingsSpace<Root>& space, Get get, const std::string& prefix) {
+  lugrip::detail::for_each_entry(lugrip::FieldTable<S>::fields, [&](const auto& f) {
+    using T = std::decay_t<decltype(std::declval<S&>().*(f.member))>;
+    const auto m = f.member;
+    const std::string name = prefix + f.name;
+    if constexpr (std::is_same_v<T, double> || std::is_same_v<T, int> || std::is_same_v<T, bool>) {
+      NumberField<Root, T> field{name, [get, m](Root& r) -> T* { return &(get(r).*m); }};
+      if constexpr (std::is_same_v<T, double>) space.reals.push_back(field);
+      else if constexpr (std::is_same_v<T, int>) space.ints.push_back(field);
+      else space.bools.push_back(field);
+    } else if constexpr (std::is_class_v<T>) {
+      add_table<T>(space, [get, m](Root& r) -> T& { return get(r).*m; }, name + ".");
+    } else {
+      static_assert(std::is_enum_v<T>, "a field type the campaign cannot draw: add it to add_table");
+    }
+  });
+}
+
+// The space of S: its base value and every field of its table.
+template <class S>
+void add_table(SettingsSpace<S>& space) {
+  add_table<S>(space, [](S& s) -> S& { return s; }, "");
+}
 
 // --- statistics ---------------------------------------------------------------------------------
 struct Stats {
@@ -285,44 +306,17 @@ class Campaign {
   explicit Campaign(AllocCounter counter = nullptr) : count_(counter) {
     // contact parameters
     params_.base = table1_params();
-    params_.reals = {LUGRIP_FUZZ_REAL(ContactParams, mu),    LUGRIP_FUZZ_REAL(ContactParams, beta_a),
-                     LUGRIP_FUZZ_REAL(ContactParams, sigma0), LUGRIP_FUZZ_REAL(ContactParams, sigma_z),
-                     LUGRIP_FUZZ_REAL(ContactParams, delta),  LUGRIP_FUZZ_REAL(ContactParams, gamma),
-                     LUGRIP_FUZZ_REAL(ContactParams, k),      LUGRIP_FUZZ_REAL(ContactParams, c_max),
-                     LUGRIP_FUZZ_REAL(ContactParams, static_ratio), LUGRIP_FUZZ_REAL(ContactParams, kinetic_ratio)};
+    add_table(params_);
     params_.init([](const ContactParams& p) { return validate(p, nullptr); });
     // CoR estimator settings
-    cor_.reals = {LUGRIP_FUZZ_REAL(CorSettings, f_n_min), LUGRIP_FUZZ_REAL(CorSettings, force_limit),
-                  LUGRIP_FUZZ_REAL(CorSettings, torque_limit), LUGRIP_FUZZ_REAL(CorSettings, zero_force),
-                  LUGRIP_FUZZ_REAL(CorSettings, zero_torque)};
+    add_table(cor_);
     cor_.init([](const CorSettings& s) { return validate(s, nullptr); });
     // observer settings
-    obs_.reals = {LUGRIP_FUZZ_REAL(ObserverSettings, dt),           LUGRIP_FUZZ_REAL(ObserverSettings, gain),
-                  LUGRIP_FUZZ_REAL(ObserverSettings, bandwidth),    LUGRIP_FUZZ_REAL(ObserverSettings, gain_min),
-                  LUGRIP_FUZZ_REAL(ObserverSettings, gain_max),     LUGRIP_FUZZ_REAL(ObserverSettings, g_floor),
-                  LUGRIP_FUZZ_REAL(ObserverSettings, torque_cutoff), LUGRIP_FUZZ_REAL(ObserverSettings, cor_sign_sigmas),
-                  LUGRIP_FUZZ_REAL(ObserverSettings, max_dt_gap),   LUGRIP_FUZZ_REAL(ObserverSettings, torque_noise),
-                  LUGRIP_FUZZ_REAL(ObserverSettings, resolution_max), LUGRIP_FUZZ_REAL(ObserverSettings, omega_limit),
-                  LUGRIP_FUZZ_REAL(ObserverSettings, cor.f_n_min),  LUGRIP_FUZZ_REAL(ObserverSettings, cor.force_limit),
-                  LUGRIP_FUZZ_REAL(ObserverSettings, cor.torque_limit), LUGRIP_FUZZ_REAL(ObserverSettings, cor.zero_force),
-                  LUGRIP_FUZZ_REAL(ObserverSettings, cor.zero_torque)};
-    obs_.ints = {LUGRIP_FUZZ_INT(ObserverSettings, max_invalid), LUGRIP_FUZZ_INT(ObserverSettings, substeps),
-                 LUGRIP_FUZZ_INT(ObserverSettings, max_substeps)};
+    add_table(obs_);
     obs_.init([](const ObserverSettings& s) { return validate(s, nullptr); });
     // controller settings
     using G = GraspControllerSettings;
-    ctl_.reals = {LUGRIP_FUZZ_REAL(G, sensor_rate),   LUGRIP_FUZZ_REAL(G, f_min),
-                  LUGRIP_FUZZ_REAL(G, f_max),         LUGRIP_FUZZ_REAL(G, max_rate),
-                  LUGRIP_FUZZ_REAL(G, reaction_lag),
-                  LUGRIP_FUZZ_REAL(G, s_ref),
-                  LUGRIP_FUZZ_REAL(G, k_p),           LUGRIP_FUZZ_REAL(G, k_i),
-                  LUGRIP_FUZZ_REAL(G, gain_force),    LUGRIP_FUZZ_REAL(G, k_cd),
-                  LUGRIP_FUZZ_REAL(G, p_cd),          LUGRIP_FUZZ_REAL(G, z_cd),
-                  LUGRIP_FUZZ_REAL(G, reserve_force), LUGRIP_FUZZ_REAL(G, reserve_torque),
-                  LUGRIP_FUZZ_REAL(G, ceiling_factor), LUGRIP_FUZZ_REAL(G, mu_probe),
-                  LUGRIP_FUZZ_REAL(G, s_pivot),       LUGRIP_FUZZ_REAL(G, tau_pivot)};
-    ctl_.ints = {LUGRIP_FUZZ_INT(G, command_ratio)};
-    ctl_.bools = {LUGRIP_FUZZ_BOOL(G, load_floors)};
+    add_table(ctl_);
     ctl_.init([](const G& s) { return validate(s, nullptr); });
   }
 
@@ -441,8 +435,7 @@ class Campaign {
     std::unique_ptr<CorEstimator> est, twin;
     if (!construct(s, valid, st, [&] { est = std::make_unique<CorEstimator>(m, s); twin = std::make_unique<CorEstimator>(m, s); }, "CorEstimator"))
       return;
-    context_ = to_string(m.params()) + ", CorSettings(f_n_min=" + std::to_string(s.f_n_min) + ", force_limit=" +
-               std::to_string(s.force_limit) + ", torque_limit=" + std::to_string(s.torque_limit) + ")";
+    context_ = to_string(m.params()) + ", " + to_string(s);
     const double p_bad = 0.3 * std::pow(src.uniform(), 3.0);
     const double scale = src.chance(0.2) ? std::pow(10.0, 12.0 * src.uniform() - 6.0) : 1.0;
     Load l;
@@ -477,7 +470,7 @@ class Campaign {
     std::unique_ptr<Observer> obs, twin;
     if (!construct(s, valid, st, [&] { obs = std::make_unique<Observer>(m, s); twin = std::make_unique<Observer>(m, s); }, "Observer"))
       return;
-    context_ = to_string(m.params()) + ", observer dt=" + std::to_string(s.dt);
+    context_ = to_string(m.params()) + ", " + to_string(s);
     const double p_bad = 0.2 * std::pow(src.uniform(), 3.0);
     Load l;
     ObserverOutput o, ot;

@@ -1,11 +1,12 @@
-"""The settings tables written by hand beside the code agree with the code: the field tables of
-the headers (``//! | field | meaning | unit | range | default |`` in include/lugrip/contact.hpp
-and observer.hpp) and of docs/conventions.md (ContactParams, CorSettings) list exactly the fields
-of the bindings' tables (``_core.<Struct>.fields``, bindings/tables.hpp), with the defaults the
-compiled structs hold, the units of the bindings' docs, and ranges that ``validate`` enforces at
-their numeric bounds (the bound accepted when closed, refused when open; a step beyond refused).
-The grasp controller's settings are left to their own tables (they are being reworked). No plant
-is involved."""
+"""The settings tables of the documentation are the C++ field tables
+(include/lugrip/settings_fields.hpp) as the bindings expose them (``_core.<Struct>.params``):
+README.md's and docs/*.md's generated blocks equal what ``lugrip._field_docs`` prints from the
+compiled tables now (a changed default, unit, range or doc line fails until the pages are
+regenerated with ``python -m lugrip._field_docs``); the ranges in the tables are what
+``validate`` enforces at their numeric bounds (the bound accepted when closed, refused when
+open; a step beyond refused); the printed form (``repr``, C++ ``to_string``) lists every field of
+the table with its value. The grasp controller's settings keep their own hand-written table,
+checked against the compiled defaults. No plant is involved."""
 
 from __future__ import annotations
 
@@ -14,79 +15,51 @@ import re
 from pathlib import Path
 
 import pytest
-from lugrip import _core
+from lugrip import _core, _field_docs
 
 REPO = Path(__file__).resolve().parents[2]
 
 
-def _table(text: str, prefix: str, header: str) -> list[list[str]]:
-    """Rows (cells stripped) of the Markdown table whose header row starts with ``header``;
-    ``prefix`` is what each line starts with (``//! `` in a header, nothing in a page)."""
-    lines = [ln[len(prefix):] if ln.startswith(prefix) else None for ln in text.splitlines()]
-    start = next(i for i, ln in enumerate(lines) if ln is not None and ln.startswith(header))
-    rows = []
-    for ln in lines[start + 2:]:
-        if ln is None or not ln.startswith("|"):
-            break
-        # five columns; a pipe inside the meaning (|f_n|, |c~|) belongs to the meaning
-        cells = [c.strip() for c in ln.strip()[1:-1].split("|")]
-        cells = [cells[0], "|".join(cells[1:-3]).strip(), *cells[-3:]]
-        rows.append([c.strip("`") for c in cells])
-    return rows
+def _blocks(text: str) -> list[str]:
+    return re.findall(r"<!-- field-table: (\w+)", text)
 
 
-def _header_rows(header: str, after: str) -> dict[str, list[str]]:
-    """{field: [meaning, unit, range, default]} of the header table following ``after``."""
-    text = (REPO / "include" / "lugrip" / header).read_text()
-    text = text[text.index(after):]
-    out = {}
-    for name, meaning, unit, rng, default in _table(text, "//! ", "| field | meaning"):
-        names = [n.strip() for n in name.split(",")]
-        defaults = [d.strip() for d in default.split(",")] if len(names) > 1 else [default]
-        for n, d in zip(names, defaults):
-            out[n] = [meaning, unit, rng, d]
-    return out
+def test_pages_print_the_field_tables_as_compiled():
+    """Every generated block of README.md and docs/*.md equals the table generated from the
+    compiled field tables; the site prints every struct of ``_field_docs.STRUCTS``."""
+    printed = []
+    stale = []
+    for page in _field_docs.pages(REPO):
+        text = page.read_text()
+        printed += _blocks(text)
+        if _field_docs.render_blocks(text) != text:
+            stale.append(page.name)
+    assert not stale, f"regenerate with `python -m lugrip._field_docs`: {stale}"
+    assert sorted(set(printed)) == sorted(_field_docs.STRUCTS)
+    assert _blocks((REPO / "README.md").read_text()) == ["ContactParams"]
+    # the fields a file must give read "required" (their defaults are refused by validate())
+    readme = _field_docs.markdown_table("ContactParams")
+    assert readme.count("| required |") == 6 and "| `k` |" in readme
 
 
-def _number(text: str) -> float | None:
-    text = text.replace("∞", "inf").replace("−", "-")
-    try:
-        return float(text)
-    except ValueError:
-        return None
+def test_a_changed_table_is_found():
+    """The check is not vacuous: a page whose block disagrees with the compiled table in one
+    default (ObserverSettings.dt 0.002 written as 0.004) is rewritten, and the rewritten block
+    holds the compiled default."""
+    text = (REPO / "docs" / "conventions.md").read_text()
+    row = next(ln for ln in text.splitlines() if ln.startswith("| `dt` |"))
+    assert row.endswith("| 0.002 |")
+    mutated = text.replace(row, row.replace("| 0.002 |", "| 0.004 |"))
+    assert _field_docs.render_blocks(mutated) == text
+    rows = [ln for ln in _field_docs.markdown_table("ObserverSettings").splitlines() if ln.startswith("| `")]
+    assert len(rows) == len(_core.ObserverSettings.params)
 
 
-def _default_matches(value, text: str) -> bool:
-    if isinstance(value, bool):
-        return text.lower() == str(value).lower()
-    if isinstance(value, (int, float)):
-        number = _number(text)
-        return number is not None and math.isclose(float(value), number, rel_tol=1e-12)
-    return text == str(value).split(".")[-1]  # an enum: its name
-
-
-def _unit_of_doc(doc: str) -> str | None:
-    m = re.search(r"\[([^\]]+)\]\s*$", doc)
-    return None if m is None else m.group(1)
-
-
-def _bounds(rng: str) -> list[tuple[float, bool, int]]:
-    """Numeric bounds of a range cell: (value, closed, side) with side -1 lower, +1 upper.
-    Bounds that name another field ("[dt, 10]") are skipped."""
-    rng = rng.replace("≥", ">=").replace("≤", "<=").replace("∞", "inf")
-    out = []
-    m = re.fullmatch(r"([\[(])\s*([^,]+),\s*([^\])]+)([\])])", rng.strip())
-    if m:
-        lo, hi = _number(m.group(2)), _number(m.group(3))
-        if lo is not None:
-            out.append((lo, m.group(1) == "[", -1))
-        if hi is not None and math.isfinite(hi):
-            out.append((hi, m.group(4) == "]", +1))
-        return out
-    m = re.fullmatch(r"(>=|>)\s*(\S+)", rng.strip())
-    if m and _number(m.group(2)) is not None:
-        out.append((_number(m.group(2)), m.group(1) == ">=", -1))
-    return out
+def test_number_texts_read_back():
+    """The table's number texts read back as the same double."""
+    for v in (0.002, 1e-9, 1e15, 4.9e9, 16.66, 0.0018, 1e-4, 500.0, 1e4, 1.0 / 3.0, 2e-5):
+        assert float(_field_docs.number(v)) == v, v
+    assert _field_docs.number(math.inf) == "∞"
 
 
 def _refused(validate, make, field: str, value) -> bool:
@@ -119,66 +92,78 @@ def _check_ranges(validate, make, field: str, rng: str, integer: bool) -> int:
     return checked
 
 
-STRUCTS = [
-    ("CorSettings", "contact.hpp", "//! Per-sample settings of the CoR estimator",
-     _core.validate_cor_settings),
-    ("ObserverSettings", "observer.hpp", "//! Observer settings", _core.validate_observer_settings),
-]
+def _base(struct: str):
+    return _core.table1_params() if struct == "ContactParams" else getattr(_core, struct)()
 
 
-@pytest.mark.parametrize("name,header,after,validate", STRUCTS, ids=[s[0] for s in STRUCTS])
-def test_header_table_matches_the_struct(name, header, after, validate):
-    """Names, defaults, units and numeric ranges of the header's table against the bindings'
-    field table, the default-constructed struct and validate()."""
-    cls = getattr(_core, name)
-    rows = _header_rows(header, after)
-    fields = {f[0]: f for f in cls.fields}
-    assert set(rows) == set(fields), (sorted(set(rows) ^ set(fields)))
-    default = cls()
+@pytest.mark.parametrize("struct", _field_docs.STRUCTS)
+def test_ranges_of_the_table_are_what_validate_enforces(struct):
+    """At each finite numeric bound of the table: the bound itself accepted when closed and
+    refused when open, a step beyond refused, by validate() naming the field with its own
+    range (not a rule between fields); the defaults lie inside their ranges (ContactParams:
+    Table 1's values)."""
+    validate = getattr(_core, VALIDATORS[struct])
+    cls = getattr(_core, struct)
+    assert validate(_base(struct)) == ""
     checked = 0
-    for field, (_meaning, unit, rng, text) in rows.items():
-        kind = fields[field][1]
-        if kind == "struct":
+    for p in cls.params:
+        if p["kind"] not in ("float", "int"):
             continue
-        assert _default_matches(getattr(default, field), text), (field, text)
-        doc_unit = _unit_of_doc(fields[field][2])
-        if doc_unit is not None:
-            assert doc_unit == unit, (field, doc_unit, unit)
-        if kind in ("float", "int"):
-            checked += _check_ranges(validate, cls, field, rng, kind == "int")
-    assert checked >= 5
+        integer = p["kind"] == "int"
+        for side, limit in ((-1, p["lo"]), (+1, p["hi"])):
+            if limit["value"] is None or math.isinf(limit["value"]):
+                continue
+            at = int(limit["value"]) if integer else limit["value"]
+            step = 1 if integer else max(abs(at) * 1e-9, 1e-15)
+            make = lambda: _base(struct)  # noqa: E731
+            assert _refused(validate, make, p["name"], at) is limit["open"], (p["name"], at)
+            assert _refused(validate, make, p["name"], at + side * step), (p["name"], at)
+            checked += 1
+    assert checked >= {"ContactParams": 12, "CorSettings": 5, "ObserverSettings": 25}.get(struct, 2)
 
 
-def _page_rows(title: str) -> dict[str, list[str]]:
-    text = (REPO / "docs" / "conventions.md").read_text()
-    text = text[text.index(title):]
-    return {r[0]: r[1:] for r in _table(text, "", "| field | meaning")}
+VALIDATORS = {
+    "ContactParams": "validate_params",
+    "CorSettings": "validate_cor_settings",
+    "ObserverSettings": "validate_observer_settings",
+    "SliderSettings": "validate_slider_settings",
+    "IdentificationSettings": "validate_identification_settings",
+    "SlipControlSettings": "validate_slip_control_settings",
+}
 
 
-def test_docs_contact_params_table_matches_the_struct():
-    """docs/conventions.md's ContactParams table: every field of the bindings' table, Table 1's
-    values, and the numeric ranges validate() enforces."""
-    rows = _page_rows("## Parameters (`ContactParams`)")
-    fields = {f[0] for f in _core.ContactParams.fields}
-    assert set(rows) == fields, sorted(set(rows) ^ fields)
-    table1 = _core.table1_params()
-    checked = 0
-    for field, (_meaning, _unit, rng, value) in rows.items():
-        assert _default_matches(getattr(table1, field), value), (field, value)
-        checked += _check_ranges(_core.validate_params, _core.table1_params, field,
-                                 rng.split(" or ")[0], False)
-    assert checked >= 8
+def test_validate_messages_carry_the_tables_unit_and_range():
+    """A bad value's line names the field, the value, the range and the unit of the table."""
+    s = _core.ObserverSettings()
+    s.dt = 0.0
+    assert _core.validate_observer_settings(s) == "dt = 0: must be finite, >= 1e-09 and <= 10 [s]\n"
+    s.dt = 0.1  # valid on its own, above max_dt_gap: the rule between the two
+    assert _core.validate_observer_settings(s) == "max_dt_gap = 0.05: must be >= dt [s]\n"
+    p = _core.table1_params()
+    p.gamma = 0.5
+    assert _core.validate_params(p) == "gamma = 0.5: must be finite, > 0 and < 1/3 [-]\n"
+    p = _core.table1_params()
+    p.k = 0.2
+    assert _core.validate_params(p) == ("k = 0.2: must be >= 0.5 or 0 (the elliptic limit surface, "
+                                       "docs/model.md 3.5) [-]\n")
 
 
-def test_docs_cor_settings_table_matches_the_struct():
-    """docs/conventions.md's CorSettings table: the fields and defaults of the struct."""
-    rows = _page_rows("### `CorSettings`")
-    fields = {f[0] for f in _core.CorSettings.fields}
-    assert set(rows) == fields, sorted(set(rows) ^ fields)
-    default = _core.CorSettings()
-    for field, (_meaning, _unit, rng, value) in rows.items():
-        assert _default_matches(getattr(default, field), value), (field, value)
-        _check_ranges(_core.validate_cor_settings, _core.CorSettings, field, rng, False)
+@pytest.mark.parametrize("struct", _field_docs.STRUCTS)
+def test_printed_form_lists_every_field_of_the_table(struct):
+    """repr (C++ to_string) is "Struct(name=value, ...)" over the table's fields in order, each
+    number reading back as the attribute's value."""
+    obj = _base(struct)
+    text = repr(obj)
+    assert text.startswith(struct + "(")
+    top = re.sub(r"\w+\((?:[^()]|\([^()]*\))*\)", "(...)", text[len(struct) + 1:-1])
+    pairs = [part.split("=", 1) for part in top.split(", ")]
+    assert [name for name, _ in pairs] == [p["name"] for p in type(obj).params]
+    for name, value in pairs:
+        attr = getattr(obj, name)
+        if isinstance(attr, bool):
+            assert value == str(attr)
+        elif isinstance(attr, (int, float)):
+            assert eval(value, {"float": float}) == attr, (name, value)  # noqa: S307
 
 
 def test_docs_controller_table_names_real_settings_with_their_defaults():
@@ -206,3 +191,18 @@ def test_docs_controller_table_names_real_settings_with_their_defaults():
             assert first == ("on" if value else "off"), (name, text_default)
         else:
             assert float(first) == pytest.approx(value, rel=1e-12), (name, text_default)
+
+
+def test_python_contact_params_follow_the_table():
+    """The Python ContactParams dataclass has the fields of the C++ table in its order, and a
+    file must give exactly the fields a default-constructed C++ struct leaves out of range."""
+    import dataclasses
+
+    import lugrip
+    from lugrip import _params
+
+    names = [p["name"] for p in _core.ContactParams.params]
+    assert [f.name for f in dataclasses.fields(lugrip.ContactParams)] == names
+    assert _params._REQUIRED == ("mu", "beta_a", "sigma0", "sigma_z", "delta", "gamma")
+    with pytest.raises(ValueError, match="missing parameter"):
+        lugrip.ContactParams.from_dict({"mu": 0.5})
