@@ -25,7 +25,7 @@ from pathlib import Path
 
 from . import _core
 
-__all__ = ["STRUCTS", "markdown_table", "render_blocks"]
+__all__ = ["STRUCTS", "controller_table", "markdown_table", "render_blocks"]
 
 #: The structs whose tables the documentation may print.
 STRUCTS = ("ContactParams", "CorSettings", "ObserverSettings", "SliderSettings",
@@ -124,10 +124,29 @@ def markdown_table(struct: str, values: str = "default") -> str:
     return "\n".join(lines) + "\n"
 
 
+def controller_table() -> str:
+    """The grasp controller's settings, one line each, from its own C++ table
+    (``lugrip/grasp_controller_fields.hpp``: name and doc with the unit): setting, what it does,
+    unit, lugrip's default and the paper's law's value (``paper_settings()``) where it differs."""
+    default, paper = _core.GraspControllerSettings(), _core.paper_settings()
+    lines = ["| setting | what it does | unit | default | the paper's law |", "|---|---|---|---|---|"]
+    for name, kind, doc in _core.GraspControllerSettings.fields:
+        m = re.fullmatch(r"(.*?)\s*\[([^\]]+)\]", doc)
+        meaning, unit = (m.group(1), m.group(2)) if m else (doc, "–" if kind != "bool" else "")
+        unit = "–" if unit == "-" else unit
+        value = {"kind": kind}
+        mine, theirs = getattr(default, name), getattr(paper, name)
+        lines.append(f"| `{name}` | {_cell(meaning)} | {unit} | {_value(value, mine)} | "
+                     f"{_value(value, theirs) if theirs != mine else 'same'} |")
+    return "\n".join(lines) + "\n"
+
+
 def render_blocks(text: str) -> str:
     """``text`` with every field-table block regenerated."""
     def block(m: re.Match) -> str:
         options = dict(o.split("=") for o in m.group(3).split())
+        if m.group(2) == "GraspControllerSettings":
+            return m.group(1) + controller_table() + m.group(5)
         return m.group(1) + markdown_table(m.group(2), **options) + m.group(5)
     return _BLOCK.sub(block, text)
 

@@ -35,8 +35,8 @@ def test_pages_print_the_field_tables_as_compiled():
         if _field_docs.render_blocks(text) != text:
             stale.append(page.name)
     assert not stale, f"regenerate with `python -m lugrip._field_docs`: {stale}"
-    assert sorted(set(printed)) == sorted(_field_docs.STRUCTS)
-    assert _blocks((REPO / "README.md").read_text()) == ["ContactParams"]
+    assert sorted(set(printed)) == sorted((*_field_docs.STRUCTS, "GraspControllerSettings"))
+    assert _blocks((REPO / "README.md").read_text()) == ["ContactParams", "GraspControllerSettings"]
     # the fields a file must give read "required" (their defaults are refused by validate())
     readme = _field_docs.markdown_table("ContactParams")
     assert readme.count("| required |") == 6 and "| `k` |" in readme
@@ -206,3 +206,23 @@ def test_python_contact_params_follow_the_table():
     assert _params._REQUIRED == ("mu", "beta_a", "sigma0", "sigma_z", "delta", "gamma")
     with pytest.raises(ValueError, match="missing parameter"):
         lugrip.ContactParams.from_dict({"mu": 0.5})
+
+
+def test_readme_prints_the_controller_settings_one_line_each():
+    """README.md's controller table: one row per field of the core's table
+    (lugrip/grasp_controller_fields.hpp), in its order, with the compiled default; the paper's
+    column reads "same" exactly where paper_settings() keeps lugrip's default."""
+    text = (REPO / "README.md").read_text()
+    block = text.split("<!-- field-table: GraspControllerSettings -->")[1].split("<!-- /field-table -->")[0]
+    rows = [line for line in block.splitlines() if line.startswith("| `")]
+    names = [r.split("`")[1] for r in rows]
+    assert names == [f[0] for f in _core.GraspControllerSettings.fields]
+    assert len(names) <= 20
+    default, paper = _core.GraspControllerSettings(), _core.paper_settings()
+    for row, (name, kind, _doc) in zip(rows, _core.GraspControllerSettings.fields):
+        cells = [c.strip() for c in row.strip("|").split("|")]
+        if kind == "bool":
+            assert cells[3] == ("on" if getattr(default, name) else "off"), row
+        else:
+            assert float(cells[3]) == pytest.approx(getattr(default, name), rel=1e-12), row
+        assert (cells[4] == "same") == (getattr(paper, name) == getattr(default, name)), row
