@@ -332,6 +332,8 @@ def score(result, data: RubbingData, plant=None) -> dict:
         ws = np.asarray(run.omega_state)
         extra = {
             "state_bound": float(np.mean(above[peak])) if peak.any() else math.nan,
+            # the reference checked: ~1 where the plant itself says it slides at its peak speed
+            "ref_check": float(np.median(ql[peak & gs])) if (peak & gs).any() else math.nan,
             "S_above": float(np.mean(S[above] >= 0.9)) if above.any() else math.nan,
             "S_below": float(np.mean(S[below] >= 0.9)) if below.any() else math.nan,
             "fail_state_load": float(np.median(ql[fail])) if fail.any() else math.nan,
@@ -492,7 +494,8 @@ def limits_table(rows: list[dict], tag: str) -> list[str]:
     lines = [
         f"**{tag}**", "",
         "| plant | S >= 0.9 at >= 98 % peak speed | bound: true load >= 0.9 of the plant's "
-        "sliding wrench at its speed and CoR | S >= 0.9 above that line / below it "
+        "sliding wrench at its speed and CoR (check: that ratio on its gross-sliding peak-speed "
+        "samples, median) | S >= 0.9 above that line / below it "
         "| failing: true load / that wrench (median) | failing: share of f_n on sliding cells "
         "(median) | failing: edge slip since 98 % of peak speed, median / 90 % [um] "
         "| viscous: sliding samples with the true resolution > resolution_max; there speed "
@@ -513,6 +516,7 @@ def limits_table(rows: list[dict], tag: str) -> list[str]:
                if orc else "-")
         lines.append(
             f"| {r['plant']} | {_f(h['S_peak'])} | {_f(h['state_bound'])} "
+            f"({_f(h.get('ref_check'), '.4f')}) "
             f"| {_f(h['S_above'])} / {_f(h['S_below'])} | {_f(h['fail_state_load'])} "
             f"| {_f(h['fail_sliding_share'], '.2f')} "
             f"| {_f(h['fail_edge_slip_um'], '.0f')} / {_f(h['fail_edge_slip_um_90'], '.0f')} "
