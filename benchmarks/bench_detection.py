@@ -524,12 +524,20 @@ def limits_table(rows: list[dict], tag: str) -> list[str]:
     return lines + [""]
 
 
+def _section_head(section: str, title: str, argv: list[str]) -> tuple[list[str], str]:
+    """A section's begin marker, title and command line (with machine and date; the caller
+    continues that line), and its end marker."""
+    lines = [f"<!-- {section}:begin -->", "", f"## {title}", "",
+             f"`python benchmarks/bench_detection.py {' '.join(argv)}`".rstrip()
+             + f" on {platform.machine()}, {time.strftime('%Y-%m-%d')}"]
+    return lines, f"<!-- {section}:end -->"
+
+
 def write_limits(path: Path, runs: list[dict], argv: list[str]) -> None:
     """The 'detection-limits' section of BENCHMARKS.md from the runs' JSON."""
-    b, e = f"<!-- {LIMITS}:begin -->", f"<!-- {LIMITS}:end -->"
-    lines = [b, "", "## Slip detection: what the plants allow (held-out maneuvers)", "",
-             f"`python benchmarks/bench_detection.py {' '.join(argv)}`".rstrip()
-             + f" on {platform.machine()}, {time.strftime('%Y-%m-%d')} (and the tables before it "
+    lines, e = _section_head(LIMITS, "Slip detection: what the plants allow (held-out maneuvers)",
+                             argv)
+    lines[-1] += (" (and the tables before it "
              "from --compare): the tuning and fresh sets of the section above (the same fits and "
              "figures), scored against each plant's own state. The grid plants' sliding wrench at a "
              "sample is their torque about the prescribed CoR with every cell sliding at its "
@@ -547,8 +555,8 @@ def write_limits(path: Path, runs: list[dict], argv: list[str]) -> None:
              "yet) some 10-20 um of edge slip after the slide reached 98 % of its peak speed, "
              "except on uniform-1.3 of the tuning set (gross sliding the observer has not taken "
              "for kinetic, S judged against the static level); docs/model.md §7.5 draws the "
-             "conclusions.",
-             ""]
+             "conclusions.")
+    lines.append("")
     for run in runs:
         lines += limits_table(run["rows"], f"{run['tag']} ({run['date']})")
     lines += [e, ""]
@@ -607,10 +615,9 @@ def main(argv=None) -> int:
     if a.out is not None:
         runs = [json.loads(c.read_text()) for c in a.compare]
         runs.append(payload)
-        b, e = f"<!-- {SECTION}:begin -->", f"<!-- {SECTION}:end -->"
-        lines = [b, "", "## Slip detection on independent plants (wide design, held-out maneuvers)", "",
-                 f"`python benchmarks/bench_detection.py {' '.join(argv)}`".rstrip()
-                 + f" on {platform.machine()}, {time.strftime('%Y-%m-%d')}. Design: peak sliding "
+        lines, e = _section_head(
+            SECTION, "Slip detection on independent plants (wide design, held-out maneuvers)", argv)
+        lines[-1] += (". Design: peak sliding "
                  "speed 0.1-10 mm/s at the patch edge (log-uniform), |c~| 0.05-20, f_n 1-10 N, "
                  "each constant-speed leg at least 0.3 mm of slip at the patch edge, reversals, loaded rest, the rigs' sensor noise and offsets. Per plant 200 "
                  "maneuvers, `lugrip.identify` with defaults on 160 (the tuning set), the "
@@ -619,8 +626,8 @@ def main(argv=None) -> int:
                  "(tables 'before' and 'after', seeds 101-108) were visible while the rules and "
                  "their thresholds were chosen; the 'fresh' set (`--seed-offset 1000`, other "
                  "maneuvers of the same plants) was first scored after the last change of a "
-                 "rule. Plants:", ""]
-        lines += [f"* **{k}**: {v}" for k, v in PLANTS.items()] + [""]
+                 "rule. Plants:")
+        lines += [""] + [f"* **{k}**: {v}" for k, v in PLANTS.items()] + [""]
         lines += [
             "Columns: the share of samples with S >= 0.9 among those at >= 98 % of their "
             "maneuver's peak |omega| that the plant itself labels gross sliding (at the slowest "
