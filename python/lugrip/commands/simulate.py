@@ -32,6 +32,7 @@ examples:
   lugrip simulate box_heavy --plant mujoco --video out/box.mp4
   lugrip simulate all unseen --plant mujoco --seeds 8 --compare patch
   lugrip simulate all unseen --plant drake --no-plots   # Drake (pip install "lugrip[drake]")
+  lugrip simulate exp2_small_resin_block --plant drake --compare mujoco --compare patch
   lugrip simulate scenarios/faults/*.yaml --no-plots     # sensor and actuator faults
   lugrip simulate --list
 An engine plant (mujoco, drake): writes DIR/<plant>.md, DIR/<plant>_<scenario>.png (MuJoCo:
