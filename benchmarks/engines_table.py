@@ -69,9 +69,14 @@ def table(plants: dict[str, dict[str, dict]]) -> str:
                 # the smallest constant that holds lies in (largest failed, smallest held]
                 held = [c["force"] for c in s["bracket"] if c["survives"]]
                 failed_f = [c["force"] for c in s["bracket"] if not c["survives"]]
-                lo = f"{mean / min(held):.3f}" if held and mean is not None else "0"
-                hi = f"{mean / max(failed_f):.3f}" if failed_f and mean is not None else "∞"
-                ratio_txt = f"{lo} to {hi}" if mean is not None else "-"
+                if mean is None:
+                    ratio_txt = "-"
+                elif not held:
+                    ratio_txt = f"< {mean / max(failed_f):.3f}"
+                elif not failed_f:
+                    ratio_txt = f"≥ {mean / min(held):.3f}"
+                else:
+                    ratio_txt = f"{mean / min(held):.3f} to {mean / max(failed_f):.3f}"
             else:
                 const_txt, ratio_txt = _fmt(const, ".3g"), _fmt(ratio, ".3f")
             rows.append(

@@ -233,7 +233,7 @@ class Scenario:
             )
         plant = data["plant"]
         if not isinstance(plant, Mapping):
-            raise ValueError(f"{where}: plant: expected a mapping (model: patch | lumped | mujoco, ...)")  # noqa: TRY004 (file content)
+            raise ValueError(f"{where}: plant: expected a mapping (model: patch | lumped | mujoco | drake, ...)")  # noqa: TRY004 (file content)
         model = plant.get("model", "patch")
         if not isinstance(model, str) or model not in plant_names():
             raise ValueError(f"{where}: plant.model: must be one of {', '.join(plant_names())}")
