@@ -77,6 +77,10 @@ def table(plants: dict[str, dict[str, dict]]) -> str:
                     ratio_txt = f"≥ {mean / min(held):.3f}"
                 else:
                     ratio_txt = f"{mean / min(held):.3f} to {mean / max(failed_f):.3f}"
+            elif search and not search.get("found", True) and search.get("history"):
+                top = max(f for f, _ in search["history"])  # even the gripper's f_max failed
+                const_txt = f"none ≤ {top:g}"
+                ratio_txt = "-" if mean is None else f"< {mean / top:.3f}"
             else:
                 const_txt, ratio_txt = _fmt(const, ".3g"), _fmt(ratio, ".3f")
             rows.append(
