@@ -12,7 +12,9 @@ from lugrip.sim.plant import (
     Plant,
     PlantClock,
     PlantSamples,
+    builds_scene,
     make_plant,
+    plant_kind,
     plant_names,
     plant_renders,
     register_plant,
@@ -65,10 +67,14 @@ class SpringPlant:
 
 
 def test_registry_names_and_rejects():
-    """Plant: none. The registry holds lugrip's C++ plants and MuJoCo; a new kind is one call."""
-    assert {"patch", "lumped", "mujoco"} <= set(plant_names())
-    assert registered("mujoco") and not registered("patch")
-    assert plant_renders("mujoco")
+    """Plant: none. The registry holds lugrip's C++ plants, MuJoCo and Drake; a new kind is
+    one call."""
+    assert {"patch", "lumped", "mujoco", "drake"} <= set(plant_names())
+    assert registered("mujoco") and registered("patch")
+    assert plant_renders("mujoco") and not plant_renders("patch")
+    assert builds_scene("mujoco") and builds_scene("drake") and not builds_scene("lumped")
+    assert plant_kind("lumped").config_model == "lumped"
+    assert plant_kind("drake").config_model == "patch"
     register_plant("spring_test", SpringPlant, "a test plant")
     try:
         p = make_plant("spring_test", touch=3)
@@ -81,7 +87,7 @@ def test_registry_names_and_rejects():
         mod._REGISTRY.pop("spring_test")
     with pytest.raises(ValueError, match="unknown plant"):
         make_plant("no_such_plant")
-    with pytest.raises(ValueError, match="C\\+\\+ plants"):
+    with pytest.raises(ValueError, match="built-in plants"):
         register_plant("patch", SpringPlant)
     with pytest.raises(ValueError):
         register_plant("bad name!", SpringPlant)

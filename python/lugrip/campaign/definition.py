@@ -7,7 +7,7 @@ A campaign file (``campaigns/<name>.yaml``)::
     name: patch_blocks
     description: ...
     scenario: exp2_small_resin_block   # base scenario: a name or a YAML path (relative to this file)
-    plant: patch                       # patch, lumped or mujoco
+    plant: patch                       # a registered plant: patch, lumped, mujoco, drake
     seed: 20261201                     # master seed
     duration: 8.0                      # [s] overrides of the base scenario (top-level keys, the
     steady_window: [3.5, 4.4]          #     plant block merged key by key)
@@ -441,7 +441,7 @@ class Campaign:
         seed = data["seed"]
         if isinstance(seed, bool) or not isinstance(seed, int) or seed < 0:
             raise CampaignError(f"seed: {seed!r} must be an integer >= 0")
-        from ..sim.plant import plant_names, registered
+        from ..sim.plant import plant_kind, plant_names
 
         plant = str(data.get("plant", "patch"))
         if plant not in plant_names():
@@ -472,9 +472,12 @@ class Campaign:
         if not isinstance(params, Mapping):
             raise CampaignError("parameters: expected a mapping name -> distribution")
         parameters = {str(k): Distribution.from_dict(str(k), v) for k, v in params.items()}
-        pads = sorted(k for k in parameters if k.startswith("pad_"))
-        if pads and not registered(plant):
-            raise CampaignError(f"parameters.{pads[0]}: only for an engine's pads (plant mujoco)")
+        kind = plant_kind(plant)
+        for k in sorted(parameters):
+            owners = [p for p in plant_names() if k in plant_kind(p).parameters]
+            if owners and k not in kind.parameters:
+                raise CampaignError(f"parameters.{k}: a parameter of the {', '.join(owners)} "
+                                    f"plant, not of {plant}")
         crit = dict(_DEFAULT_CRITERIA)
         if "crush_factor" in parameters:
             crit["no_crush"] = True
@@ -496,7 +499,7 @@ class Campaign:
             raise CampaignError(
                 "criteria.no_crush: needs a crush force per run (draw parameters.crush_factor)"
             )
-        if registered(plant):  # an engine reports its scene status
+        if kind.scene:  # a plant that builds its own scene reports its scene status
             crit.setdefault("scene_ok", True)
         eval_seed = data.get("evaluation_seed")
         if eval_seed is not None and (
@@ -800,11 +803,11 @@ class Campaign:
                 "torque": p.get("push_torque", 0.0),
             }
             plant["disturbances"] = [*list(plant.get("disturbances") or []), push]
-        pad = {k[len("pad_"):]: p[k] for k in ("pad_k_slide", "pad_k_twist") if k in p}
-        if pad:
-            mj = dict(d.get("mujoco") or {})
-            mj["pad"] = dict(mj.get("pad") or {}) | pad
-            d["mujoco"] = mj
+        from ..sim.plant import plant_kind
+
+        for k, path in plant_kind(self.plant).parameters.items():  # the plant's own draws
+            if k in p:
+                _set_path(d, path, p[k])
         plant["seed"] = p["plant_seed"]
         d["plant"] = plant
         mism = {k[len("mismatch_"):]: v for k, v in p.items() if k.startswith("mismatch_")}
@@ -912,6 +915,18 @@ def load_campaign(path: str | Path) -> Campaign:
     except ValueError as err:  # YamlLimitError: names the file and the line
         raise CampaignError(str(err)) from None
     return Campaign.from_dict(data, source=p)
+
+
+def _set_path(d: dict, path: tuple[str, ...], value) -> None:
+    """Set ``d[path[0]][path[1]]...`` to ``value``, copying (or creating) each mapping on the
+    way so that the base scenario's blocks are not changed."""
+    head, *rest = path
+    if not rest:
+        d[head] = value
+        return
+    sub = dict(d.get(head) or {})
+    _set_path(sub, tuple(rest), value)
+    d[head] = sub
 
 
 def _controller_call(name: str, opts: dict, scenario) -> tuple[str, dict, dict, dict]:

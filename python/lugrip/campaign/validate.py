@@ -7,8 +7,8 @@ is not a parameter file, a mass of 1e-300 kg were stored as failed runs, 0 % suc
 
 * the seed (stored as a 64-bit integer with the results) and the base scenario's duration;
 * run 0 with every controller: the plant, the estimator, the controller and the observer are
-  built and the closed loop steps a few samples (patch and lumped plants) or the MuJoCo scene
-  is specified (MuJoCo plant); the static grasp force of the object's weight, which the run's
+  built (an engine's scene by its plant's reset), and on a plant that runs the loop in C++
+  (patch, lumped) the closed loop steps a few samples; the static grasp force of the object's weight, which the run's
   metrics evaluate, is in the solver's range;
 * each drawn parameter at each end of its distribution's support (the others as in run 0),
   with the first controller.
@@ -75,7 +75,7 @@ def _check_load(cfg, field: str) -> None:
 
 def _build(campaign: Campaign, values: dict[str, float], controllers) -> None:
     """Build the grasp of ``values`` for each of ``controllers`` (raises what a run would)."""
-    from ..sim.plant import make_plant, registered
+    from ..sim.plant import make_plant
     from ..sim.scenarios import Scenario, simulate
     from .definition import _controller_call
 
@@ -83,10 +83,11 @@ def _build(campaign: Campaign, values: dict[str, float], controllers) -> None:
     cfg = scn.plant_config(campaign.plant)
     _check_load(cfg, f"parameters.mass = {values['mass']:g}" if "mass" in values
                 else "the base scenario's plant.object.mass")
-    if registered(campaign.plant):  # an engine: its scene is built (and checked) by reset
-        make_plant(campaign.plant).reset(scn, config=cfg)
-        scn.estimator_for(campaign.plant)
-        return
+    plant = make_plant(campaign.plant)
+    plant.reset(scn, config=cfg)  # the plant (an engine: its scene) is built and checked
+    scn.estimator_for(campaign.plant)
+    if not callable(getattr(plant, "closed_loop", None)):
+        return  # an engine's run costs seconds: its build is the check
     for name in controllers:
         kind, ctrl, obs, opts = _controller_call(name, campaign.controllers[name], scn)
         s = Scenario.from_dict(scn.to_dict() | {"controller": ctrl, "observer": obs,

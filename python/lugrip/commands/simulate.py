@@ -12,7 +12,7 @@ import math
 import sys
 from pathlib import Path
 
-from ..sim.plant import plant_names, plant_renders, registered
+from ..sim.plant import builds_scene, plant_names, plant_renders
 from . import CliError
 
 __all__ = ["register", "run"]
@@ -32,11 +32,13 @@ examples:
   lugrip simulate box_heavy --plant mujoco --video out/box.mp4
   lugrip simulate all unseen --plant mujoco --seeds 8 --compare patch
   lugrip simulate all unseen --plant drake --no-plots   # Drake (pip install "lugrip[drake]")
+  lugrip simulate exp2_small_resin_block --plant drake --compare mujoco --compare patch
   lugrip simulate scenarios/faults/*.yaml --no-plots     # sensor and actuator faults
   lugrip simulate --list
-MuJoCo plant: writes DIR/mujoco.md, DIR/mujoco_<scenario>.png (frames of the lift and the pivot
-when offscreen rendering works: MUJOCO_GL=egl or osmesa) and the metrics JSON (default
-DIR/mujoco_metrics.json). Without OpenGL the frames and the video are skipped with a message.
+An engine plant (mujoco, drake): writes DIR/<plant>.md, DIR/<plant>_<scenario>.png (MuJoCo:
+frames of the lift and the pivot when offscreen rendering works: MUJOCO_GL=egl or osmesa) and
+the metrics JSON (default DIR/<plant>_metrics.json). Without OpenGL the frames and the video are
+skipped with a message.
 """
 
 
@@ -50,8 +52,8 @@ def register(subparsers) -> None:
         description=(
             "Simulate scenarios in closed loop (plant -> fingertip sensors -> observers -> "
             "grasp-force controller, 500 Hz / 50 Hz), with the constant-force and friction-cone "
-            "baselines; write the paper's figures, a Markdown report (experiments.md; MuJoCo: "
-            "mujoco.md) and the metrics JSON with a pass flag per criterion."
+            "baselines; write the paper's figures, a Markdown report (experiments.md; an "
+            "engine plant: <plant>.md) and the metrics JSON with a pass flag per criterion."
         ),
         epilog=_EPILOG,
         formatter_class=argparse.RawDescriptionHelpFormatter,
@@ -101,21 +103,22 @@ def register(subparsers) -> None:
         type=int,
         default=1,
         metavar="N",
-        help="MuJoCo plant: also run lugrip on N - 1 further noise seeds (default 1)",
+        help="an engine plant (mujoco, drake): also run lugrip on N - 1 further noise seeds "
+        "(default 1)",
     )
     p.add_argument(
         "--compare",
         action="append",
-        choices=("patch", "lumped"),
+        choices=plant_names(),
         default=None,
-        help="MuJoCo plant: run this plant too and put it beside MuJoCo (repeatable)",
+        help="an engine plant: run this plant too and put it beside the engine (repeatable)",
     )
     p.add_argument(
         "--no-frames", action="store_true", help="MuJoCo plant: no rendered frames in the figures"
     )
     p.add_argument("--force", action="store_true",
                    help="overwrite the result files of an earlier run in --out (experiments.md, "
-                        "metrics.json, mujoco.md, figures) and an existing --json/--video file")
+                        "metrics.json, <plant>.md, figures) and an existing --json/--video file")
     p.add_argument("--no-baselines", action="store_true", help="only lugrip's controller")
     p.add_argument("--no-plots", action="store_true", help="skip the figures")
     p.add_argument("--list", action="store_true", help="list the available scenarios and exit")
@@ -139,7 +142,7 @@ def run(args: argparse.Namespace) -> int:
                               figures=not args.no_plots)
     from ..sim import report
 
-    engine = registered(args.plant or "patch")
+    engine = builds_scene(args.plant or "patch")
     if engine and plant_renders(args.plant) and (args.video or not args.no_frames):
         report.choose_gl_backend()  # before anything imports MuJoCo
     from ..sim.scenarios import find_scenario, list_scenarios, load_scenario, scenario_dir
@@ -177,8 +180,11 @@ def run(args: argparse.Namespace) -> int:
     except ValueError as err:
         raise CliError(str(err)) from None
     if not engine and (args.video or args.compare or args.seeds != 1 or args.no_frames):
-        raise CliError("--video, --seeds, --compare and --no-frames need an engine plant "
-                       "(--plant mujoco)")
+        scenes = ", ".join(p for p in plant_names() if builds_scene(p))
+        raise CliError("--video, --seeds, --compare and --no-frames need a plant that builds "
+                       f"its own scene (--plant {scenes})")
+    if args.compare and args.plant in args.compare:
+        raise CliError(f"--compare {args.plant}: the plant itself")
     if args.seeds < 1:
         raise CliError(f"--seeds {args.seeds}: must be >= 1")
     if args.video is not None and args.video.suffix.lower() != ".mp4":
@@ -243,8 +249,9 @@ def run(args: argparse.Namespace) -> int:
 
 #: The result files ``simulate`` writes in --out (names and patterns): a folder holding any
 #: of them is refused without --force.
-RESULT_FILES = ("experiments.md", "metrics.json", "mujoco.md", "mujoco_metrics.json",
-                "fig1[1357]_*.png", "*_baselines.png", "mujoco_*.png")
+RESULT_FILES = ("experiments.md", "metrics.json", "fig1[1357]_*.png", "*_baselines.png",
+                *(f"{p}{x}" for p in plant_names() if builds_scene(p)
+                  for x in (".md", "_metrics.json", "_*.png")))
 
 
 def check_outputs(args: argparse.Namespace, scenario_paths: list[str]) -> None:
@@ -252,7 +259,7 @@ def check_outputs(args: argparse.Namespace, scenario_paths: list[str]) -> None:
     scenario runs; the scenario files are inputs."""
     from ._output import check_dir, check_file
 
-    if args.no_plots and not registered(args.plant or "patch"):  # only the metrics file is written
+    if args.no_plots and not builds_scene(args.plant or "patch"):  # only the metrics file is written
         if args.json is None:
             check_dir(args.out, "--out", force=args.force, results=("metrics.json",),
                       inputs=scenario_paths)

@@ -90,6 +90,15 @@ class RigTruth:
             object.__setattr__(self, "beta_a", float(self.beta_a))
         object.__setattr__(self, "viscous", bool(self.viscous))
 
+    @classmethod
+    def coulomb(cls, name: str, mu: float, *, delta: float, gamma: float, pressure: str,
+                tau_max_points, notes: str = "") -> RigTruth:
+        """The truth of an engine's Coulomb pad (MuJoCo's, Drake's): one friction coefficient
+        ``mu`` (static = kinetic = nominal), no viscous shear."""
+        return cls(name=name, mu_static=mu, mu_kinetic=mu, mu=mu, beta_a=None, viscous=False,
+                   delta=delta, gamma=gamma, pressure=pressure,
+                   tau_max_points=tuple(tau_max_points), notes=notes)
+
     def rho(self, f_n) -> np.ndarray | float:
         """True contact radius delta * f_n**gamma [m]."""
         out = self.delta * np.asarray(f_n, dtype=float) ** self.gamma

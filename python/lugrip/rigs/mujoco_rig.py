@@ -181,13 +181,9 @@ class MujocoRubbingRig:
         """mu, the torsional law and what the plant does not model."""
         p = self.pad
         forces = (0.25, 0.5, 1.0, 2.0, 4.0, 8.0, 12.0, 16.0, 24.0)
-        return RigTruth(
-            name="mujoco",
-            mu_static=p.mu,
-            mu_kinetic=p.mu,
-            mu=p.mu,
-            beta_a=None,
-            viscous=False,
+        return RigTruth.coulomb(
+            "mujoco",
+            p.mu,
             delta=p.delta,
             gamma=p.gamma,
             pressure=(

@@ -9,8 +9,10 @@ plant. A plant kind is one module with a class that satisfies :class:`Plant` and
 import the plant's module only when it is used). Every ``--plant`` choice, scenario check and
 campaign asks this registry; nothing else names a plant kind.
 
-The reference implementation is :class:`lugrip.sim.mujoco.plant.MujocoPlant`; the runner is
-:func:`lugrip.sim.runner.run_plant_loop`.
+Registered kinds: "patch" and "lumped" (lugrip's own C++ grasp simulator,
+:mod:`lugrip.sim.cplant`), "mujoco" (:class:`lugrip.sim.mujoco.plant.MujocoPlant`, the reference
+implementation of an engine) and "drake" (:class:`lugrip.sim.drake.plant.DrakePlant`). The
+runner is :func:`lugrip.sim.runner.run_plant_loop`.
 
 The cycle
 ---------
@@ -47,6 +49,14 @@ The cycle
     scenario names none for it (an engine whose contact is not lugrip's model states what
     identification on it gives); without it, the plant block's contact.
 
+``closed_loop(config, controller_settings, observer_settings, mode_schedule, duration, **options)`` (optional)
+    A plant whose physics and lugrip's controller can run together in compiled code offers
+    the whole loop in one call with :func:`lugrip.sim.run_closed_loop`'s arguments (the
+    keyword options the runner takes: ``kind``, ``constant_force``, ``cone_*``, ``estimator``,
+    ``faults``, ``stuck_samples``, ``healthy_finger_fallback``); the runner then hands the run
+    to it instead of stepping the plant (the C++ plants; same schedule, faults and baselines
+    as the runner's, tests/python/test_cplant.py compares the two).
+
 ``scene_status()``
     A dict {status, detail, time, contact_time}: ``status`` is "ok" or a short code naming a
     scene fault (the object not between the fingers, a finger closing on nothing, a contact
@@ -71,7 +81,7 @@ from __future__ import annotations
 
 import dataclasses
 import importlib
-from collections.abc import Callable, Mapping
+from collections.abc import Callable, Mapping, Sequence
 from typing import Any, Protocol, runtime_checkable
 
 import numpy as np
@@ -80,9 +90,13 @@ __all__ = [
     "SCENE_STATUS",
     "Plant",
     "PlantClock",
+    "PlantKind",
     "PlantSamples",
+    "builds_scene",
     "make_plant",
+    "plant_class",
     "plant_description",
+    "plant_kind",
     "plant_names",
     "plant_renders",
     "register_plant",
@@ -139,7 +153,9 @@ class PlantSamples:
       vertical) [N] and torque about its CoG [N m].
     * ``gripper_y`` (n,): the grasp point's height [m] (the hand's lift).
     * ``extra``: plant-specific columns, each (n,), logged with the run under their own names
-      (MuJoCo: ``pad_deflection_0``, ``pad_twist_1``, ``roll``, ...).
+      (MuJoCo: ``pad_deflection_0``, ``pad_twist_1``, ``roll``, ...). A column named as one the
+      runner derives replaces it: ``slip`` (a plant whose slip is a path length),
+      ``supported`` and ``dropped`` (a plant with its own support and drop rule, latched).
     """
 
     t: np.ndarray
@@ -202,63 +218,96 @@ class Plant(Protocol):
 
 # --- the registry ----------------------------------------------------------------------------
 
-#: name -> (factory or "module:attribute", one line of description)
-_REGISTRY: dict[str, tuple[Callable[..., Plant] | str, str]] = {}
-#: registered plants whose factory takes ``frame_callback`` (MuJoCo's offscreen frames)
-_RENDERS: set[str] = set()
+
+@dataclasses.dataclass(frozen=True)
+class PlantKind:
+    """What the registry knows of a plant kind without building one (:func:`plant_kind`)."""
+
+    #: a callable returning a :class:`Plant`, or a "module:attribute" string naming one
+    factory: Callable[..., Plant] | str
+    #: one line of description
+    description: str = ""
+    #: the factory takes ``frame_callback=f(model, data, t)`` (MuJoCo's offscreen frames)
+    frames: bool = False
+    #: the plant builds a scene of its own from the scenario (its block, e.g. ``mujoco:``): it
+    #: can fail to grasp (the scene status and the ``scene_ok`` criterion), its runs are
+    #: reported per engine (``lugrip simulate``'s ``<name>.md``)
+    scene: bool = True
+    #: the :class:`lugrip.sim.PlantConfig` model of the plant block the plant reads ("patch":
+    #: an engine reads the patch plant's object, contact, actuator, sensors and moves)
+    config_model: str = "patch"
+    #: campaign parameters of this kind only: parameter name -> the key path in the scenario
+    #: it sets (e.g. ``pad_k_slide`` -> ("mujoco", "pad", "k_slide"))
+    parameters: Mapping[str, tuple[str, ...]] = dataclasses.field(default_factory=dict)
+
+
+#: name -> PlantKind
+_REGISTRY: dict[str, PlantKind] = {}
+#: the kinds registered by this module (not replaceable)
+_BUILTIN: frozenset[str] = frozenset()
 
 
 def register_plant(name: str, factory: Callable[..., Plant] | str, description: str = "", *,
-                   frames: bool = False) -> None:
+                   frames: bool = False, scene: bool = True, config_model: str = "patch",
+                   parameters: Mapping[str, Sequence[str]] | None = None) -> None:
     """Make plant kind ``name`` available to :func:`make_plant` and ``--plant``.
 
     ``factory`` is a callable returning a :class:`Plant` (called with :func:`make_plant`'s
     keyword options), or a ``"module:attribute"`` string naming one, imported on first use (so
     an engine's package is imported only when its plant is used). Registering a name again
-    replaces it. ``frames``: the factory takes ``frame_callback=f(model, data, t)`` called
-    after every sensor sample with MuJoCo's model and data (``lugrip simulate --video`` and the
-    report's frames)."""
+    replaces it, except lugrip's built-in kinds. ``frames``, ``scene``, ``config_model``, ``parameters``: see
+    :class:`PlantKind`."""
     key = str(name).strip().lower()
     if not key or not key.replace("_", "").replace("-", "").isalnum():
         raise ValueError(f"plant name {name!r}: expected letters, digits, '-' or '_'")
-    if key in _C_PLANTS:
-        raise ValueError(f"plant name {key!r} is one of lugrip's own C++ plants")
+    if key in _BUILTIN:
+        raise ValueError(f"plant name {key!r} is one of lugrip's built-in plants")
     if not (callable(factory) or (isinstance(factory, str) and ":" in factory)):
         raise TypeError("factory: expected a callable or a 'module:attribute' string")
-    _REGISTRY[key] = (factory, str(description))
-    _RENDERS.discard(key)
-    if frames:
-        _RENDERS.add(key)
+    if config_model not in ("patch", "lumped"):
+        raise ValueError(f"config_model {config_model!r}: expected 'patch' or 'lumped'")
+    params = {str(k): tuple(str(x) for x in v) for k, v in (parameters or {}).items()}
+    if any(not v for v in params.values()):
+        raise ValueError("parameters: every parameter needs a non-empty key path")
+    _REGISTRY[key] = PlantKind(factory, str(description), bool(frames), bool(scene),
+                               config_model, params)
+
+
+def plant_kind(name: str) -> PlantKind:
+    """The registered :class:`PlantKind` of ``name`` (ValueError when unknown)."""
+    key = str(name).strip().lower()
+    if key not in _REGISTRY:
+        raise ValueError(f"unknown plant {name!r}; known: {', '.join(plant_names())}")
+    return _REGISTRY[key]
 
 
 def plant_renders(name: str) -> bool:
     """Plant kind ``name`` renders MuJoCo frames (``register_plant(..., frames=True)``)."""
-    return str(name).strip().lower() in _RENDERS
+    return registered(name) and plant_kind(name).frames
+
+
+def builds_scene(name: str) -> bool:
+    """Plant kind ``name`` builds a scene of its own (``register_plant(..., scene=True)``)."""
+    return registered(name) and plant_kind(name).scene
 
 
 def plant_names() -> tuple[str, ...]:
-    """Every plant kind a scenario may run on: lugrip's own C++ plants ("patch", "lumped",
-    run by the C++ closed loop) and the registered ones."""
-    return (*_C_PLANTS, *_REGISTRY)
+    """Every plant kind a scenario may run on, in registration order."""
+    return tuple(_REGISTRY)
 
 
 def plant_description(name: str) -> str:
     """The one-line description of plant kind ``name``."""
-    key = str(name).strip().lower()
-    if key in _C_PLANTS:
-        return _C_PLANTS[key]
-    if key not in _REGISTRY:
-        raise ValueError(f"unknown plant {name!r}; known: {', '.join(plant_names())}")
-    return _REGISTRY[key][1]
+    return plant_kind(name).description
 
 
-def make_plant(name: str, **options: Any) -> Plant:
-    """A new plant of the registered kind ``name``, built with ``options`` (the kind's own
-    keywords, e.g. MuJoCo's ``frame_callback``)."""
+def plant_class(name: str) -> Callable[..., Plant]:
+    """The factory of plant kind ``name`` (its module imported; ImportError naming the package
+    when the engine is not installed), without building a plant."""
     key = str(name).strip().lower()
     if key not in _REGISTRY:
         raise ValueError(f"unknown plant {name!r}; registered: {', '.join(_REGISTRY) or 'none'}")
-    factory, _ = _REGISTRY[key]
+    factory = _REGISTRY[key].factory
     if isinstance(factory, str):
         module, _, attr = factory.partition(":")
         try:
@@ -266,29 +315,47 @@ def make_plant(name: str, **options: Any) -> Plant:
         except ModuleNotFoundError as err:
             raise ImportError(f"the {key!r} plant needs the package {err.name!r}, which is not "
                               "installed") from err
+    return factory
+
+
+def make_plant(name: str, **options: Any) -> Plant:
+    """A new plant of the registered kind ``name``, built with ``options`` (the kind's own
+    keywords, e.g. MuJoCo's ``frame_callback``)."""
+    factory = plant_class(name)
     plant = factory(**options)
     if not isinstance(plant, Plant):
-        raise TypeError(f"plant {key!r}: {factory!r} returned {type(plant).__name__}, which "
+        raise TypeError(f"plant {name!r}: {factory!r} returned {type(plant).__name__}, which "
                         "lacks reset/step/scene_status")
     return plant
 
 
 def registered(name: str) -> bool:
-    """``name`` is a registered (Plant-interface) kind, not one of the C++ plants."""
+    """``name`` is a registered plant kind."""
     return str(name).strip().lower() in _REGISTRY
 
 
-#: lugrip's own plants, run by the C++ closed loop (lugrip.sim.run_closed_loop)
-_C_PLANTS: Mapping[str, str] = {
-    "patch": "lugrip's distributed-contact (pressure patch) grasp plant, in C++",
-    "lumped": "lugrip's lumped LuGre/limit-surface slider plant, in C++ (no translational slip)",
-}
+# --- the built-in plants ---------------------------------------------------------------------
 
+register_plant(
+    "patch",
+    "lugrip.sim.cplant:PatchPlant",
+    "lugrip's distributed-contact (pressure patch) grasp plant, in C++",
+    scene=False,
+)
+register_plant(
+    "lumped",
+    "lugrip.sim.cplant:LumpedPlant",
+    "lugrip's lumped LuGre/limit-surface slider plant, in C++ (no translational slip)",
+    scene=False,
+    config_model="lumped",
+)
 register_plant(
     "mujoco",
     "lugrip.sim.mujoco.plant:MujocoPlant",
     "MuJoCo gripper with compliant pads and condim-4 contacts (an independent engine)",
     frames=True,
+    parameters={"pad_k_slide": ("mujoco", "pad", "k_slide"),
+                "pad_k_twist": ("mujoco", "pad", "k_twist")},
 )
 register_plant(
     "drake",
@@ -296,3 +363,4 @@ register_plant(
     "Drake gripper with compliant-hydroelastic pads: the patch's pressure field and limit "
     "surface from the engine (an independent engine; pip install 'lugrip[drake]')",
 )
+_BUILTIN = frozenset(_REGISTRY)

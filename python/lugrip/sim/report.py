@@ -16,7 +16,7 @@ from typing import Any
 
 from .._atomic import write_text_atomic
 from .mujoco.render import GL_PACKAGES, choose_gl_backend
-from .plant import plant_renders
+from .plant import plant_class, plant_description, plant_renders
 from .scenarios import (
     CRITERIA,
     ScenarioResult,
@@ -475,7 +475,7 @@ def run_mujoco_set(
             others.get("patch", {}).get(r.name),
             note=None if render_msg is None else "no frames: " + render_msg,
         )
-        figures[r.name] = save(fig, out / f"mujoco_{r.name}.png")
+        figures[r.name] = save(fig, out / f"{engine}_{r.name}.png")
         if log:
             n_ok = sum(x["pass"] for x in rows)
             log(
@@ -485,6 +485,7 @@ def run_mujoco_set(
     for plant in compare:
         evaluate_cross(list(others[plant].values()))
     return {
+        "engine": engine,
         "results": results,
         "compare": others,
         "seeds": seed_rows,
@@ -508,7 +509,7 @@ def mujoco_table(data: dict[str, Any]) -> str:
     )
     rows = [head, "|" + "---|" * 15]
     for name, r in data["results"].items():
-        plants = [("mujoco", r, data["seeds"].get(name))]
+        plants = [(data.get("engine", "mujoco"), r, data["seeds"].get(name))]
         plants += [(p, res[name], None) for p, res in data["compare"].items() if name in res]
         for plant, res, seeds in plants:
             m = res.metrics["lugrip"]
@@ -535,31 +536,29 @@ def mujoco_table(data: dict[str, Any]) -> str:
     return "\n".join(rows)
 
 
+def engine_method(engine: str) -> str:
+    """The paragraph that describes plant kind ``engine`` in its report: its class's
+    ``report_method()`` when it has one, else the registry's one-line description."""
+    method = getattr(plant_class(engine), "report_method", None)
+    return method() if callable(method) else plant_description(engine) + "."
+
+
 def mujoco_markdown(data: dict[str, Any], base: Path) -> str:
-    """The MuJoCo section: method, side-by-side table, per-seed failures, omega against the
-    true slip rate, figures."""
+    """The engine's section (MuJoCo by default, ``data["engine"]``): method, side-by-side
+    table, per-seed failures, omega against the true slip rate, figures."""
     res = data["results"]
+    engine = data.get("engine", "mujoco")
+    label = _ENGINE_LABEL.get(engine, engine)
     n_pass = sum(r.passed for r in res.values())
     lines = [
         (
-            f"**MuJoCo: {n_pass}/{len(res)} scenarios pass on the file's seed with today's "
+            f"**{label}: {n_pass}/{len(res)} scenarios pass on the file's seed with today's "
             "controller** (lugrip.SlipControl: each finger's observer and the GraspController, "
             "with each scenario's own controller block). The table says which criterion fails; "
-            "the patch rows are judged by the file's own criteria for that plant."
+            "the compared plants' rows are judged by the file's own criteria for that plant."
         ),
         "",
-        "Plant: MuJoCo " + _mujoco_version() + ", two force-controlled fingers with compliant "
-        "12 mm spherical pads (4 N/mm in-plane and 2 N m/rad twist springs between finger and "
-        "pad), elliptic cone, condim 4 with the torsional coefficient μ ξ ρ(f_n) of the present "
-        "normal force, noslip 10, 1 ms steps; fingertip wrench (the object's action on each pad) "
-        "averaged over 2 ms, 500 Hz, noise 0.005 N / 0.01 N mm; command at 50 Hz through a 30 ms "
-        "lag and a 200 N/s rate limit. The observers and controller use each scenario's "
-        "estimator block for MuJoCo (the shipped files: the pad and each object's μ identified "
-        "on MuJoCo rubbing data, validation/mujoco/README.md). Slip and rotation: the object's grasp point and angle relative to the "
-        "pads (pad spring deflection excluded), from the lift start. *min. static force*: "
-        "MuJoCo's own slip force for the steady loads (its cone with μ_spin(f)); for the patch "
-        "plant lugrip's limit surface. The wrist roll is MuJoCo only (the patch plant has no "
-        "wrist rotation); the seeds vary the sensor noise.",
+        engine_method(engine),
         "",
         mujoco_table(data),
         "",
@@ -578,14 +577,15 @@ def mujoco_markdown(data: dict[str, Any], base: Path) -> str:
             f"{min(slip):.3f}-{max(slip):.3f} mm, rotation {min(rot):.2f}-{max(rot):.2f}°"
         )
     if fails:
-        lines += ["Seeds failing on MuJoCo:", "", *fails, ""]
+        lines += [f"Seeds failing on {label}:", "", *fails, ""]
     from .faults import fault_table
 
     faults = fault_table(list(res.values()))
     if faults:
-        lines += ["Sensor and actuator faults on MuJoCo (one row per fault scenario):", "", faults, ""]
+        lines += [f"Sensor and actuator faults on {label} (one row per fault scenario):", "",
+                  faults, ""]
     lines += [
-        "ω̂ against MuJoCo's true slip rate (pad 0 and 1, from the lift start): "
+        f"ω̂ against {label}'s true slip rate (pad 0 and 1, from the lift start): "
         + "; ".join(
             f"{n}: RMS error {_f(r.metrics['lugrip'].get('omega_rmse'), 3)} rad/s, peak true "
             f"{_f(r.metrics['lugrip'].get('omega_true_peak'), 3)}, peak ω̂ "
@@ -598,33 +598,37 @@ def mujoco_markdown(data: dict[str, Any], base: Path) -> str:
     if data.get("render"):
         lines += [f"Frames: not rendered ({data['render']}).", ""]
     for name, path in data["figures"].items():
-        lines += [f"![{name} on MuJoCo]({Path(path).relative_to(base).as_posix()})", ""]
+        lines += [f"![{name} on {label}]({Path(path).relative_to(base).as_posix()})", ""]
     return "\n".join(lines)
 
 
-def _mujoco_version() -> str:
-    import mujoco
-
-    return mujoco.__version__
+#: how the reports name an engine (its registered name otherwise)
+_ENGINE_LABEL = {"mujoco": "MuJoCo", "drake": "Drake"}
 
 
 def write_mujoco_outputs(data: dict[str, Any], out_dir: str | Path, json_path=None) -> dict[str, Path]:
-    """mujoco.md and the metrics JSON (MuJoCo results, the compared plants' results, the seeds)."""
+    """``<engine>.md`` and the metrics JSON (default ``<engine>_metrics.json``: the engine's
+    results, the compared plants' results, the seeds); the engine is ``data["engine"]``
+    (:func:`run_mujoco_set`), MuJoCo by default."""
+    engine = data.get("engine", "mujoco")
     out = Path(out_dir)
     out.mkdir(parents=True, exist_ok=True)
     md = mujoco_markdown(data, out)
-    write_text_atomic(out / "mujoco.md", "# Closed loop on MuJoCo, beside the patch plant\n\n" + md)
+    beside = ", ".join(data["compare"]) or "no other plant"
+    title = f"# Closed loop on {_ENGINE_LABEL.get(engine, engine)}, beside {beside}\n\n"
+    write_text_atomic(out / f"{engine}.md", title + md)
     doc = metrics_document(list(data["results"].values()))
-    doc["plant"] = "mujoco"
+    doc["plant"] = engine
     doc["seeds"] = data["seeds"]
     doc["render"] = data.get("render")
     doc["compare"] = {
         p: metrics_document(list(rs.values())) for p, rs in data["compare"].items() if rs
     }
-    path = Path(json_path) if json_path is not None else out / "mujoco_metrics.json"
+    path = Path(json_path) if json_path is not None else out / f"{engine}_metrics.json"
     path.parent.mkdir(parents=True, exist_ok=True)
     write_text_atomic(path, json.dumps(_jsonable(doc), indent=2, allow_nan=False) + "\n")
-    return {"mujoco.md": out / "mujoco.md", "metrics": path, **{f"mujoco_{k}.png": v for k, v in data["figures"].items()}}
+    return {f"{engine}.md": out / f"{engine}.md", "metrics": path,
+            **{f"{engine}_{k}.png": v for k, v in data["figures"].items()}}
 
 
 def mujoco_demo_section(out_dir: Path, progress=None, full: bool = False) -> tuple[str, list[str]]:

@@ -97,11 +97,22 @@ def run_plant_loop(
             An object with a ``ground_truth(omegas)`` method gets each sample's true spin of
             the object on each finger after its step.
 
+    A plant with a ``closed_loop`` method (lugrip's C++ plants) runs the whole loop in that
+    one call (same schedule, faults and baselines) unless ``controller_factory`` is given.
+
     Returns:
-        :class:`PlantRun`, one row per sensor sample.
+        :class:`PlantRun`, one row per sensor sample (a plant's ``closed_loop``: its
+        :class:`ClosedLoopRun`, without ``scene``).
     """
     if kind not in ("lugrip", "constant_force", "friction_cone"):
         raise ValueError(f"kind {kind!r}: expected lugrip, constant_force or friction_cone")
+    fused = getattr(plant, "closed_loop", None)
+    if callable(fused) and controller_factory is None:  # the plant runs the loop in C++
+        return fused(config, controller_settings, observer_settings, mode_schedule, duration,
+                     kind=kind, constant_force=constant_force, cone_margin=cone_margin,
+                     cone_release_rate=cone_release_rate, estimator=estimator, faults=faults,
+                     stuck_samples=stuck_samples or 0,
+                     healthy_finger_fallback=healthy_finger_fallback)
     contact = config.contact
     est = estimator_params(contact, estimator)
     if est is None:  # the plant's own belief about its contact, when it states one
@@ -205,6 +216,8 @@ def run_plant_loop(
     run = PlantRun(_log(blocks, config, lift_start))
     scene_status = dict(plant.scene_status())
     run.scene = {**scene_status, "contact_time": contact_time, "controller_start": ctrl_start}
+    if "dropped" in blocks[0][0].extra:  # the plant's own drop rule (latched)
+        return run
     # dropped (latched): from the lift start, the slip or the rotation beyond its limit or the
     # contact lost
     t = run["t"]
@@ -282,15 +295,16 @@ def _log(blocks, config, lift_start: float) -> dict[str, np.ndarray]:
         c[f"contact_{k}"] = contact[:, k].astype(np.int64)
     for name in outs[0].extra:
         c[name] = cat([o.extra[name] for o in outs])
-    # the object rests on its support until both fingers touched it and the lift started
-    touched = np.logical_or.accumulate(contact, axis=0).all(axis=1)
-    c["supported"] = (~touched | (t < lift_start)).astype(np.int64)
+    if "supported" not in c:  # (a plant that knows it reports it among its extra columns)
+        # the object rests on its support until both fingers touched it and the lift started
+        touched = np.logical_or.accumulate(contact, axis=0).all(axis=1)
+        c["supported"] = (~touched | (t < lift_start)).astype(np.int64)
     ok = np.isfinite(c["command"]) & np.isfinite(c["slip"]) & np.isfinite(theta)
     ok &= fault | np.isfinite(meas).all(axis=(1, 2))
     est = np.isfinite(log[:, [_COL[x] for x in ("omega_hat_0", "omega_hat_1", "S_0", "S_1")]])
     ok &= ~stepped | est.all(axis=1)
     c["finite"] = ok.astype(np.int64)
-    c["dropped"] = np.zeros(len(t), dtype=np.int64)
+    c.setdefault("dropped", np.zeros(len(t), dtype=np.int64))
     return c
 
 

@@ -20,7 +20,7 @@ from .._yaml import load_yaml, to_number
 from . import faults as _faults
 from ._closed_loop import estimator_params
 from ._plant import PlantConfig
-from .plant import plant_names, registered
+from .plant import builds_scene, plant_kind, plant_names
 
 
 #: Controller settings every scenario states: the gripper's force range [N] and rate limits [N/s].
@@ -155,8 +155,8 @@ _KEYS = {
 }
 
 
-#: Plant models a scenario runs on when this module was imported: the two of lugrip's own
-#: simulator and the registered engines (lugrip.sim.plant; the checks below ask the registry).
+#: Plant models a scenario runs on when this module was imported: the registered kinds
+#: (lugrip.sim.plant; the checks below ask the registry).
 PLANT_MODELS = plant_names()
 
 
@@ -233,7 +233,7 @@ class Scenario:
             )
         plant = data["plant"]
         if not isinstance(plant, Mapping):
-            raise ValueError(f"{where}: plant: expected a mapping (model: patch | lumped | mujoco, ...)")  # noqa: TRY004 (file content)
+            raise ValueError(f"{where}: plant: expected a mapping (model: patch | lumped | mujoco | drake, ...)")  # noqa: TRY004 (file content)
         model = plant.get("model", "patch")
         if not isinstance(model, str) or model not in plant_names():
             raise ValueError(f"{where}: plant.model: must be one of {', '.join(plant_names())}")
@@ -273,7 +273,7 @@ class Scenario:
             faults=_faults.fault_block(data.get("faults"), where),
             source=source,
             engines={str(k): dict(v or {}) for k, v in data.items()
-                     if k not in _KEYS and registered(k)},
+                     if k not in _KEYS and builds_scene(k)},
             known_limits=_known_limits(data.get("known_limits"), where),
         )
         if s.suite not in SUITES:
@@ -328,8 +328,7 @@ class Scenario:
         d = copy.deepcopy(self.plant)
         if model is not None:
             d["model"] = model
-        if registered(d.get("model", "patch")):  # an engine reads the patch plant's block
-            d["model"] = "patch"
+        d["model"] = plant_kind(d.get("model", "patch")).config_model  # an engine: "patch"
         if seed is not None:
             d["seed"] = int(seed)
         d["disturbances"] = expand_disturbances(d.get("disturbances") or [])

@@ -49,9 +49,9 @@ from typing import Any
 from .. import __version__
 from .._controller import controller_settings
 from .._params import ContactParams  # noqa: F401  (part of this module's namespace before the split)
-from ._closed_loop import ClosedLoopRun, run_closed_loop
+from ._closed_loop import ClosedLoopRun
 from ._plant import PlantConfig
-from .plant import make_plant, registered
+from .plant import make_plant
 from .runner import run_plant_loop
 
 # the loader, the metrics and the judge (lugrip.sim.scenarios stays the public name of all three)
@@ -101,10 +101,9 @@ def simulate(
     frame_callback=None,
     **options,
 ) -> ClosedLoopRun:
-    """One closed-loop run of `scenario` on plant `model` (patch, lumped: lugrip's C++ loop;
-    a registered engine such as mujoco: :func:`lugrip.sim.runner.run_plant_loop` on
-    :func:`lugrip.sim.plant.make_plant`'s plant, `frame_callback` among its options) with
-    controller `kind`."""
+    """One closed-loop run of `scenario` on the registered plant `model`
+    (:func:`lugrip.sim.runner.run_plant_loop` on :func:`lugrip.sim.plant.make_plant`'s plant,
+    `frame_callback` among its options) with controller `kind`."""
     est = scenario.estimator_for(model)
     if scenario.faults:
         options = dict(
@@ -113,22 +112,11 @@ def simulate(
             stuck_samples=scenario.faults.get("stuck_samples", 0),
             healthy_finger_fallback=scenario.faults.get("healthy_finger_fallback", False),
         )
-    if registered(model):  # an engine behind the Plant interface
-        plant = make_plant(model, **({} if frame_callback is None else
-                                     {"frame_callback": frame_callback}))
-        return run_plant_loop(
-            plant,
-            scenario,
-            cfg,
-            scenario.controller,
-            scenario.observer,
-            schedule,
-            scenario.duration,
-            kind=kind,
-            estimator=est,
-            **options,
-        )
-    return run_closed_loop(
+    plant = make_plant(model, **({} if frame_callback is None else
+                                 {"frame_callback": frame_callback}))
+    return run_plant_loop(
+        plant,
+        scenario,
         cfg,
         scenario.controller,
         scenario.observer,

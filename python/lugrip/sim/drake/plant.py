@@ -36,8 +36,8 @@ import numpy as np
 
 from ..mujoco.gripper import _object_bottom
 from ..mujoco.loop import disturbance_wrench
-from ..mujoco.plant import MujocoPlant
 from ..plant import PlantClock, PlantSamples
+from ..scene_faults import SceneWatch
 from .pad import DrakePad, PadWrench, add_pad, rigid_properties
 
 __all__ = ["PAD_FILE", "DrakePlant", "build_gripper", "min_jerk", "pad_parameters"]
@@ -242,7 +242,7 @@ def build_gripper(spec, **kwargs) -> _Gripper:
     return _Gripper(spec, **kwargs)
 
 
-class DrakePlant:
+class DrakePlant(SceneWatch):
     """The Drake gripper of a scenario (its ``mujoco:`` scene block and plant block).
 
     Args:
@@ -252,6 +252,29 @@ class DrakePlant:
     """
 
     name = "drake"
+
+    @staticmethod
+    def report_method() -> str:
+        """The plant as ``lugrip simulate --plant drake``'s report describes it."""
+        from importlib.metadata import PackageNotFoundError, version as dist_version
+
+        try:
+            version = dist_version("drake")
+        except PackageNotFoundError:  # a Drake not installed from the wheel
+            version = "(version unknown)"
+        return (
+            f"Plant: Drake {version}, the scenario's MuJoCo scene built in Drake: two "
+            "force-controlled fingers, each fingertip a compliant-hydroelastic sphere on sprung "
+            "in-plane and twist mounts (objects/drake/pad.yaml identified on the Drake rubbing "
+            "rig), so the patch's pressure field, torsional capacity and limit surface are the "
+            "engine's; discrete solver at 1 ms with regularised friction (the plant's stiction "
+            "tolerance, 1e-6 m/s by default); fingertip wrench from Drake's contact results averaged over 2 ms, 500 Hz; "
+            "command at 50 Hz through the scenario's actuator lag and rate limit. The observers "
+            "and controller use the identified pad with the object's μ unless the scenario names "
+            "an estimator for Drake. Slip and rotation: the object's grasp point and angle "
+            "relative to the pads (mount deflection excluded), from the lift start. *min. static "
+            "force*: the elliptic-cone slip force of the steady loads (as for MuJoCo)."
+        )
 
     def __init__(self, *, pad: DrakePad | None = None, timestep: float = 1e-3,
                  approximation: str = "lagged", stiction_tolerance: float = 1e-6):
@@ -423,10 +446,6 @@ class DrakePlant:
             slip=rel_h - self._ref[0], rotation=rot - self._ref[1], theta=theta, cog=cog,
             omega=omega, v_slip=v_slip, external=external, gripper_y=hand_z, extra=extra,
         )
-
-    #: the scene status (never raises), as the MuJoCo plant finds it: a pad that never reached
-    #: the object, a finger at its stop without contact, a contact lost after the grasp
-    _scene_faults = MujocoPlant._scene_faults
 
     def _object_between(self) -> bool:
         return self.model.object_between()

@@ -226,13 +226,9 @@ class DrakeRubbingRig:
         """mu, the engine's measured torsional capacity and what the plant does not model."""
         p = self.pad
         delta, gamma = self._radius_law()
-        return RigTruth(
-            name="drake",
-            mu_static=p.mu,
-            mu_kinetic=p.mu,
-            mu=p.mu,
-            beta_a=None,
-            viscous=False,
+        return RigTruth.coulomb(
+            "drake",
+            p.mu,
             delta=delta,
             gamma=gamma,
             pressure=(

@@ -23,6 +23,7 @@ import mujoco
 import numpy as np
 
 from ..plant import PlantClock, PlantSamples
+from ..scene_faults import SceneWatch
 from .gripper import build_scene
 
 try:
@@ -33,8 +34,6 @@ except ImportError as _err:  # built against another MuJoCo, or without MuJoCo's
 
 __all__ = ["MujocoPlant"]
 
-#: Consecutive contact-free sensor samples after which a pad's contact counts as lost.
-_LOST_SAMPLES = 10
 #: pulse shape codes of lugrip._mjstep
 _SHAPES = {"rectangular": 0, "rect": 0, "half_sine": 1, "halfsine": 1, "ramp": 2, "triangle": 3}
 
@@ -50,7 +49,7 @@ def _stepper_module():
     return _mjstep
 
 
-class MujocoPlant:
+class MujocoPlant(SceneWatch):
     """The MuJoCo gripper of a scenario's ``mujoco:`` block (:class:`SceneSpec`).
 
     Args:
@@ -59,6 +58,25 @@ class MujocoPlant:
     """
 
     name = "mujoco"
+
+    @staticmethod
+    def report_method() -> str:
+        """The plant as ``lugrip simulate --plant mujoco``'s report describes it."""
+        return (
+            "Plant: MuJoCo " + mujoco.__version__ + ", two force-controlled fingers with "
+            "compliant 12 mm spherical pads (4 N/mm in-plane and 2 N m/rad twist springs between "
+            "finger and pad), elliptic cone, condim 4 with the torsional coefficient μ ξ ρ(f_n) "
+            "of the present normal force, noslip 10, 1 ms steps; fingertip wrench (the object's "
+            "action on each pad) averaged over 2 ms, 500 Hz, noise 0.005 N / 0.01 N mm; command "
+            "at 50 Hz through a 30 ms lag and a 200 N/s rate limit. The observers and controller "
+            "use each scenario's estimator block for MuJoCo (the shipped files: the pad and each "
+            "object's μ identified on MuJoCo rubbing data, validation/mujoco/README.md). Slip "
+            "and rotation: the object's grasp point and angle relative to the pads (pad spring "
+            "deflection excluded), from the lift start. *min. static force*: MuJoCo's own slip "
+            "force for the steady loads (its cone with μ_spin(f)); for the patch plant lugrip's "
+            "limit surface. The wrist roll is MuJoCo only (the patch plant has no wrist "
+            "rotation); the seeds vary the sensor noise."
+        )
 
     def __init__(self, *, frame_callback: Callable[[Any, Any, float], None] | None = None):
         self.frame_callback = frame_callback
@@ -180,45 +198,6 @@ class MujocoPlant:
     def mj_step_seconds(self) -> float:
         """CPU time spent inside ``mj_step`` since reset [s] (the stepping thread's clock)."""
         return float(self._stepper.mj_step_seconds)
-
-    def _scene_faults(self, t, contact, fingers) -> None:
-        """The scene status (never raises): a pad that never reached the object, a finger at
-        its stop without contact, a contact lost after the grasp."""
-        st = self._status
-        if st["contact_time"] is None:
-            both = np.flatnonzero(contact.all(axis=1))
-            if both.size:
-                st["contact_time"] = float(t[both[0]])
-        if st["status"] != "ok" or (self._touched.all() and contact.all()):
-            self._lost[:] = 0  # (the common case: both pads in contact, nothing to check)
-            return
-        for j in range(t.shape[0]):
-            if st["status"] != "ok":
-                break
-            ts = float(t[j])
-            self._touched |= contact[j]
-            touched = self._touched
-            if touched.all():
-                self._lost = np.where(contact[j], 0, self._lost + 1)
-                k = int(np.argmax(self._lost >= _LOST_SAMPLES))
-                if self._lost[k] >= _LOST_SAMPLES:
-                    st.update(status="lost_contact", time=ts,
-                              detail=f"pad {k} without contact for {_LOST_SAMPLES * self._T * 1e3:.0f} ms")
-                continue
-            at_stop = fingers[j] >= self._travel - 2e-4
-            free = [k for k in (0, 1) if at_stop[k] and not touched[k]]
-            if free:
-                k = free[0]
-                between = self._object_between()
-                st.update(
-                    status="closed_on_nothing" if between else "object_not_reached", time=ts,
-                    detail=f"finger {k} closed to its stop without contact"
-                    + ("" if between else "; the object is not between the fingers"),
-                )
-            elif ts >= self._lift_start:
-                st.update(status="object_not_reached", time=ts,
-                          detail=f"pad(s) {[k for k in (0, 1) if not touched[k]]} without "
-                                 "contact at the lift start")
 
     def _object_between(self) -> bool:
         """The line between the pad centres passes through the object (now: the scene fault
