@@ -18,7 +18,7 @@ inline constexpr auto grasp_controller_fields = [] {
       field("f_max", &S::f_max, "maximum force [N]"),
       field("max_rate", &S::max_rate, "the gripper's slew rate: limit on command changes (inf: off) [N/s]"),
       field("reaction_lag", &S::reaction_lag, "the gripper's force time constant the reactions overshoot for (0: off) [s]"),
-      field("s_ref", &S::s_ref, "reference of the slippage indicator [-]"),
+      field("s_ref", &S::s_ref, "utilisation the PI holds in stick: lower is more margin against a wrong mu, more force [-]"),
       field("k_p", &S::k_p, "proportional gain (at gain_force on a translational load) [N]"),
       field("k_i", &S::k_i, "integral gain (at gain_force on a translational load) [N/s]"),
       field("gain_force", &S::gain_force, "PI gains scale with command / gain_force and the load's slope (0: constant, paper) [N]"),
