@@ -75,7 +75,7 @@ def main(argv=None) -> int:
             f"({(time.perf_counter() - t0) / 60:.1f} min). The scenes' seeds vary the sensor noise "
             "only, so every seed meets a push at the same phase of the 50 Hz command clock. Each "
             "draw shifts every pulse's start by its own uniform offset in [0, 20 ms) and runs "
-            "lugrip on MuJoCo (identified parameters, the scene's standing reserve); no baselines.",
+            "lugrip on MuJoCo (identified parameters; the controller with the reserve learned from the pushes; the unseen scenes' push envelopes stated as numbers, not derived by the scene); no baselines.",
             "",
             *lines,
             end,
