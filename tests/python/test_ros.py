@@ -311,8 +311,11 @@ def _identify_recording_like_csv(tmp_path, rec_log: str) -> None:
     np.testing.assert_allclose(np.asarray(rec.f_t), cols["f_t"], rtol=1e-9, atol=1e-12)
     np.testing.assert_allclose(np.asarray(rec.tau), cols["tau"], rtol=1e-9, atol=1e-15)
     om_rec, om_run = np.asarray(rec.omega), run["omega_true_0"][first:]
+    # the recorder may match the truth topic a few samples after the wrench topic (8 seen): omega
+    # is unknown (NaN) before its first message, and present at every sample after it
     known = np.isfinite(om_rec)
-    assert known.sum() >= len(om_rec) - 2, (len(om_rec) - known.sum(), "omega samples missing")
+    k0 = int(np.argmax(known))
+    assert known[k0:].all() and k0 <= 0.05 * len(om_rec), (k0, int((~known[k0:]).sum()))
     np.testing.assert_allclose(om_rec[known], om_run[known], rtol=1e-9, atol=1e-12)
     n = len(cols["f_n"])
     csv_path = tmp_path / "run_finger0.csv"
