@@ -827,7 +827,7 @@ double GraspController::static_floor(double& slope_exponent) noexcept {
     const double n = n_load_[i];
     const double ft = sum_f_t_[i] / n, tau = sum_tau_[i] / n;
     double load_ft = ft, load_tau = tau;  // the load the feed-forward answers (mean or trend)
-    bool trend = false;
+    StaticLoadMap load_map = maps[i];  // its map
     if (s_.load_floors) {
       double f = f_mean[i];
       const double f_ref = f_grasp;  // a light finger's extrapolated noise is no edge
@@ -839,20 +839,20 @@ double GraspController::static_floor(double& slope_exponent) noexcept {
         const double ahead = (n - 1.0 - k_mean) + kFeedforwardHorizon / dt_;
         const double slope_f = (n * sum_kf_[i] - sum_k_[i] * sum_f_t_[i]) / den;
         const double slope_t = (n * sum_kt_[i] - sum_k_[i] * sum_tau_[i]) / den;
-        const double fx = solver_.solve(std::max(0.0, ft + slope_f * ahead), tau + slope_t * ahead,
-                                        kFeedforwardSlippage).force;
+        const double x_ft = std::max(0.0, ft + slope_f * ahead), x_tau = tau + slope_t * ahead;
+        const StaticLoadMap x_map = solver_.map(x_ft, x_tau);
+        const double fx = solver_.solve(x_map, x_ft, x_tau, kFeedforwardSlippage).force;
         if (std::isfinite(fx) && fx > (1.0 + kFeedforwardTrend) * f_ref) {
           f = fx;
-          load_ft = std::max(0.0, ft + slope_f * ahead);
-          load_tau = tau + slope_t * ahead;
-          trend = true;
+          load_ft = x_ft;
+          load_tau = x_tau;
+          load_map = x_map;
         }
       }
       if (std::isfinite(f)) force = std::max(force, f);
     }
     if (s_.ceiling_factor > 0.0) {  // the grip this load needs at S = 1
-      const double f = trend ? solver_.solve(load_ft, load_tau, 1.0).force
-                             : solver_.solve(maps[i], load_ft, load_tau, 1.0).force;
+      const double f = solver_.solve(load_map, load_ft, load_tau, 1.0).force;
       if (std::isfinite(f)) ceiling_load_ = std::max(ceiling_load_, f);
     }
     if (s_.load_floors) {  // the pushes seen: the part of the load that came and went
@@ -914,39 +914,52 @@ CorSettings static_cor_settings() {
 StaticForceSolver::StaticForceSolver(const ContactModel& model) : est_(model, static_cor_settings()) {}
 StaticForceSolver::StaticForceSolver(const ContactParams& params) : est_(params, static_cor_settings()) {}
 
-double StaticForceSolver::slippage(double f_n, double f_t, double tau, double* c_tilde) noexcept {
+double StaticForceSolver::evaluate(double f_n, double f_t, double tau, CorOutput& o) noexcept {
   constexpr double nan = std::numeric_limits<double>::quiet_NaN();
   if (!(std::isfinite(f_n) && f_n > 0.0 && std::isfinite(f_t) && std::isfinite(tau))) return nan;
   est_.reset();  // no history: tau below the zero threshold takes the default side
-  CorOutput o;
   est_.step(CorInput{f_n, std::fabs(f_t), tau}, o);
   if (!is_valid(o.status) || !(o.g > 0.0)) return nan;
-  if (c_tilde) *c_tilde = std::fabs(o.c_tilde);
-  last_g_ = o.g;
-  last_rho_ = o.rho;
   // |tau - c f_t| = |tau| + |c| f_t (tau and c have opposite signs, docs/model.md 6). Equal to |y| of
   // the estimator except for a torque below its zero threshold, whose sign it holds from history.
   return (std::fabs(tau) + std::fabs(o.c) * std::fabs(f_t)) / o.g;
 }
+
+double StaticForceSolver::slippage(double f_n, double f_t, double tau, double* c_tilde) noexcept {
+  CorOutput o;
+  const double s = evaluate(f_n, f_t, tau, o);
+  if (c_tilde && std::isfinite(s)) *c_tilde = std::fabs(o.c_tilde);
+  return s;
+}
+
+namespace {
+// The map of the load (f_t, tau) through one evaluation o of the estimator at f_n: S = A + B
+// there, A = |tau| / g, B = |c| |f_t| / g.
+StaticLoadMap map_through(double f_n, double f_t, double tau, double pw, const CorOutput& o) noexcept {
+  StaticLoadMap m;
+  m.f0 = f_n;
+  m.pw = pw;
+  m.a = std::fabs(tau) / o.g;
+  m.b = std::fabs(o.c) * std::fabs(f_t) / o.g;
+  m.valid = true;
+  return m;
+}
+}  // namespace
 
 StaticLoadMap StaticForceSolver::map(double f_t, double tau) noexcept {
   StaticLoadMap m;
   const double ft = std::fabs(f_t);
   if (!(std::isfinite(ft) && std::isfinite(tau)) || (ft == 0.0 && tau == 0.0)) return m;
   const ContactParams& p = est_.model().params();
-  m.pw = 1.0 + p.gamma;
+  const double pw = 1.0 + p.gamma;
   // 1.25 (f_tr + f_rot) at S = 1 puts the load inside the diamond |f~_t| + |tau~| <= 0.8, so
   // inside the (convex) LS, where |c~| is the one of every root at S <= 1
   const double f_tr = ft / p.mu;
-  const double f_rot = std::pow(std::fabs(tau) / (p.mu * est_.model().xi() * p.delta), 1.0 / m.pw);
-  m.f0 = 1.25 * (f_tr + f_rot);
-  double c0 = 0.0;
-  const double s0 = slippage(m.f0, ft, tau, &c0);
-  if (!(std::isfinite(s0) && s0 > 0.0)) return m;
-  m.a = std::fabs(tau) / last_g_;
-  m.b = c0 * last_rho_ * ft / last_g_;
-  m.valid = true;
-  return m;
+  const double f_rot = std::pow(std::fabs(tau) / (p.mu * est_.model().xi() * p.delta), 1.0 / pw);
+  const double f0 = 1.25 * (f_tr + f_rot);
+  CorOutput o;
+  const double s0 = evaluate(f0, ft, tau, o);
+  return std::isfinite(s0) && s0 > 0.0 ? map_through(f0, ft, tau, pw, o) : m;
 }
 
 double StaticLoadMap::slippage(double f_n) const noexcept {
@@ -997,21 +1010,17 @@ StaticForceResult StaticForceSolver::solve(const StaticLoadMap& map, double f_t,
     return r;
   }
   const ContactParams& p = est_.model().params();
-  // Guess: the larger of the pure-translation and pure-torsion forces at S = s_ref.
-  const double f_tr = ft / (p.mu * s_ref);
-  const double f_rot = std::pow(std::fabs(tau) / (p.mu * est_.model().xi() * p.delta * s_ref),
-                                1.0 / (1.0 + p.gamma));
-  double start = std::max(f_tr, f_rot);
   // The map in closed form (the map's root), checked by one evaluation; a check that fails
   // (a zero threshold of the estimator crossed, a degenerate load) gives a new map from that
   // evaluation, twice at most, then the bracket below takes over from there.
+  double start = 0.0;
   StaticLoadMap m = map;
   for (int pass = 0; pass < 3 && m.valid; ++pass) {
     const double f = m.root(s_ref);
     if (!(std::isfinite(f) && f > 0.0)) break;
     ++r.iterations;
-    double c = 0.0;
-    const double s = slippage(f, ft, tau, &c);
+    CorOutput o;
+    const double s = evaluate(f, ft, tau, o);
     if (!(std::isfinite(s) && s > 0.0)) break;
     start = f;
     // S at the LS itself (s_ref = 1) is computed by either branch of the estimator, which agree
@@ -1019,13 +1028,17 @@ StaticForceResult StaticForceSolver::solve(const StaticLoadMap& map, double f_t,
     if (std::fabs(s - s_ref) <= 1e-10 * s_ref) {
       r.force = f;
       r.slippage = s;
-      r.c_tilde = c;
+      r.c_tilde = std::fabs(o.c_tilde);
       r.converged = true;
       return r;
     }
-    m.f0 = f;
-    m.a = std::fabs(tau) / last_g_;
-    m.b = c * last_rho_ * ft / last_g_;
+    m = map_through(f, ft, tau, m.pw, o);
+  }
+  if (!(start > 0.0)) {  // no map: the larger of the pure-translation and pure-torsion forces at s_ref
+    const double f_tr = ft / (p.mu * s_ref);
+    const double f_rot = std::pow(std::fabs(tau) / (p.mu * est_.model().xi() * p.delta * s_ref),
+                                  1.0 / (1.0 + p.gamma));
+    start = std::max(f_tr, f_rot);
   }
   // Residual in logs: S_static decreases with f_n, roughly as a power law.
   const double log_ref = std::log(s_ref);

@@ -294,8 +294,9 @@ class StaticForceSolver {
   bool set_mu(double mu) noexcept { return est_.set_mu(mu); }
 
  private:
+  // S_static at f_n (NaN where invalid) with the estimate it came from in o
+  double evaluate(double f_n, double f_t, double tau, CorOutput& o) noexcept;
   CorEstimator est_;
-  double last_g_ = 0.0, last_rho_ = 0.0;  // g and rho of the last slippage() evaluation
 };
 
 //! Two-mode grasp-force controller f_n = f_ns + f_nd (eq. 34, docs/model.md 9).
