@@ -266,6 +266,12 @@ def test_frontier_summary_on_hand_made_rows():
                "paper": {"success_rate": 0.2, "wilson95": list(wilson(1, 5)), "mean_force": 2.0}}
     fr = frontier_summary(rows, c, summary)
     assert fr["runs"] == 5 and fr["no_constant_passes"] == 1
+    # passable: runs 0, 1 and 4 (run 2 has no passing force, run 3's is above its crush force);
+    # lugrip held run 2, which no constant under the crush force passes: the bound is an estimate
+    assert fr["passable"] == 3 and fr["passable_rate"] == 0.6
+    assert fr["passable_wilson95"] == list(wilson(3, 5))
+    assert fr["controllers"]["lugrip"]["held_where_no_constant_passes"] == 1
+    assert fr["controllers"]["paper"]["held_where_no_constant_passes"] == 0
     assert fr["max_rate"] == 0.4 and fr["max_successes"] == 2 and fr["max_force"] == 1.0
     assert list(frontier_rate([r[0] for r in table], [r[1] for r in table], [0.5, 1.0, 2.0, 3.0])) \
         == [0.2, 0.4, 0.4, 0.4]

@@ -77,8 +77,17 @@ def frontier_summary(rows: Sequence[dict], campaign: Campaign, summary: dict | N
 
     f_max = float(campaign.base_scenario().controller.get("f_max", controller_settings()["f_max"]))
     passing = sorted(float(v) for v, c in zip(fp, cr) if v is not None and (c is None or v <= c))
+    # Runs some constant under the crush force passes. A command that never exceeds a run's crush
+    # force grips it at most as hard as the constant at that force, so where holding grows with
+    # the grip no controller passes the other runs: their share bounds every controller's success
+    # from above (checked below: each controller's successes on those runs).
+    passable = {int(r["run"]) for r, v, c in zip(runs, fp, cr)
+                if v is not None and (c is None or v <= c)}
     out: dict[str, Any] = {
         "runs": n,
+        "passable": len(passable),
+        "passable_rate": len(passable) / n,
+        "passable_wilson95": list(wilson(len(passable), n)),
         "f_max": f_max,
         "no_constant_passes": sum(v is None for v in fp),
         # a force above the smallest passing one failed: success is not monotone there
@@ -118,6 +127,7 @@ def frontier_summary(rows: Sequence[dict], campaign: Campaign, summary: dict | N
         }
         both = sorted(set(held) & set(const))
         points[c] = {
+            "held_where_no_constant_passes": sum(ok for i, ok in held.items() if i not in passable),
             "paired_runs": len(both),
             "holds_constant_fails": sum(held[i] and not const[i] for i in both),
             "constant_holds_it_fails": sum(const[i] and not held[i] for i in both),
@@ -423,6 +433,13 @@ def markdown(data: dict[str, Any], figure: str | None = None,
                "(success not monotone in the force there: such a run counts as held only below "
                "that failing force)" if fr.get("non_monotone") else "") + ".",
             "",
+            f"- Runs some constant under the crush force passes: **{_fmt(fr['passable_rate'])}** "
+            f"({fr['passable']}/{fr['runs']}, Wilson [{fr['passable_wilson95'][0]:.3f}, "
+            f"{fr['passable_wilson95'][1]:.3f}]). A command that never exceeds a run's crush force "
+            f"grips no harder than the constant at that force, so where holding grows with the "
+            f"grip this bounds every controller's success; held where no constant passes: "
+            + ", ".join(f"{c} {pt.get('held_where_no_constant_passes', 0)}"
+                        for c, pt in fr["controllers"].items()) + ".",
             f"- Frontier maximum: **{_fmt(fr['max_rate'])}** ({fr['max_successes']}/{fr['runs']}"
             f", Wilson [{lo:.3f}, {hi:.3f}], optimistic: the best constant is chosen after the "
             f"fact) at F = {_fmt(fr['max_force'])} N.",
