@@ -280,12 +280,12 @@ def build_scene(
     table = ""
     if spec.table:
         # A plane, not a box: every contact of the scene (table-object, pad sphere-object) then
-        # goes through one of MuJoCo's analytic colliders (plane-box, plane-cylinder,
-        # sphere-box, sphere-cylinder), which compute the same contacts from 3.2 to 4.x. With a
-        # box table the object's contacts with it changed with the version: a cylinder on a box
-        # goes through convex collision detection, whose defaults changed (native CCD from 3.3,
-        # multiple contacts per pair, multiccd, from 3.8: one contact instead of a line before),
-        # and the box-box collider was rewritten in 3.12.
+        # goes through one of MuJoCo's closed-form colliders (plane-box, plane-cylinder,
+        # sphere-box, sphere-cylinder), which compute the same contacts from 3.2 to 4.x. On a
+        # box table a cylinder goes through convex collision detection, whose defaults changed
+        # (native CCD from 3.3; multiccd from 3.8: one contact under a lying cylinder before),
+        # and the box-box collider changed its depth in 3.4 and was rewritten in 3.12
+        # (docs/simulation.md).
         table = (
             f'<geom name="table" type="plane" pos="0 0 {bottom}" size="0.4 0.4 0.01" '
             f'friction="{spec.table_friction} 0.005 0.0001" rgba="0.6 0.6 0.65 1"/>'
