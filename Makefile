@@ -7,7 +7,7 @@ CPP_BUILD := build/cpp
 OUT    ?= out
 
 # MuJoCo for the build (the C++ stepper lugrip._mjstep compiles against its headers) and the run
-MUJOCO_SPEC ?= mujoco>=3.12
+MUJOCO_SPEC ?= mujoco>=3.2
 SOURCES := $(shell find src include bindings python -type f \( -name '*.cpp' -o -name '*.hpp' -o -name '*.py' \)) pyproject.toml CMakeLists.txt
 
 PHONY_DEMO := install-demo
@@ -89,7 +89,7 @@ test-cpp: deps-cpp
 # wheels for this Python), in a second venv beside lugrip's wheel: the MuJoCo and I/O tests.
 # tests/python/test_packaging.py checks this list against pyproject.toml.
 OLDEST_VENV := $(VENV)-oldest
-OLDEST := numpy==1.24.4 scipy==1.10.1 matplotlib==3.7.0 pyyaml==6.0.1 mujoco==3.12.0 \
+OLDEST := numpy==1.24.4 scipy==1.10.1 matplotlib==3.7.0 pyyaml==6.0.1 mujoco==3.2.0 \
 	tqdm==4.66.0 pyarrow==14.0.0 mcap==1.1.0 rosbags==0.10.10
 OLDEST_TESTS := tests/python/test_mujoco_ident.py tests/python/test_mujoco_pad.py \
 	tests/python/test_mujoco_scenes.py tests/python/test_mujoco_validation.py \

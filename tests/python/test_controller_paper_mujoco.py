@@ -28,7 +28,7 @@ def test_big_block_stick_slip_at_lift_off_is_caught_by_the_reflex_and_the_probe(
     """Seed 401 of experiment 1: the block's pads slide in stick-slip at lift-off, S alternates
     around the reflex threshold from sample to sample. The reflex (its samples counted anywhere
     in the period) and the grip probe (mu_probe 0.08; off by default) catch it within 0.3 mm
-    (measured 0.17 mm); with neither (no load floors: feed-forward and reflex off, no probe),
+    (measured 0.14 mm); with neither (no load floors: feed-forward and reflex off, no probe),
     the block slides more than 1 mm before the PI catches the load."""
     run, on, slip, _ = _lift("exp1_big_resin_block", {"mu_probe": 0.08}, seed=401, duration=3.0)
     _, _, slip_old, _ = _lift("exp1_big_resin_block", {"load_floors": False, "mu_probe": 0.0},

@@ -267,6 +267,94 @@ def test_every_scenario_has_a_mujoco_scene(name):
         s.plant_config(model)
 
 
+#: geom type pairs MuJoCo collides in closed form (mjc_PlaneBox, mjc_PlaneCylinder, mjc_SphereBox,
+#: mjc_SphereCylinder): no convex collision detection, whose defaults changed between versions
+_ANALYTIC = {frozenset(p) for p in (("plane", "box"), ("plane", "cylinder"), ("sphere", "box"),
+                                    ("sphere", "cylinder"))}
+
+
+def _scene_model(name):
+    from lugrip.sim.mujoco.gripper import build_scene
+
+    s = sc.load_scenario(name)
+    cfg = s.plant_config("mujoco")
+    m, _ = build_scene(s.scene_spec(), params=cfg.contact, mass=cfg.object.mass,
+                       inertia=cfg.object.inertia, cog=cfg.object.cog)
+    return m
+
+
+def _touching_pairs(m):
+    """The geom pairs MuJoCo's collision may check: explicit pairs, and geoms of different
+    bodies that the contype/conaffinity filter lets meet (not both on the world body)."""
+    out = {frozenset((int(a), int(b))) for a, b in zip(m.pair_geom1, m.pair_geom2)}
+    for i in range(m.ngeom):
+        for j in range(i + 1, m.ngeom):
+            bi, bj = int(m.geom_bodyid[i]), int(m.geom_bodyid[j])
+            if bi == bj or bi == bj == 0:
+                continue
+            ci, cj = int(m.geom_contype[i]), int(m.geom_contype[j])
+            if (ci & int(m.geom_conaffinity[j])) or (cj & int(m.geom_conaffinity[i])):
+                out.add(frozenset((i, j)))
+    return out
+
+
+@pytest.mark.parametrize("name", ALL)
+def test_every_scene_contact_has_a_closed_form_collider(name):
+    """The MuJoCo scene itself (no lugrip model): every geom pair that can touch (the object
+    with the table and with each pad) is a plane or a sphere against a box or a cylinder, which
+    MuJoCo collides in closed form, so MuJoCo 3.2 to 4.x compute the same contacts (a box table
+    sent a lying cylinder through convex collision detection: one contact before MuJoCo 3.8,
+    two after; docs/simulation.md)."""
+    m = _scene_model(name)
+    names = {int(v): k.removeprefix("mjGEOM_").lower()
+             for k, v in mujoco.mjtGeom.__members__.items()}
+    pairs = _touching_pairs(m)
+    obj = mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_GEOM, "object")
+    assert pairs and all(obj in p for p in pairs)
+    for p in pairs:
+        kinds = frozenset(names[int(m.geom_type[g])] for g in p)
+        assert kinds in _ANALYTIC, (name, sorted(kinds))
+
+
+def _toggle(m, flag):
+    """Flip MuJoCo's option flag `flag` (an enable bit in some versions, a disable bit in
+    others); False when this MuJoCo has no such flag."""
+    for enum, field in ((mujoco.mjtEnableBit, "enableflags"),
+                        (mujoco.mjtDisableBit, "disableflags")):
+        bit = enum.__members__.get(flag)
+        if bit is not None:
+            setattr(m.opt, field, getattr(m.opt, field) ^ int(bit))
+            return True
+    return False
+
+
+def test_lying_bottle_runs_bit_for_bit_alike_with_either_convex_collision_setting():
+    """The MuJoCo scene itself, open loop (no lugrip model): the exp3 bottle lying on the table,
+    squeezed with 8 N and lifted 5 cm, gives the same trajectory to the last bit whether
+    MuJoCo's multiccd (default from 3.8) and native CCD (default from 3.3) are on or off."""
+    runs = []
+    for flags in ((), ("MULTICCD",), ("NATIVECCD",)):
+        m = _scene_model("exp3_plastic_bottle_pivot")
+        toggled = [_toggle(m, f"mj{kind}_{flag}") for flag in flags for kind in ("ENBL", "DSBL")]
+        if flags and not any(toggled):
+            continue  # this MuJoCo has no such setting (native CCD before 3.2.3)
+        d = mujoco.MjData(m)
+        hz = mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_ACTUATOR, "hz")
+        traj = []
+        for k in range(1500):
+            t = k * m.opt.timestep
+            d.ctrl[0] = d.ctrl[1] = 8.0
+            d.ctrl[hz] = 0.05 * min(max(t - 0.3, 0.0), 1.0)
+            mujoco.mj_step(m, d)
+            traj.append(d.qpos.copy())
+        runs.append(np.array(traj))
+    assert len(runs) >= 2
+    z = mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_JOINT, "oz")
+    assert runs[0][-1, m.jnt_qposadr[z]] > 0.04  # lifted with the hand
+    for r in runs[1:]:
+        assert np.array_equal(r, runs[0])
+
+
 def test_unseen_objects_cover_the_four_kinds():
     """The unseen set: a heavy mostly-translational load, a light object (< 50 g), a large
     gravity torque and a pivot to vertical, each with short-edged pulses and a wrist roll."""

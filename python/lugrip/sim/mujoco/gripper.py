@@ -258,7 +258,7 @@ def build_scene(
 ) -> tuple[mujoco.MjModel, list[Pad]]:
     """The MJCF model of one grasp: the object's grasp point on the grasp axis at
     `grasp_height` [m] (its CoG at `cog` = (horizontal, vertical) [m] from it), the pads
-    `clearance` off its faces, the table under it.
+    `clearance` off its faces, the table (a plane) under it.
 
     Bodies: ``object`` (joints ox, oy, oz, otheta), ``hand`` (hy, hz, hroll: position servos),
     ``finger0/1`` (f0, f1: force motors m0, m1), ``pad0/1`` (pad0_x, pad0_y, pad0_twist: in-plane
@@ -279,8 +279,15 @@ def build_scene(
     i_obj = float(inertia)
     table = ""
     if spec.table:
+        # A plane, not a box: every contact of the scene (table-object, pad sphere-object) then
+        # goes through one of MuJoCo's closed-form colliders (plane-box, plane-cylinder,
+        # sphere-box, sphere-cylinder), which compute the same contacts from 3.2 to 4.x. On a
+        # box table a cylinder goes through convex collision detection, whose defaults changed
+        # (native CCD from 3.3; multiccd from 3.8: one contact under a lying cylinder before),
+        # and the box-box collider changed its depth in 3.4 and was rewritten in 3.12
+        # (docs/simulation.md).
         table = (
-            f'<geom name="table" type="box" pos="0 0 {bottom - 0.01}" size="0.4 0.4 0.01" '
+            f'<geom name="table" type="plane" pos="0 0 {bottom}" size="0.4 0.4 0.01" '
             f'friction="{spec.table_friction} 0.005 0.0001" rgba="0.6 0.6 0.65 1"/>'
         )
     pads = []
