@@ -442,6 +442,11 @@ def test_simulate_cli_on_mujoco(tmp_path, capsys):
     bare.pop("mujoco")
     (tmp_path / "bare.yaml").write_text(yaml.safe_dump(bare))
     assert main(["simulate", str(tmp_path / "bare.yaml"), "--plant", "mujoco"]) == 2
+    # --no-plots on an engine plant: the metrics and the report, no figure
+    quiet = tmp_path / "quiet"
+    assert main(["simulate", str(path), "--plant", "mujoco", "--no-baselines", "--no-plots",
+                 "--out", str(quiet)]) == 0
+    assert (quiet / "mujoco.md").is_file() and not list(quiet.glob("*.png"))
 
 
 def test_video_and_frames_or_a_clear_message(tmp_path):

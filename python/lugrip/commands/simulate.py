@@ -299,6 +299,7 @@ def _run_engine(args: argparse.Namespace, paths: list[str]) -> int:
             baselines=not args.no_baselines,
             log=lambda s: print(s, file=sys.stderr, flush=True),
             engine=args.plant,
+            plots=not args.no_plots,
         )
     except RenderUnavailable as err:  # raised only for the video writer; frames degrade
         raise CliError(str(err)) from None

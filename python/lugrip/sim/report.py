@@ -395,10 +395,12 @@ def run_mujoco_set(
     baselines: bool = True,
     log=None,
     engine: str = "mujoco",
+    plots: bool = True,
 ) -> dict[str, Any]:
     """Run scenarios on an engine (``engine``, a registered Plant kind; MuJoCo by default) (with both baselines on the file's seed, lugrip alone on
     `seeds` - 1 further noise seeds), and on the `compare` plants; write one figure per
-    scenario (rendered frames of the lift and pivot when offscreen rendering works) and an MP4
+    scenario unless `plots` is false (rendered frames of the lift and pivot when offscreen
+    rendering works) and an MP4
     of lugrip's run when `video` is given (one scenario: that path; several: NAME inserted
     before the suffix).
 
@@ -406,6 +408,7 @@ def run_mujoco_set(
     "seeds": {name: [summary per seed]}, "figures": {name: path}, "render": message or None,
     "videos": {name: path}}.
     """
+    frames = frames and plots  # the frames are drawn into the figures only
     backend = choose_gl_backend() if (frames or video) else None
     from .mujoco.render import FrameRecorder, RenderUnavailable
 
@@ -469,13 +472,14 @@ def run_mujoco_set(
         for plant in compare:
             others[plant][r.name] = run_scenario(scn, plant_model=plant, baselines=baselines)
         evaluate_cross(list(results.values()))
-        fig = figure_mujoco(
-            r,
-            recorder.frames if recorder is not None else (),
-            others.get("patch", {}).get(r.name),
-            note=None if render_msg is None else "no frames: " + render_msg,
-        )
-        figures[r.name] = save(fig, out / f"{engine}_{r.name}.png")
+        if plots:
+            fig = figure_mujoco(
+                r,
+                recorder.frames if recorder is not None else (),
+                others.get("patch", {}).get(r.name),
+                note=None if render_msg is None else "no frames: " + render_msg,
+            )
+            figures[r.name] = save(fig, out / f"{engine}_{r.name}.png")
         if log:
             n_ok = sum(x["pass"] for x in rows)
             log(
