@@ -81,6 +81,34 @@ def test_hysteresis_between_static_and_kinetic_levels():
     assert not kin[i[6] - 1] and S[i[6] - 1] == pytest.approx(0.5 / 1.3, rel=0.02)
 
 
+def test_stribeck_capacity_steady_sliding_speed():
+    """No plant (eqs. 16-18 wrenches, pure rotation, Table 1). With stribeck_speed v_s the
+    sliding update's capacity is g (1 + (r_s - 1) exp(-(v / v_s)^2)), v = |omega| rho / sqrt(2)
+    at c~ = 0 (docs/model.md 7.5): a load that breaks away and then holds at that capacity plus
+    sigma_1 omega* at a chosen omega* gives omega_state = omega* in steady sliding (here the
+    capacity falls more slowly than sigma_1 omega rises, one root), where the observer without
+    the curve reads the excess friction as speed."""
+    p = ContactParams.table1().replace(static_ratio=1.3, kinetic_ratio=1.0)
+    f_n = 5.0
+    rho = p.delta * f_n ** p.gamma
+    g = p.mu * p.xi * p.delta * f_n ** (1.0 + p.gamma)
+    sigma_1 = p.beta_a * math.pi * rho ** 4 * 0.5
+    v_s = 2.0e-5
+    w_star = 0.01
+    level = 1.0 + 0.3 * math.exp(-((w_star * rho / math.sqrt(2.0)) / v_s) ** 2)
+    hold = (g * level + sigma_1 * w_star) / g  # the load over g at omega*
+    loads = np.concatenate([np.linspace(0.0, 1.6, 300), np.linspace(1.6, hold, 100),
+                            np.full(1500, hold)])
+    log = _rotation_log(p, f_n, loads)
+    curve = Observer(p.replace(stribeck_speed=v_s)).run(log)
+    one = Observer(p).run(log)
+    assert np.asarray(curve.kinetic)[-1]
+    assert np.asarray(curve.omega_state)[-1] == pytest.approx(w_star, rel=1e-3)
+    w_one = (hold - 1.0) * g / sigma_1  # one sliding level: the excess read as speed
+    assert np.asarray(one.omega_state)[-1] == pytest.approx(w_one, rel=1e-3)
+    assert w_one > 1.05 * w_star
+
+
 @settings(max_examples=30, deadline=None)
 @given(st.floats(0.5, 3.0), st.floats(0.5, 3.0))
 def test_ratio_validation(rs, rk):
