@@ -494,11 +494,13 @@ STRIBECK_JOINT = ("mu", "delta", "gamma", "beta_a")
 #: the maneuvers)
 STRIBECK_T_JOINT = 3.0
 #: cost evaluations of the Nelder-Mead search of the curve's rest level and speed
-STRIBECK_EVALUATIONS = 30
+STRIBECK_EVALUATIONS = 20
+#: iterations of each Gauss-Newton fit of the joint fit (it starts near its minimum)
+STRIBECK_ITERATIONS = 8
 # the ranges of the friction ratios and the Stribeck speed, from the C++ field table
 _LIMITS = {p["name"]: (p["lo"]["value"], p["hi"]["value"]) for p in _core.ContactParams.params}
-kMinRatio, kMaxRatio = _LIMITS["static_ratio"]
-kMaxStribeck = _LIMITS["stribeck_speed"][1]
+_MIN_RATIO, _MAX_RATIO = _LIMITS["static_ratio"]
+_MAX_STRIBECK = _LIMITS["stribeck_speed"][1]
 
 
 @dataclasses.dataclass(frozen=True)
@@ -525,9 +527,9 @@ def _stribeck_joint(train, val, p_hat, curve, free_t, bnds, method, max_iteratio
     """Stage 7's Stribeck curve put into the observer (mu the level at speed, static_ratio the
     level at rest over it, stribeck_speed its speed; kinetic_ratio kept as the same absolute
     level) and eq. 32 minimised again over the sliding level, delta, gamma and beta_A together
-    with the curve, unregularised: Gauss-Newton over those four, a Nelder-Mead search of the
-    curve's rest level and speed (values only, ``STRIBECK_EVALUATIONS``) with them held, and
-    Gauss-Newton again. The refinement fitted them with one dry level, which a falling friction
+    with the curve, unregularised: Gauss-Newton over those four (``STRIBECK_ITERATIONS``), a
+    Nelder-Mead search of the curve's rest level and speed (values only,
+    ``STRIBECK_EVALUATIONS``) with them held, and Gauss-Newton again. The refinement fitted them with one dry level, which a falling friction
     biases: a slow slide's excess friction read as speed, the shape and the viscous term bent to
     absorb it. Kept only where the per-maneuver cost (mean squared omega_hat error of each
     training and validation maneuver) falls significantly against the refined parameters with
@@ -537,22 +539,23 @@ def _stribeck_joint(train, val, p_hat, curve, free_t, bnds, method, max_iteratio
 
     t0 = time.perf_counter()
     a, b, v_s = curve
-    rest = min(b / a, kMaxRatio)
+    rest = min(b / a, _MAX_RATIO)
     p = p_hat.replace(
         mu=p_hat.mu * a, static_ratio=rest,
-        kinetic_ratio=min(max(p_hat.kinetic_ratio / a, kMinRatio), rest), stribeck_speed=v_s)
+        kinetic_ratio=min(max(p_hat.kinetic_ratio / a, _MIN_RATIO), rest), stribeck_speed=v_s)
     free = tuple(n for n in STRIBECK_JOINT if n in free_t)
     if not free:
         return _Joint(p_hat, False, (), (), 0.0, "(d) Stribeck curve: no free parameter to refit with it")
 
     def gauss_newton(q):
-        return minimise(train, q, free, bnds, method=method, max_iterations=max_iterations,
+        return minimise(train, q, free, bnds, method=method,
+                        max_iterations=min(max_iterations, STRIBECK_ITERATIONS),
                         tolerance=tolerance).params
 
     def curve_at(q, x):
-        r = min(1.0 + math.exp(x[0]), kMaxRatio)
+        r = min(1.0 + math.exp(x[0]), _MAX_RATIO)
         return q.replace(static_ratio=r, kinetic_ratio=min(q.kinetic_ratio, r),
-                         stribeck_speed=min(math.exp(x[1]), kMaxStribeck))
+                         stribeck_speed=min(math.exp(x[1]), _MAX_STRIBECK))
 
     p = gauss_newton(p)
     q = p
