@@ -529,9 +529,9 @@ def _stribeck_joint(train, val, p_hat, curve, free_t, bnds, method, max_iteratio
     level) and eq. 32 minimised again over the sliding level, delta, gamma and beta_A together
     with the curve, unregularised: Gauss-Newton over those four (``STRIBECK_ITERATIONS``), a
     Nelder-Mead search of the curve's rest level and speed (values only,
-    ``STRIBECK_EVALUATIONS``) with them held, and Gauss-Newton again. The refinement fitted them with one dry level, which a falling friction
-    biases: a slow slide's excess friction read as speed, the shape and the viscous term bent to
-    absorb it. Kept only where the per-maneuver cost (mean squared omega_hat error of each
+    ``STRIBECK_EVALUATIONS``) with them held, and Gauss-Newton again. The refinement fitted
+    them with one dry level, which a falling friction biases: a slow slide's excess friction
+    read as speed, the shape and the viscous term bent to absorb it. Kept only where the per-maneuver cost (mean squared omega_hat error of each
     training and validation maneuver) falls significantly against the refined parameters with
     the friction levels: the log of its ratio, paired over the maneuvers, with
     t >= ``STRIBECK_T_JOINT``."""
