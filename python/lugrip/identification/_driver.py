@@ -531,10 +531,10 @@ def _stribeck_joint(train, val, p_hat, curve, free_t, bnds, method, max_iteratio
     Nelder-Mead search of the curve's rest level and speed (values only,
     ``STRIBECK_EVALUATIONS``) with them held, and Gauss-Newton again. The refinement fitted
     them with one dry level, which a falling friction biases: a slow slide's excess friction
-    read as speed, the shape and the viscous term bent to absorb it. Kept only where the per-maneuver cost (mean squared omega_hat error of each
-    training and validation maneuver) falls significantly against the refined parameters with
-    the friction levels: the log of its ratio, paired over the maneuvers, with
-    t >= ``STRIBECK_T_JOINT``."""
+    read as speed, the shape and the viscous term bent to absorb it. Kept only where the
+    per-maneuver cost (mean squared omega_hat error of each training and validation maneuver)
+    falls significantly against the refined parameters with the friction levels: the log of
+    its ratio, paired over the maneuvers, with t >= ``STRIBECK_T_JOINT``."""
     from scipy.optimize import minimize
 
     t0 = time.perf_counter()
@@ -545,7 +545,8 @@ def _stribeck_joint(train, val, p_hat, curve, free_t, bnds, method, max_iteratio
         kinetic_ratio=min(max(p_hat.kinetic_ratio / a, _MIN_RATIO), rest), stribeck_speed=v_s)
     free = tuple(n for n in STRIBECK_JOINT if n in free_t)
     if not free:
-        return _Joint(p_hat, False, (), (), 0.0, "(d) Stribeck curve: no free parameter to refit with it")
+        return _Joint(p_hat, False, (), (), 0.0,
+                      "(d) Stribeck curve: no free parameter to refit with it")
 
     def gauss_newton(q):
         return minimise(train, q, free, bnds, method=method,
