@@ -281,8 +281,10 @@ def stribeck_levels(plant, data: RubbingData) -> list[tuple[float, object, np.nd
 
 def _oracle_rmse(p0, settings: dict, levels, **replace) -> float:
     """|omega_object| RMSE over the maneuvers of ``levels`` with mu set to each one's level,
-    ratios 1, and ``replace`` applied to the file's parameters."""
-    p = p0.replace(static_ratio=1.0, kinetic_ratio=1.0, **replace)
+    ratios 1 (no Stribeck curve), and ``replace`` applied to the file's parameters."""
+    # no Stribeck curve either (a version before it has no such field)
+    none = {"stribeck_speed": 0.0} if hasattr(p0, "stribeck_speed") else {}
+    p = p0.replace(static_ratio=1.0, kinetic_ratio=1.0, **none, **replace)
     se, n = 0.0, 0
     for level, log, om in levels:
         run = lugrip.Observer(p.replace(mu=level), **settings).run(log)
@@ -590,7 +592,8 @@ def write_limits(path: Path, runs: list[dict], argv: list[str]) -> None:
              "share of f_n on sliding cells comes from a re-run of those maneuvers (a cell "
              "slides when its bristle is at >= 0.9 of its sliding deflection). Oracle "
              "observers (viscous plants): the fitted file with mu set per maneuver to the "
-             "plant's dry sliding level at its peak speed and static_ratio = kinetic_ratio = 1; "
+             "plant's dry sliding level at its peak speed and static_ratio = kinetic_ratio = 1 "
+             "(no Stribeck curve); "
              "then also the true delta, gamma, beta_A and pressure exponent k (2 Hertz, "
              "infinity uniform); then (with --oracle-refit) the levels with delta, gamma and "
              "beta_A refitted on the 160 training maneuvers (eq. 32 under those levels, "
@@ -673,7 +676,10 @@ def main(argv=None) -> int:
                  "(tables 'before' and 'after', seeds 101-108) were visible while the rules and "
                  "their thresholds were chosen; the 'fresh' set (`--seed-offset 1000`, other "
                  "maneuvers of the same plants) was first scored after the last change of a "
-                 "rule. Plants:")
+                 "rule, except the joint fit of the Stribeck curve (viscous plants), whose "
+                 "significance test took its form after the fresh set of hertz-viscous had "
+                 "rejected the fit; 'unseen' (`--seed-offset 2000`, the viscous plants) was "
+                 "first scored after that change. Plants:")
         lines += [""] + [f"* **{k}**: {v}" for k, v in PLANTS.items()] + [""]
         lines += [
             "Columns: the share of samples with S >= 0.9 among those at >= 98 % of their "
@@ -686,9 +692,10 @@ def main(argv=None) -> int:
             "false, the RMSE of |omega_hat| against predicting zero; with a viscous shear the "
             "|omega| RMSE over all samples (omega_object); fit: wall time of `identify` on "
             "this shared machine (other jobs running, the runs of a table partly in parallel: "
-            "BENCHMARKS' identification sections give the timing). Before: the observer and "
-            "identification before the friction levels and the omega_hat gate, on the same data; "
-            "after and fresh: this version.",
+            "BENCHMARKS' identification sections give the timing). Before: the version before "
+            "the Stribeck curve in the observer and its joint fit with mu, delta, gamma and "
+            "beta_A (docs/model.md §7.5, §8.3 stage 7), on the same data; after, fresh and "
+            "unseen: this version ('unseen before': the version before on that set).",
             "",
         ]
         for run in runs:

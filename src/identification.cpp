@@ -257,9 +257,14 @@ void run_segment(Observer& obs, const SegmentWork& w, int64_t begin, int64_t end
         c.sigma0 = sigma0;
         c.sigma_z = sigma_z;
         c.g = Dual(o.g);
-        // friction ratios: in stick the observer's update uses static_ratio times the capacity
-        const double stick_factor =
+        // friction ratios: in stick the observer's update uses static_ratio times the capacity;
+        // once sliding with a Stribeck speed a factor of the speed state (its value taken from
+        // the observer's capacity, its dependence on the state and on static_ratio and
+        // stribeck_speed not differentiated: the gradient of those is approximate)
+        double stick_factor =
             ((p.static_ratio != 1.0 || p.kinetic_ratio != 1.0) && !o.kinetic) ? p.static_ratio : 1.0;
+        if (o.kinetic && p.stribeck_speed > 0.0 && p.mu * f_n * rho * G >= os.g_floor)
+          stick_factor = o.g / (p.mu * f_n * rho * G);
         if (p.mu * f_n * rho * G >= os.g_floor) {
           const double unit = stick_factor * p.mu * f_n;  // g = unit rho G(a)
           for (int k = 0; k < N; ++k) c.g.d[k] = unit * (drho[k] * G + rho * dG * da[k]);

@@ -197,8 +197,23 @@ Status Observer::step(const ObserverInput& in, ObserverOutput& out) noexcept {
       const double load = p.sigma0 * std::fabs(z0) / rc.g;  // friction about the CoR over g
       kinetic = load >= (kinetic_ ? kStickRelease : kBreakawayLevel) * p.kinetic_ratio;
     }
-    if (kinetic) s_capacity = p.kinetic_ratio;
-    else rc.g *= p.static_ratio;
+    if (kinetic) {
+      s_capacity = p.kinetic_ratio;
+      if (p.stribeck_speed > 0.0) {
+        // Stribeck capacity: from static_ratio g at rest to g at speed, with the RMS sliding
+        // speed over the patch from the speed state at the start of the sample (restated about
+        // the unclipped CoR, as omega_object); S stays judged against kinetic_ratio g
+        double w_obj = 0.0, v_unused = 0.0;
+        const double a_u = std::fabs(co.c_tilde_unclipped);
+        unclipped_slip(w0, std::fabs(co.c_tilde), a_u, co.rho, w_obj, v_unused);
+        const double v = std::fabs(w_obj) * co.rho * std::sqrt(a_u * a_u + 0.5) / p.stribeck_speed;
+        const double factor = 1.0 + (p.static_ratio - 1.0) * std::exp(-v * v);
+        rc.g *= factor;
+        s_capacity /= factor;
+      }
+    } else {
+      rc.g *= p.static_ratio;
+    }
   }
   rc.drive = in.tau - co.c * in.f_t;
   if (s_.gain_mode == GainMode::Fixed) {

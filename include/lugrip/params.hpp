@@ -8,6 +8,8 @@ namespace lugrip {
 //! Range of ContactParams::static_ratio and kinetic_ratio [-].
 constexpr double kMinFrictionRatio = 0.5;
 constexpr double kMaxFrictionRatio = 3.0;
+//! Upper bound of ContactParams::stribeck_speed [m/s].
+constexpr double kMaxStribeckSpeed = 1.0;
 
 //! Physical parameters of one fingertip/object contact (SI units). Units, valid ranges and
 //! meanings: the field table, lugrip/settings_fields.hpp (docs/conventions.md prints it).
@@ -29,6 +31,11 @@ struct ContactParams {
   //! once sliding has started (the lower envelope of the sliding loads in identification).
   //! 1 (default) = mu. With both ratios 1 the observer is the paper's (docs/model.md 7.5).
   double kinetic_ratio = 1.0;
+  //! Stribeck speed v_s [m/s]: when > 0, once sliding, the observer's update uses the capacity
+  //! g (1 + (static_ratio - 1) exp(-(v / v_s)^2)), v the RMS sliding speed over the patch from
+  //! its speed state, so that mu is the sliding friction at speed and a slow slide's higher
+  //! friction is not read as speed. 0 (default): the update uses g once sliding (docs/model.md 7.5).
+  double stribeck_speed = 0.0;
 };
 
 //! Checks every field against its range in the field table. Returns true when valid; otherwise

@@ -56,7 +56,10 @@ struct FieldTable<ContactParams> {
                     "break-away friction over mu, mu_s / mu: S's capacity in stick (1: the paper)"),
       detail::param("kinetic_ratio", &S::kinetic_ratio, "-", detail::ge(kMinFrictionRatio),
                     detail::le(kMaxFrictionRatio),
-                    "sliding friction level over mu, mu_k / mu: S's capacity once sliding (1: the paper)"));
+                    "sliding friction level over mu, mu_k / mu: S's capacity once sliding (1: the paper)"),
+      detail::param("stribeck_speed", &S::stribeck_speed, "m/s", detail::ge(0.0), detail::le(kMaxStribeckSpeed),
+                    "Stribeck speed of the sliding update's capacity, falling from static_ratio g at rest to g "
+                    "at speed (0: none, the update uses g once sliding)"));
   static constexpr auto rules = std::make_tuple(detail::Rule<S>{
       "static_ratio", [](const S& p) { return p.static_ratio; },
       [](const S& p) {

@@ -19,6 +19,9 @@ __all__ = ["PRESETS", "ContactParams"]
 _FIELDS = tuple(p["name"] for p in _core.ContactParams.params)
 _UNITS = {p["name"]: p["unit"] for p in _core.ContactParams.params}
 _REQUIRED = tuple(line.split(" = ")[0] for line in _core.validate_params(_core.ContactParams()).splitlines())
+#: fields written to a parameter file only when they differ from their default (files without
+#: friction levels or a Stribeck speed stay as they were)
+_OPTIONAL = {"static_ratio": 1.0, "kinetic_ratio": 1.0, "stribeck_speed": 0.0}
 
 
 @dataclasses.dataclass(frozen=True)
@@ -44,6 +47,11 @@ class ContactParams:
         kinetic_ratio: sliding friction level over mu, mu_k / mu, in [0.5, 3]: the capacity
             S is judged against once sliding has started. Both 1 (default, the paper's
             model): no Stribeck term, S as in the paper (docs/model.md §7.5).
+        stribeck_speed: Stribeck speed v_s [m/s], in [0, 1]; > 0: once sliding, the
+            observer's update uses the capacity g (1 + (static_ratio - 1) exp(-(v/v_s)^2)),
+            v the RMS sliding speed over the patch from its speed state, mu then being the
+            sliding friction at speed (identified where the speed is observable and the
+            sliding friction falls with it); 0 (default): the update uses g once sliding.
 
     Raises:
         ValueError: naming every invalid field.
@@ -59,6 +67,7 @@ class ContactParams:
     c_max: float = 1.5
     static_ratio: float = 1.0
     kinetic_ratio: float = 1.0
+    stribeck_speed: float = 0.0
 
     def __post_init__(self) -> None:
         for name in _FIELDS:
@@ -182,7 +191,7 @@ class ContactParams:
                 name: {"value": getattr(self, name) if math.isfinite(getattr(self, name)) else ".inf",
                        "unit": _UNITS[name]}
                 for name in _FIELDS
-                if name not in ("static_ratio", "kinetic_ratio") or getattr(self, name) != 1.0
+                if name not in _OPTIONAL or getattr(self, name) != _OPTIONAL[name]
             }
         }
         if observer is not None:

@@ -54,7 +54,8 @@ def valid_rule(name: str, v: float) -> bool:
 
 def test_table1_preset():
     p = lugrip.ContactParams.table1()
-    assert p.to_dict() == {**TABLE1, "k": 4.0, "c_max": 1.5, "static_ratio": 1.0, "kinetic_ratio": 1.0}
+    assert p.to_dict() == {**TABLE1, "k": 4.0, "c_max": 1.5, "static_ratio": 1.0, "kinetic_ratio": 1.0,
+                           "stribeck_speed": 0.0}
     assert lugrip.ContactParams.preset("table1") == p
     assert p.xi == pytest.approx(0.6354098136, abs=1e-10)
 

@@ -35,7 +35,7 @@ examples:
 
 _UNITS = {"mu": "-", "beta_a": "N s/m^3", "sigma0": "N m/rad", "sigma_z": "N m s/rad",
           "delta": "m/N^gamma", "gamma": "-", "k": "-", "c_max": "-",
-          "static_ratio": "-", "kinetic_ratio": "-"}
+          "static_ratio": "-", "kinetic_ratio": "-", "stribeck_speed": "m/s"}
 _MEANING = {"mu": "friction coefficient of the limit surface",
             "beta_a": "viscous friction per unit area and speed",
             "sigma0": "micro-asperity stiffness",
@@ -45,7 +45,8 @@ _MEANING = {"mu": "friction coefficient of the limit surface",
             "k": "pressure exponent (0: elliptic limit surface)",
             "c_max": "saturation of |c~|",
             "static_ratio": "break-away friction / mu (S's capacity in stick)",
-            "kinetic_ratio": "sliding friction level / mu (S's capacity once sliding)"}
+            "kinetic_ratio": "sliding friction level / mu (S's capacity once sliding)",
+            "stribeck_speed": "Stribeck speed of the sliding update's capacity (0: none)"}
 
 
 def register(subparsers) -> None:

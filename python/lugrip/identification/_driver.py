@@ -410,8 +410,31 @@ def identify(
             [m for m, _ in pairs], [ph for _, ph in pairs], p_hat, dict(odict)
         )
         p_hat = p_hat.replace(static_ratio=levels.static_ratio, kinetic_ratio=levels.kinetic_ratio)
-        stage = dataclasses.replace(stage, report=stage.report + (levels.line,))
-        ident.append(levels.line)
+        lines = (levels.line,)
+        if levels.curve is not None and stage.speed_observable:
+            joint = _stribeck_joint(train, val, p_hat, levels.curve, free_t, bnds, method,
+                                    max_iterations, tolerance)
+            lines += (joint.line,)
+            fit_time += joint.fit_time
+            if joint.accepted:
+                p_hat = joint.params
+                estimates = [
+                    dataclasses.replace(
+                        e, value=getattr(p_hat, e.name), stderr=math.nan,
+                        note=(e.note + "; " if e.note else "")
+                        + "refitted with the Stribeck curve (stage 7), no standard error")
+                    if e.name in joint.free else e
+                    for e in estimates
+                ]
+                ev, split = evaluate_split(train, val, train_m, val_m, p_hat)
+                at_bound = [(n, "Stribeck joint fit") for n in joint.at_bound]
+                if at_bound:
+                    status = "failed"
+                    message = "parameter(s) at a bound: " + ", ".join(
+                        f"{n} ({where})" for n, where in at_bound)
+                    warnings.warn(message, IdentificationWarning, stacklevel=2)
+        stage = dataclasses.replace(stage, report=stage.report + lines)
+        ident.extend(lines)
     data_warnings = _data_warnings(split, stage)
     for w in data_warnings:
         warnings.warn(w, IdentificationWarning, stacklevel=2)
@@ -461,6 +484,123 @@ def identify(
         stages=stage,
         warnings=tuple(data_warnings),
     )
+
+
+#: parameters the joint fit with the Stribeck curve refits by eq. 32 (docs/model.md §8.3, stage
+#: 7): the sliding level and what a speed-dependent friction biases when it is fitted with one
+#: level
+STRIBECK_JOINT = ("mu", "delta", "gamma", "beta_a")
+#: the joint fit is kept when the log of the per-maneuver cost falls with t >= this (paired over
+#: the maneuvers)
+STRIBECK_T_JOINT = 3.0
+#: cost evaluations of the Nelder-Mead search of the curve's rest level and speed
+STRIBECK_EVALUATIONS = 20
+#: iterations of each Gauss-Newton fit of the joint fit (it starts near its minimum)
+STRIBECK_ITERATIONS = 8
+# the ranges of the friction ratios and the Stribeck speed, from the C++ field table
+_LIMITS = {p["name"]: (p["lo"]["value"], p["hi"]["value"]) for p in _core.ContactParams.params}
+_MIN_RATIO, _MAX_RATIO = _LIMITS["static_ratio"]
+_MAX_STRIBECK = _LIMITS["stribeck_speed"][1]
+
+
+@dataclasses.dataclass(frozen=True)
+class _Joint:
+    params: ContactParams
+    accepted: bool
+    free: tuple
+    at_bound: tuple
+    fit_time: float
+    line: str
+
+
+def _maneuver_mse(problems, params: ContactParams) -> np.ndarray:
+    """Per maneuver of the problems: the mean squared omega_hat error of its scored samples."""
+    out = []
+    for prob in problems:
+        sse, cnt = prob.per_maneuver(prob.evaluate(params, False))
+        out.append(np.where(cnt > 0, sse / np.maximum(cnt, 1), np.nan))
+    return np.concatenate(out)
+
+
+def _stribeck_joint(train, val, p_hat, curve, free_t, bnds, method, max_iterations,
+                    tolerance) -> _Joint:
+    """Stage 7's Stribeck curve put into the observer (mu the level at speed, static_ratio the
+    level at rest over it, stribeck_speed its speed; kinetic_ratio kept as the same absolute
+    level) and eq. 32 minimised again over the sliding level, delta, gamma and beta_A together
+    with the curve, unregularised: Gauss-Newton over those four (``STRIBECK_ITERATIONS``), a
+    Nelder-Mead search of the curve's rest level and speed (values only,
+    ``STRIBECK_EVALUATIONS``) with them held, and Gauss-Newton again. The refinement fitted
+    them with one dry level, which a falling friction biases: a slow slide's excess friction
+    read as speed, the shape and the viscous term bent to absorb it. Kept only where the
+    per-maneuver cost (mean squared omega_hat error of each training and validation maneuver)
+    falls significantly against the refined parameters with the friction levels: the log of
+    its ratio, paired over the maneuvers, with t >= ``STRIBECK_T_JOINT``."""
+    from scipy.optimize import minimize
+
+    t0 = time.perf_counter()
+    a, b, v_s = curve
+    rest = min(b / a, _MAX_RATIO)
+    p = p_hat.replace(
+        mu=p_hat.mu * a, static_ratio=rest,
+        kinetic_ratio=min(max(p_hat.kinetic_ratio / a, _MIN_RATIO), rest), stribeck_speed=v_s)
+    free = tuple(n for n in STRIBECK_JOINT if n in free_t)
+    if not free:
+        return _Joint(p_hat, False, (), (), 0.0,
+                      "(d) Stribeck curve: no free parameter to refit with it")
+
+    def gauss_newton(q):
+        return minimise(train, q, free, bnds, method=method,
+                        max_iterations=min(max_iterations, STRIBECK_ITERATIONS),
+                        tolerance=tolerance).params
+
+    def curve_at(q, x):
+        r = min(1.0 + math.exp(x[0]), _MAX_RATIO)
+        return q.replace(static_ratio=r, kinetic_ratio=min(q.kinetic_ratio, r),
+                         stribeck_speed=min(math.exp(x[1]), _MAX_STRIBECK))
+
+    p = gauss_newton(p)
+    q = p
+
+    def cost(x):
+        try:
+            c = float(train.evaluate(curve_at(q, x), False)["cost"])
+        except ValueError:  # outside the parameters' valid ranges
+            return math.inf
+        return c if math.isfinite(c) else math.inf
+
+    x0 = np.array([math.log(max(p.static_ratio - 1.0, 1.0e-3)), math.log(p.stribeck_speed)])
+    res = minimize(cost, x0, method="Nelder-Mead",
+                   options={"initial_simplex": np.vstack([x0, x0 + [0.3, 0.0], x0 + [0.0, 0.3]]),
+                            "maxfev": STRIBECK_EVALUATIONS, "xatol": 0.02, "fatol": 0.0})
+    if math.isfinite(res.fun) and res.fun < cost(x0):
+        p = gauss_newton(curve_at(q, res.x))
+    problems = [train] + ([val] if val is not None else [])
+    before, after = _maneuver_mse(problems, p_hat), _maneuver_mse(problems, p)
+    ok = (before > 0.0) & (after > 0.0)  # NaN (nothing scored) compares False
+    d = np.log(before[ok] / after[ok])  # scale-free: a few fast maneuvers do not dominate
+    t = (float(np.mean(d)) / (float(np.std(d, ddof=1)) / math.sqrt(d.size))
+         if d.size > 2 and np.std(d) > 0 else 0.0)
+    accepted = t >= STRIBECK_T_JOINT
+    at_bound = tuple(
+        n for n in free
+        if math.isclose(getattr(p, n), bnds[n][0], rel_tol=1e-6)
+        or math.isclose(getattr(p, n), bnds[n][1], rel_tol=1e-6)
+    )
+    c_one = float(train.evaluate(p_hat, False)["cost"])
+    c_joint = float(train.evaluate(p, False)["cost"])
+    elapsed = time.perf_counter() - t0
+    line = (
+        f"(d) Stribeck curve in the observer and eq. 32 refitted over {', '.join(free)} "
+        f"together with it ({elapsed:.1f} s): stribeck_speed {p.stribeck_speed:.3g} m/s, "
+        f"static_ratio {p.static_ratio:.3g} (the level at rest over mu), mu {p_hat.mu:.4g} -> "
+        f"{p.mu:.4g}, delta {p_hat.delta:.4g} -> {p.delta:.4g}, gamma {p_hat.gamma:.4g} -> "
+        f"{p.gamma:.4g}, beta_a {p_hat.beta_a:.4g} -> {p.beta_a:.4g}; training cost "
+        f"{c_one:.4g} with one sliding level, {c_joint:.4g} with the curve, log per-maneuver "
+        f"cost lower with t = {t:.3g} over {d.size} maneuvers: "
+        + ("kept" if accepted else f"not kept (needs t >= {STRIBECK_T_JOINT:g})")
+    )
+    return _Joint(p if accepted else p_hat, accepted, free, at_bound if accepted else (),
+                  elapsed, line)
 
 
 def _data_warnings(split: dict, stage) -> list[str]:

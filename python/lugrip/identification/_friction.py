@@ -14,7 +14,7 @@ from .._params import ContactParams
 from ._data import _Maneuver
 from ._phases import SLIDING
 
-__all__ = ["FrictionLevels", "friction_levels"]
+__all__ = ["FrictionLevels", "friction_levels", "stribeck_curve"]
 
 STRIBECK_T = 3.0  # |t| of the slope of log(sliding level) on log(speed) above which it counts
 STRIBECK_MIN = 1.03  # smallest static / kinetic ratio that counts as a Stribeck term
@@ -38,6 +38,10 @@ class FrictionLevels:
         median_ratio: the break-away level (quantile of the peaks) over the sliding level.
         runs: maneuvers with a break-away used for the test.
         line: the report line.
+        curve: where the Stribeck term counts, the runs' dry sliding levels against their
+            speed fitted with :func:`stribeck_curve`, (level at speed, level at rest,
+            Stribeck speed [m/s]);
+            None otherwise or where the curve's knee is not in the data.
     """
 
     static_ratio: float
@@ -47,6 +51,7 @@ class FrictionLevels:
     median_ratio: float
     runs: int
     line: str
+    curve: tuple[float, float, float] | None = None
 
 
 def _smooth(x: np.ndarray, n: int) -> np.ndarray:
@@ -54,6 +59,39 @@ def _smooth(x: np.ndarray, n: int) -> np.ndarray:
         return x.copy()
     k = np.ones(n) / n
     return np.convolve(x, k, mode="same")
+
+
+def stribeck_curve(speeds: np.ndarray, levels: np.ndarray, static: float):
+    """The runs' dry sliding levels (over the fitted surface) against their sliding speed,
+    fitted with l(v) = a + (b - a) exp(-(v / v_s)^2): the level falls from b at rest to a at
+    speed, b at least the break-away level ``static``. Robust (soft L1) least squares in a, b
+    and log v_s, a run's level also carrying the limit surface's shape error. Returns
+    (a, b, v_s), or None when the knee is not in the data (v_s within 5 % of the log speed
+    range of its ends, or a range narrower than a factor 4) or b is not above a by
+    ``STRIBECK_MIN``."""
+    from scipy.optimize import least_squares
+
+    v = np.asarray(speeds, float)
+    lv = np.asarray(levels, float)
+    lo, hi = math.log(float(v.min())), math.log(float(v.max()))
+    if not hi - lo > math.log(4.0):
+        return None
+    fast = lv[v >= np.quantile(v, 0.75)]
+    a0 = float(min(np.median(fast), static / STRIBECK_MIN))
+    b0 = max(static, float(np.max(lv)))
+
+    def resid(x):
+        return x[0] + (x[1] - x[0]) * np.exp(-np.square(v / math.exp(x[2]))) - lv
+
+    spread = max(float(np.median(np.abs(lv - np.median(lv)))), 1.0e-3)
+    fit = least_squares(resid, [a0, b0 * 1.001, 0.5 * (lo + hi)],
+                        bounds=([0.5, static, lo], [3.0, 3.0, hi]),
+                        loss="soft_l1", f_scale=spread)
+    a, b, ls = (float(x) for x in fit.x)
+    margin = 0.05 * (hi - lo)
+    if not (fit.success and lo + margin < ls < hi - margin and b / a >= STRIBECK_MIN):
+        return None
+    return a, b, math.exp(ls)
 
 
 def friction_levels(
@@ -133,6 +171,7 @@ def friction_levels(
         stribeck = t <= -STRIBECK_T and med >= STRIBECK_MIN
         if stribeck:
             static = float(np.clip(static_q, kinetic, 3.0))
+    curve = stribeck_curve(speeds_a, levels_a, static) if stribeck else None
     line = (
         f"(d) friction levels from {q_all.size} gross-sliding samples of {n} runs (load |y|/g "
         f"on the fitted surface; dry part without sigma_1 |omega| for the runs): sliding level {kinetic:.3g} ({100 * SLIDING_QUANTILE:g} % "
@@ -147,4 +186,7 @@ def friction_levels(
             f"{STRIBECK_MIN:g}): static_ratio = kinetic_ratio = {kinetic:.3g}"
         )
     )
-    return FrictionLevels(static, kinetic, stribeck, t, med, n, line)
+    if curve is not None:
+        line += (f"; the runs' dry levels follow {curve[0]:.3g} + ({curve[1]:.3g} - {curve[0]:.3g}) "
+                 f"exp(-(v/{curve[2]:.3g} m/s)^2) with the RMS speed v over the patch")
+    return FrictionLevels(static, kinetic, stribeck, t, med, n, line, curve)

@@ -12,7 +12,7 @@ from typing import Any
 import numpy as np
 
 from .._observer import Observer
-from .._params import ContactParams
+from .._params import _OPTIONAL, _UNITS, ContactParams
 
 
 @dataclasses.dataclass(frozen=True)
@@ -221,11 +221,11 @@ class IdentificationResult:
                 "c_max": {"value": self.params.c_max, "unit": "-"},
             }
             # the friction levels of stage 7 (docs/model.md 7.5), written like
-            # ContactParams.to_yaml does: only when not 1
+            # ContactParams.to_yaml does: only when not at their default
             | {
-                name: {"value": getattr(self.params, name), "unit": "-"}
-                for name in ("static_ratio", "kinetic_ratio")
-                if getattr(self.params, name) != 1.0
+                name: {"value": getattr(self.params, name), "unit": _UNITS[name]}
+                for name, default in _OPTIONAL.items()
+                if getattr(self.params, name) != default
             },
             # the observer inside the cost: the parameters are identified FOR it (docs/model.md
             # 8.1), so online use must run the same one (lugrip observe --params reads this)
