@@ -3,17 +3,14 @@
 
     lugrip simulate all unseen --plant patch  --short --no-plots --out DIR/patch
     lugrip simulate all unseen --plant mujoco --short --no-plots --out DIR/mujoco
-    lugrip simulate all --plant drake --short --no-plots [--no-baselines] --out DIR/drake_paper
-    lugrip simulate unseen --plant drake --short --no-plots [--no-baselines] --out DIR/drake_unseen
-
-    python benchmarks/drake_constant.py DIR/drake_constant.jsonl SCENARIO ...
+    lugrip simulate all --plant drake --short --no-plots --out DIR/drake_paper
+    lugrip simulate unseen --plant drake --short --no-plots --out DIR/drake_unseen
 
 Usage: python benchmarks/engines_table.py PLANT=METRICS.json [PLANT=METRICS.json ...]
-(several files of one plant are merged; a ``.jsonl`` file is read as drake_constant.py's rows).
+(several files of one plant are merged).
 Per scenario and plant: pass (and the criteria that failed), the worst slip and rotation over
 the hold phases, the mean hold force per finger, the smallest passing constant force
-(bisection) and lugrip's mean over it; for drake_constant.py's rows, the constant forces tried
-and whether each held ("5.4 no, 8.1 yes": the smallest that holds lies between).
+(bisection; "none <= F" when even the gripper's f_max F fails) and lugrip's mean over it.
 """
 
 from __future__ import annotations
@@ -28,18 +25,8 @@ def load(args: list[str]) -> dict[str, dict[str, dict]]:
     for arg in args:
         plant, _, path = arg.partition("=")
         with open(path) as f:
-            if path.endswith(".jsonl"):
-                plants[plant].update({r["name"]: _bracket_row(r) for r in map(json.loads, f)})
-            else:
-                plants[plant].update(json.load(f)["scenarios"])
+            plants[plant].update(json.load(f)["scenarios"])
     return plants
-
-
-def _bracket_row(r: dict) -> dict:
-    """A drake_constant.py row in the shape of a metrics file's scenario."""
-    m = {k: r[k] for k in ("hold_slip_mm", "hold_rotation_deg", "mean_force")}
-    return {"metrics": {"lugrip": m}, "pass": r["pass"],
-            "criteria": {k: {"pass": False} for k in r["failed"]}, "bracket": r["constant"]}
 
 
 def _fmt(x, spec: str) -> str:
@@ -63,21 +50,7 @@ def table(plants: dict[str, dict[str, dict]]) -> str:
             const = search.get("force")
             mean = m.get("mean_force")
             ratio = None if const is None or mean is None else mean / const
-            if s.get("bracket"):
-                const_txt = ", ".join(f"{c['force']:.3g} {'yes' if c['survives'] else 'no'}"
-                                      for c in s["bracket"])
-                # the smallest constant that holds lies in (largest failed, smallest held]
-                held = [c["force"] for c in s["bracket"] if c["survives"]]
-                failed_f = [c["force"] for c in s["bracket"] if not c["survives"]]
-                if mean is None:
-                    ratio_txt = "-"
-                elif not held:
-                    ratio_txt = f"< {mean / max(failed_f):.3f}"
-                elif not failed_f:
-                    ratio_txt = f"≥ {mean / min(held):.3f}"
-                else:
-                    ratio_txt = f"{mean / min(held):.3f} to {mean / max(failed_f):.3f}"
-            elif search and not search.get("found", True) and search.get("history"):
+            if search and not search.get("found", True) and search.get("history"):
                 top = max(f for f, _ in search["history"])  # even the gripper's f_max failed
                 const_txt = f"none ≤ {top:g}"
                 ratio_txt = "-" if mean is None else f"< {mean / top:.3f}"
