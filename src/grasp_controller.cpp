@@ -944,6 +944,17 @@ StaticLoadMap map_through(double f_n, double f_t, double tau, double pw, const C
   m.valid = true;
   return m;
 }
+
+// The forces [N] at which the load alone reaches S = s: its translation (|f_t| = s mu f_n) and
+// its torsion (|tau| = s tau_max(f_n)), each without the other.
+struct PureLoadForces {
+  double translation, torsion;
+};
+PureLoadForces pure_load_forces(const ContactModel& model, double ft, double tau, double s) noexcept {
+  const ContactParams& p = model.params();
+  return {ft / (p.mu * s),
+          std::pow(std::fabs(tau) / (p.mu * model.xi() * p.delta * s), 1.0 / (1.0 + p.gamma))};
+}
 }  // namespace
 
 StaticLoadMap StaticForceSolver::map(double f_t, double tau) noexcept {
@@ -952,11 +963,10 @@ StaticLoadMap StaticForceSolver::map(double f_t, double tau) noexcept {
   if (!(std::isfinite(ft) && std::isfinite(tau)) || (ft == 0.0 && tau == 0.0)) return m;
   const ContactParams& p = est_.model().params();
   const double pw = 1.0 + p.gamma;
-  // 1.25 (f_tr + f_rot) at S = 1 puts the load inside the diamond |f~_t| + |tau~| <= 0.8, so
+  // 1.25 (translation + torsion) at S = 1 puts the load inside the diamond |f~_t| + |tau~| <= 0.8, so
   // inside the (convex) LS, where |c~| is the one of every root at S <= 1
-  const double f_tr = ft / p.mu;
-  const double f_rot = std::pow(std::fabs(tau) / (p.mu * est_.model().xi() * p.delta), 1.0 / pw);
-  const double f0 = 1.25 * (f_tr + f_rot);
+  const PureLoadForces pure = pure_load_forces(est_.model(), ft, tau, 1.0);
+  const double f0 = 1.25 * (pure.translation + pure.torsion);
   CorOutput o;
   const double s0 = evaluate(f0, ft, tau, o);
   return std::isfinite(s0) && s0 > 0.0 ? map_through(f0, ft, tau, pw, o) : m;
@@ -1009,7 +1019,6 @@ StaticForceResult StaticForceSolver::solve(const StaticLoadMap& map, double f_t,
     r.converged = true;
     return r;
   }
-  const ContactParams& p = est_.model().params();
   // The map in closed form (the map's root), checked by one evaluation; a check that fails
   // (a zero threshold of the estimator crossed, a degenerate load) gives a new map from that
   // evaluation, twice at most, then the bracket below takes over from there.
@@ -1035,10 +1044,8 @@ StaticForceResult StaticForceSolver::solve(const StaticLoadMap& map, double f_t,
     m = map_through(f, ft, tau, m.pw, o);
   }
   if (!(start > 0.0)) {  // no map: the larger of the pure-translation and pure-torsion forces at s_ref
-    const double f_tr = ft / (p.mu * s_ref);
-    const double f_rot = std::pow(std::fabs(tau) / (p.mu * est_.model().xi() * p.delta * s_ref),
-                                  1.0 / (1.0 + p.gamma));
-    start = std::max(f_tr, f_rot);
+    const PureLoadForces pure = pure_load_forces(est_.model(), ft, tau, s_ref);
+    start = std::max(pure.translation, pure.torsion);
   }
   // Residual in logs: S_static decreases with f_n, roughly as a power law.
   const double log_ref = std::log(s_ref);
