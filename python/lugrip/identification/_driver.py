@@ -513,13 +513,18 @@ class _Joint:
     line: str
 
 
-def _maneuver_mse(problems, params: ContactParams) -> np.ndarray:
-    """Per maneuver of the problems: the mean squared omega_hat error of its scored samples."""
+def _maneuver_mse(problems, params: ContactParams) -> tuple[np.ndarray, float]:
+    """Per maneuver of the problems: the mean squared omega_hat error of its scored samples;
+    and the first problem's cost (eq. 32), from the same evaluation."""
     out = []
-    for prob in problems:
-        sse, cnt = prob.per_maneuver(prob.evaluate(params, False))
+    cost = math.nan
+    for k, prob in enumerate(problems):
+        ev = prob.evaluate(params, False)
+        if k == 0:
+            cost = float(ev["cost"])
+        sse, cnt = prob.per_maneuver(ev)
         out.append(np.where(cnt > 0, sse / np.maximum(cnt, 1), np.nan))
-    return np.concatenate(out)
+    return np.concatenate(out), cost
 
 
 def _stribeck_joint(train, val, p_hat, curve, free_t, bnds, method, max_iterations,
@@ -575,7 +580,7 @@ def _stribeck_joint(train, val, p_hat, curve, free_t, bnds, method, max_iteratio
     if math.isfinite(res.fun) and res.fun < cost(x0):
         p = gauss_newton(curve_at(q, res.x))
     problems = [train] + ([val] if val is not None else [])
-    before, after = _maneuver_mse(problems, p_hat), _maneuver_mse(problems, p)
+    (before, c_one), (after, c_joint) = _maneuver_mse(problems, p_hat), _maneuver_mse(problems, p)
     ok = (before > 0.0) & (after > 0.0)  # NaN (nothing scored) compares False
     d = np.log(before[ok] / after[ok])  # scale-free: a few fast maneuvers do not dominate
     t = (float(np.mean(d)) / (float(np.std(d, ddof=1)) / math.sqrt(d.size))
@@ -586,8 +591,6 @@ def _stribeck_joint(train, val, p_hat, curve, free_t, bnds, method, max_iteratio
         if math.isclose(getattr(p, n), bnds[n][0], rel_tol=1e-6)
         or math.isclose(getattr(p, n), bnds[n][1], rel_tol=1e-6)
     )
-    c_one = float(train.evaluate(p_hat, False)["cost"])
-    c_joint = float(train.evaluate(p, False)["cost"])
     elapsed = time.perf_counter() - t0
     line = (
         f"(d) Stribeck curve in the observer and eq. 32 refitted over {', '.join(free)} "
