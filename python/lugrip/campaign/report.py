@@ -76,13 +76,15 @@ def frontier_summary(rows: Sequence[dict], campaign: Campaign, summary: dict | N
     from .._controller import controller_settings
 
     f_max = float(campaign.base_scenario().controller.get("f_max", controller_settings()["f_max"]))
-    passing = sorted(float(v) for v, c in zip(fp, cr) if v is not None and (c is None or v <= c))
-    # Runs some constant under the crush force passes. A command that never exceeds a run's crush
-    # force grips it at most as hard as the constant at that force, so where holding grows with
-    # the grip no controller passes the other runs: their share bounds every controller's success
-    # from above (checked below: each controller's successes on those runs).
-    passable = {int(r["run"]) for r, v, c in zip(runs, fp, cr)
-                if v is not None and (c is None or v <= c)}
+    # Runs some constant under the crush force passes, with their smallest passing force. A
+    # command that never exceeds a run's crush force grips it at most as hard as the constant at
+    # that force, so where holding grows with the grip no controller passes the other runs: their
+    # share bounds every controller's success from above (checked below: each controller's
+    # successes on those runs).
+    held_by = {int(r["run"]): float(v) for r, v, c in zip(runs, fp, cr)
+               if v is not None and (c is None or v <= c)}
+    passing = sorted(held_by.values())
+    passable = set(held_by)
     out: dict[str, Any] = {
         "runs": n,
         "passable": len(passable),
