@@ -18,7 +18,7 @@ import pytest
 import yaml
 from lugrip import cli, static_grasp_force
 from lugrip.campaign import Campaign, CampaignError, load_campaign, run_one, wilson
-from lugrip.campaign.report import frontier_rate, frontier_summary
+from lugrip.campaign.report import belief_summary, frontier_rate, frontier_summary
 from lugrip.campaign.runner import _criteria, _simulate, constant_frontier, search_constant
 
 ROOT = Path(__file__).resolve().parents[2]
@@ -498,6 +498,50 @@ def test_frontier_report_and_replay_of_a_fragile_run(tmp_path, capsys):
     rep = json.loads((out / "replay_1.json").read_text())
     stored = {r["controller"]: r["success"] for r in rows if r["run"] == 1}
     assert {k: v["success"] for k, v in rep["controllers"].items()} == stored
+
+
+def test_rows_carry_the_friction_belief_told_and_learned():
+    """Plant: lugrip's patch plant (distributed contact, not the controller's model). One run
+    with mu believed 35 % too high (mismatch_mu +0.35): lugrip's row carries the belief as told
+    (exactly 1.35 times the drawn mu) and at the end; with the grip probe off (the default) the
+    belief never moves, with it on it can only fall (never above the told mu) and never below
+    half the told mu. The constant force's row has no belief to learn: the report leaves it out."""
+    d = _short(mass=0.1, mu=0.6, offset_x=0.0, mismatch_mu=0.35, push_count=1)
+    d["controllers"] = {"lugrip": {}, "constant_force": {"force": 1.0}}
+    rows = {r["controller"]: r for r in run_one(_campaign(d), 0)}
+    told = rows["lugrip"]["m_mu_belief_start"]
+    assert told == pytest.approx(1.35 * 0.6, rel=1e-12)
+    assert rows["lugrip"]["m_mu_belief_end"] == told
+    d["controllers"] = {"lugrip": {"controller": {"mu_probe": 0.08}}}
+    (row,) = run_one(_campaign(d), 0)
+    assert row["m_mu_belief_start"] == pytest.approx(told, rel=1e-12)
+    assert 0.5 * told <= row["m_mu_belief_end"] <= told
+    summary = belief_summary(list(rows.values()), ["lugrip", "constant_force"])
+    assert set(summary) == {"lugrip"}
+    assert summary["lugrip"]["told_over_true"][0] == pytest.approx(1.35)
+
+
+def test_belief_summary_on_hand_made_rows():
+    """Told / true and end / true per run, their median and 10-90 %, the runs whose belief
+    moved, and of the runs told at least 5 % wrong those that ended with at most half the
+    error: against a count by hand. Rows without belief columns (older results) give None."""
+    def row(c, mu, start, end):
+        return {"controller": c, "p_mu": mu, "m_mu_belief_start": start, "m_mu_belief_end": end}
+
+    rows = [row("lugrip", 0.5, 0.675, 0.675),   # told 1.35, not moved
+            row("lugrip", 0.5, 0.675, 0.55),    # 1.35 -> 1.10: error 0.35 -> 0.10, halved
+            row("lugrip", 0.8, 1.08, 0.96),     # 1.35 -> 1.20: 0.35 -> 0.20, not halved
+            row("lugrip", 1.0, 1.02, 0.90),     # told 2 % wrong: not counted; moved
+            row("paper", 0.5, 0.675, 0.675)]
+    s = belief_summary(rows, ["lugrip", "paper", "constant_force"])
+    lug = s["lugrip"]
+    assert lug["runs"] == 4 and lug["moved"] == 3 and lug["told_wrong"] == 3
+    assert lug["error_halved"] == 1
+    assert lug["told_over_true"][0] == pytest.approx(1.35)
+    assert lug["end_over_true"][0] == pytest.approx(np.median([1.35, 1.10, 1.20, 0.90]))
+    assert lug["end_over_true"][1] == pytest.approx(np.quantile([1.35, 1.10, 1.20, 0.90], 0.1))
+    assert s["paper"]["moved"] == 0 and s["paper"]["error_halved"] == 0
+    assert belief_summary([{"controller": "lugrip", "p_mu": 0.5}], ["lugrip"]) is None
 
 
 # --- MuJoCo ---------------------------------------------------------------------------------------

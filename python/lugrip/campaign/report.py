@@ -18,7 +18,8 @@ import numpy as np
 
 from .definition import PARAMETERS, Campaign
 
-__all__ = ["frontier_rate", "frontier_summary", "summarise", "wilson", "write_report"]
+__all__ = ["belief_summary", "frontier_rate", "frontier_summary", "summarise", "wilson",
+           "write_report"]
 
 
 def wilson(successes: int, n: int, z: float = 1.959964) -> tuple[float, float]:
@@ -296,9 +297,40 @@ def summarise(rows: Sequence[dict], campaign: Campaign, *, out_dir: str | Path |
         "criteria": campaign.criteria,
         "summary": summary,
         "paired_with_lugrip": paired,
+        "belief": belief_summary(rows, controllers),
         "failure_map": fmap,
         "worst_runs": worst_runs,
     }
+
+
+def belief_summary(rows: Sequence[dict], controllers: Sequence[str]) -> dict[str, Any] | None:
+    """The friction belief of the controllers that hold one (lugrip, paper) against each run's
+    true mu (the drawn ``p_mu``): told / true and at the end / true (median and 10-90 %), how
+    many runs moved the belief, and of the runs told at least 5 % wrong, how many ended with at
+    most half the error. None without drawn mu or belief columns (older results)."""
+    out: dict[str, Any] = {}
+    for c in controllers:
+        if c not in ("lugrip", "paper"):
+            continue
+        rr = [r for r in rows if r["controller"] == c and r.get("p_mu")
+              and r.get("m_mu_belief_start") is not None and r.get("m_mu_belief_end") is not None]
+        if not rr:
+            continue
+        told = np.array([r["m_mu_belief_start"] / r["p_mu"] for r in rr])
+        end = np.array([r["m_mu_belief_end"] / r["p_mu"] for r in rr])
+        wrong = np.abs(told - 1.0) >= 0.05
+        halved = wrong & (np.abs(end - 1.0) <= 0.5 * np.abs(told - 1.0))
+        out[c] = {
+            "runs": len(rr),
+            "told_over_true": [float(np.median(told)), float(np.quantile(told, 0.1)),
+                               float(np.quantile(told, 0.9))],
+            "end_over_true": [float(np.median(end)), float(np.quantile(end, 0.1)),
+                              float(np.quantile(end, 0.9))],
+            "moved": int(np.sum(end != told)),
+            "told_wrong": int(np.sum(wrong)),
+            "error_halved": int(np.sum(halved)),
+        }
+    return out or None
 
 
 def _fmt(v: Any, digits: int = 3) -> str:
@@ -477,6 +509,19 @@ def markdown(data: dict[str, Any], figure: str | None = None,
         for c, p in data["paired_with_lugrip"].items():
             lines.append(f"| {c} | {p['runs']} | {p['lugrip_holds_other_fails']} | "
                          f"{p['other_holds_lugrip_fails']} |")
+    if data.get("belief"):
+        lines += ["", "## Friction belief", "",
+                  "The controller's mu over each run's true mu: as told (the campaign's mismatch) "
+                  "and at the end of the run (what it learned); median [10 %, 90 %].", "",
+                  "| controller | runs | told / true | at the end / true | runs it moved | "
+                  "told >= 5 % wrong | of those, error at least halved |",
+                  "|---|---:|---|---|---:|---:|---:|"]
+        for c, b in data["belief"].items():
+            t, e = b["told_over_true"], b["end_over_true"]
+            lines.append(
+                f"| {c} | {b['runs']} | {t[0]:.3f} [{t[1]:.3f}, {t[2]:.3f}] | "
+                f"{e[0]:.3f} [{e[1]:.3f}, {e[2]:.3f}] | {b['moved']} | {b['told_wrong']} | "
+                f"{b['error_halved']} |")
     lines += ["", "## Failure map", ""]
     if figure:
         lines += [f"![failure map]({figure})", ""]

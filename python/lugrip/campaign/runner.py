@@ -53,6 +53,8 @@ METRICS = (
     "command_in_limits",
     "scene_status",
     "peak_command",
+    "mu_belief_start",
+    "mu_belief_end",
 )
 
 

@@ -136,6 +136,10 @@ def compute_metrics(
             and np.all(cmd <= f_max + 1e-12)
         ),
     )
+    if "mu_belief" in run:  # the controller's friction belief, as told and at the end
+        belief = np.asarray(run["mu_belief"], dtype=float)
+        if belief.size and np.all(np.isfinite(belief)):
+            m.update(mu_belief_start=float(belief[0]), mu_belief_end=float(belief[-1]))
     if scenario.steady_window is not None:
         sw = run.window(*scenario.steady_window)
         ft = float(np.mean(0.5 * (run["f_t_true_0"][sw] + run["f_t_true_1"][sw])))
