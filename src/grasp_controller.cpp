@@ -917,8 +917,9 @@ StaticForceSolver::StaticForceSolver(const ContactParams& params) : est_(params,
 double StaticForceSolver::evaluate(double f_n, double f_t, double tau, CorOutput& o) noexcept {
   constexpr double nan = std::numeric_limits<double>::quiet_NaN();
   if (!(std::isfinite(f_n) && f_n > 0.0 && std::isfinite(f_t) && std::isfinite(tau))) return nan;
-  est_.reset();  // no history: tau below the zero threshold takes the default side
-  est_.step(CorInput{f_n, std::fabs(f_t), tau}, o);
+  // No history: the estimator is never committed to (its held estimate stays the reset one), so
+  // a tau below the zero threshold takes the default side.
+  est_.evaluate(CorInput{f_n, std::fabs(f_t), tau}, o);
   if (!is_valid(o.status) || !(o.g > 0.0)) return nan;
   // |tau - c f_t| = |tau| + |c| f_t (tau and c have opposite signs, docs/model.md 6). Equal to |y| of
   // the estimator except for a torque below its zero threshold, whose sign it holds from history.

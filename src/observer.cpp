@@ -267,9 +267,9 @@ Status Observer::step(const ObserverInput& in, ObserverOutput& out) noexcept {
   invalid_run_ = 0;
   need_init_ = false;
   kinetic_ = kinetic && status != Status::Reinitialized;
-  // Written field by field to last_ and out (no zero-initialised temporary, no struct copy
-  // through the stack).
-  auto fill = [&](ObserverOutput& r) {
+  // Written field by field to out (no zero-initialised temporary), then copied whole to last_.
+  {
+    ObserverOutput& r = out;
     r.omega_hat = report ? omega_ : 0.0;
     r.omega_state = omega_;
     r.kinetic = kinetic_;
@@ -297,9 +297,8 @@ Status Observer::step(const ObserverInput& in, ObserverOutput& out) noexcept {
     r.c_tilde_unclipped = co.c_tilde_unclipped;
     r.omega_object = report ? omega_object : 0.0;
     r.v_slip = report ? v_slip : 0.0;
-  };
-  fill(last_);
-  fill(out);
+  }
+  last_ = out;
   return status;
 }
 
