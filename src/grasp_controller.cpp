@@ -968,7 +968,7 @@ StaticLoadMap StaticForceSolver::map(double f_t, double tau) noexcept {
   // inside the (convex) LS, where |c~| is the one of every root at S <= 1
   const PureLoadForces pure = pure_load_forces(est_.model(), ft, tau, 1.0);
   const double f0 = 1.25 * (pure.translation + pure.torsion);
-  CorOutput o;
+  CorOutput& o = scratch_;
   const double s0 = evaluate(f0, ft, tau, o);
   return std::isfinite(s0) && s0 > 0.0 ? map_through(f0, ft, tau, pw, o) : m;
 }
@@ -1029,7 +1029,7 @@ StaticForceResult StaticForceSolver::solve(const StaticLoadMap& map, double f_t,
     const double f = m.root(s_ref);
     if (!(std::isfinite(f) && f > 0.0)) break;
     ++r.iterations;
-    CorOutput o;
+    CorOutput& o = scratch_;
     const double s = evaluate(f, ft, tau, o);
     if (!(std::isfinite(s) && s > 0.0)) break;
     start = f;

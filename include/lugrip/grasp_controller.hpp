@@ -297,6 +297,7 @@ class StaticForceSolver {
   // S_static at f_n (NaN where invalid) with the estimate it came from in o
   double evaluate(double f_n, double f_t, double tau, CorOutput& o) noexcept;
   CorEstimator est_;
+  CorOutput scratch_;  // the estimate of map() and solve() (every field written: no per-call zeroing)
 };
 
 //! Two-mode grasp-force controller f_n = f_ns + f_nd (eq. 34, docs/model.md 9).
