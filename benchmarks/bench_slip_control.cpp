@@ -10,7 +10,8 @@
 // outputs bit for bit (the command, the controller's forces, every finger's estimate), so that
 // two builds can be shown to compute the same numbers. The same source builds against any lugrip
 // version with this API, so a baseline can be built from another checkout and run beside it:
-//   bench_slip_control [--quick]
+//   bench_slip_control [--quick] [--observe]
+// --observe times SlipControl::observe() instead (the two observers without the controller).
 #include <cmath>
 #include <cstdint>
 #include <cstdio>
@@ -65,7 +66,11 @@ struct BitHash {
 }  // namespace
 
 int main(int argc, char** argv) {
-  const bool quick = argc > 1 && std::strcmp(argv[1], "--quick") == 0;
+  bool quick = false, observe_only = false;
+  for (int i = 1; i < argc; ++i) {
+    quick = quick || std::strcmp(argv[i], "--quick") == 0;
+    observe_only = observe_only || std::strcmp(argv[i], "--observe") == 0;
+  }
   const int n = quick ? 20000 : 100000;
   const int reps = quick ? 5 : 15;
   std::mt19937 rng(7);
@@ -93,7 +98,10 @@ int main(int argc, char** argv) {
     const long before = lugrip_support::g_allocations.load();
     const auto t0 = lugrip_bench::Clock::now();
     for (int k = 0; k < n; ++k) {
-      sc.step(stream[static_cast<size_t>(k)], out);
+      if (observe_only)
+        sc.observe(stream[static_cast<size_t>(k)], out);
+      else
+        sc.step(stream[static_cast<size_t>(k)], out);
       sink += out.force;
     }
     const auto t1 = lugrip_bench::Clock::now();
@@ -107,10 +115,10 @@ int main(int argc, char** argv) {
     sc.step(stream[static_cast<size_t>(k)], out);
     hash.add_all(out);
   }
-  std::printf("SlipControl::step, two fingers: median %.1f ns per step, best %.1f ns, worst %.1f ns "
+  std::printf("SlipControl::%s, two fingers: median %.1f ns per step, best %.1f ns, worst %.1f ns "
               "(%d repetitions of %d steps); allocations in the timed loops: %ld; build %s (%s); "
               "outputs' bit hash %016llx%s\n",
-              per_step[per_step.size() / 2], per_step.front(), per_step.back(), reps, n, allocs,
+              observe_only ? "observe" : "step", per_step[per_step.size() / 2], per_step.front(), per_step.back(), reps, n, allocs,
               LUGRIP_BENCH_BUILD_TYPE, LUGRIP_BENCH_CXX_FLAGS, static_cast<unsigned long long>(hash.h),
               sink > 0 ? "" : " ");
   return 0;
