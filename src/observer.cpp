@@ -310,3 +310,5 @@ Status Observer::step(const ObserverInput& in, ObserverOutput& out) noexcept {
 }
 
 }  // namespace lugrip
+
+#undef LUGRIP_OBSERVER_INLINE
