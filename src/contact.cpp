@@ -47,6 +47,12 @@ const ContactParams& checked(const ContactParams& p) {
   validate_or_throw(p);
   return p;
 }
+
+// delta f_n^gamma, written out where the CoR estimate needs it (the compiler keeps the member
+// function an out-of-line call there)
+inline double contact_radius(const ContactParams& p, double f_n) noexcept {
+  return p.delta * detail::fast_pow_pos(f_n, p.gamma);
+}
 }  // namespace
 
 ContactModel::ContactModel(const ContactParams& params) : p_(checked(params)), ls_(params.k) {
@@ -93,7 +99,7 @@ bool ContactModel::set_mu(double mu) noexcept {
   return true;
 }
 
-double ContactModel::rho(double f_n) const noexcept { return p_.delta * detail::fast_pow_pos(f_n, p_.gamma); }
+double ContactModel::rho(double f_n) const noexcept { return contact_radius(p_, f_n); }
 double ContactModel::ft_max(double f_n) const noexcept { return p_.mu * f_n; }
 double ContactModel::tau_max(double f_n) const noexcept {
   return p_.mu * ls_.xi() * p_.delta * std::pow(f_n, p_.gamma + 1.0);
@@ -281,7 +287,7 @@ Status CorEstimator::evaluate(const CorInput& in, CorOutput& out) const noexcept
   const ContactParams& p = model_.params();
   const LimitSurface& ls = model_.limit_surface();
   const double f_n = in.f_n;
-  const double rho = model_.rho(f_n);
+  const double rho = contact_radius(p, f_n);
   const double ft_t = in.f_t / (p.mu * f_n);
   const double tau_t = in.tau / (p.mu * ls.xi() * rho * f_n);
   // A normal force so small (f_n_min set near 0) that f_t,max or tau_max underflows cannot be
@@ -299,7 +305,11 @@ Status CorEstimator::evaluate(const CorInput& in, CorOutput& out) const noexcept
   // zero-initialised temporary, no struct copy through the stack).
   const double f_pow = f * detail::fast_pow_pos(f, p.gamma);  // |f~_t|^(gamma+1)
   // |sigma| overflows for a denormal torque: report it as the largest finite value, like t = 0.
-  const double sigma = t > 0.0 ? std::copysign(std::fmin(f_pow / t, std::numeric_limits<double>::max()), in.tau)
+  // (f_pow / t is >= 0, never NaN: the comparison is std::fmin without its library call)
+  const double ratio = t > 0.0 ? f_pow / t : 0.0;
+  const double sigma = t > 0.0 ? std::copysign(ratio < std::numeric_limits<double>::max() ? ratio
+                                                                                           : std::numeric_limits<double>::max(),
+                                               in.tau)
                                : (f > 0.0 ? std::numeric_limits<double>::max() : 0.0);
   double a = 0.0, sign = 1.0;
   double a_free = 0.0;        // |c~| before the clip
@@ -319,7 +329,7 @@ Status CorEstimator::evaluate(const CorInput& in, CorOutput& out) const noexcept
     inside = t < 1.0;
   } else {
     const bool no_torque = t < s_.zero_torque;
-    const double a_sigma = t > 0.0 ? model_.invert_sigma(f_pow / t, &iters)
+    const double a_sigma = t > 0.0 ? model_.invert_sigma(ratio, &iters)
                                    : std::numeric_limits<double>::infinity();
     const LsPoint q = ls.eval(a_sigma);
     inside = f * f + t * t < q.F * q.F + q.T * q.T;

@@ -816,7 +816,7 @@ double GraspController::static_floor(double& slope_exponent) noexcept {
     const double ft = sum_f_t_[i] / n_load_[i], tau = sum_tau_[i] / n_load_[i];
     if (s_.load_floors || s_.ceiling_factor > 0.0 || s_.gain_force > 0.0) maps[i] = solver_.map(ft, tau);
     if (!s_.load_floors) continue;
-    f_mean[i] = solver_.solve(maps[i], ft, tau, kFeedforwardSlippage).force;
+    f_mean[i] = solver_.force(maps[i], ft, tau, kFeedforwardSlippage);
     if (std::isfinite(f_mean[i])) f_grasp = std::max(f_grasp, f_mean[i]);
   }
   floor_measured_ = f_grasp;
@@ -841,7 +841,7 @@ double GraspController::static_floor(double& slope_exponent) noexcept {
         const double slope_t = (n * sum_kt_[i] - sum_k_[i] * sum_tau_[i]) / den;
         const double x_ft = std::max(0.0, ft + slope_f * ahead), x_tau = tau + slope_t * ahead;
         const StaticLoadMap x_map = solver_.map(x_ft, x_tau);
-        const double fx = solver_.solve(x_map, x_ft, x_tau, kFeedforwardSlippage).force;
+        const double fx = solver_.force(x_map, x_ft, x_tau, kFeedforwardSlippage);
         if (std::isfinite(fx) && fx > (1.0 + kFeedforwardTrend) * f_ref) {
           f = fx;
           load_ft = x_ft;
@@ -852,7 +852,7 @@ double GraspController::static_floor(double& slope_exponent) noexcept {
       if (std::isfinite(f)) force = std::max(force, f);
     }
     if (s_.ceiling_factor > 0.0) {  // the grip this load needs at S = 1
-      const double f = solver_.solve(load_map, load_ft, load_tau, 1.0).force;
+      const double f = solver_.force(load_map, load_ft, load_tau, 1.0);
       if (std::isfinite(f)) ceiling_load_ = std::max(ceiling_load_, f);
     }
     if (s_.load_floors) {  // the pushes seen: the part of the load that came and went
@@ -879,7 +879,7 @@ double GraspController::static_floor(double& slope_exponent) noexcept {
     reserve_force_ = std::max(reserve_force_, r_f);
     reserve_torque_ = std::max(reserve_torque_, r_t);
     if (r_f > 0.0 || r_t > 0.0) {
-      const double f = solver_.solve(std::fabs(ft) + r_f, std::fabs(tau) + r_t, 1.0).force;
+      const double f = solver_.force(std::fabs(ft) + r_f, std::fabs(tau) + r_t, 1.0);
       if (std::isfinite(f)) force = std::max(force, f);
       if (std::isfinite(f)) ceiling_load_ = std::max(ceiling_load_, f);
     }
@@ -917,8 +917,9 @@ StaticForceSolver::StaticForceSolver(const ContactParams& params) : est_(params,
 double StaticForceSolver::evaluate(double f_n, double f_t, double tau, CorOutput& o) noexcept {
   constexpr double nan = std::numeric_limits<double>::quiet_NaN();
   if (!(std::isfinite(f_n) && f_n > 0.0 && std::isfinite(f_t) && std::isfinite(tau))) return nan;
-  est_.reset();  // no history: tau below the zero threshold takes the default side
-  est_.step(CorInput{f_n, std::fabs(f_t), tau}, o);
+  // No history: the estimator is never committed to (its held estimate stays the reset one), so
+  // a tau below the zero threshold takes the default side.
+  est_.evaluate(CorInput{f_n, std::fabs(f_t), tau}, o);
   if (!is_valid(o.status) || !(o.g > 0.0)) return nan;
   // |tau - c f_t| = |tau| + |c| f_t (tau and c have opposite signs, docs/model.md 6). Equal to |y| of
   // the estimator except for a torque below its zero threshold, whose sign it holds from history.
@@ -967,9 +968,43 @@ StaticLoadMap StaticForceSolver::map(double f_t, double tau) noexcept {
   // inside the (convex) LS, where |c~| is the one of every root at S <= 1
   const PureLoadForces pure = pure_load_forces(est_.model(), ft, tau, 1.0);
   const double f0 = 1.25 * (pure.translation + pure.torsion);
-  CorOutput o;
+  CorOutput& o = scratch_;
   const double s0 = evaluate(f0, ft, tau, o);
-  return std::isfinite(s0) && s0 > 0.0 ? map_through(f0, ft, tau, pw, o) : m;
+  if (!(std::isfinite(s0) && s0 > 0.0)) return m;
+  m = map_through(f0, ft, tau, pw, o);
+  m.inside = true;
+  return m;
+}
+
+bool StaticForceSolver::general_branch(double f_n, double ft, double tau) const noexcept {
+  // Conservative ranges (a false answer only costs the checking evaluation): with f_n in
+  // [1e-6, 1e9] N, |tau| >= 1e-200 N m, mu xi delta >= 1e-100 and beta_A <= 1e250 the
+  // estimator's normalised load, sigma, g, c, sigma_1 and y are finite and nonzero (rho =
+  // delta f_n^gamma < 1e3 m), and its input limits (1e12) hold; then the branch: |f~_t| computed
+  // as the estimator computes it, at or above its zero threshold (below: a pure torsion, |c~| =
+  // 0, whatever the map says).
+  const CorSettings& cs = est_.settings();
+  const ContactParams& p = est_.model().params();
+  const double at = std::fabs(tau);
+  return f_n >= 1.0e-6 && f_n <= 1.0e9 && at >= 1.0e-200 && at <= cs.torque_limit && ft <= cs.force_limit &&
+         p.mu * est_.model().xi() * p.delta >= 1.0e-100 && p.beta_a <= 1.0e250 &&
+         std::fabs(ft / (p.mu * f_n)) >= cs.zero_force;
+}
+
+double StaticForceSolver::force(const StaticLoadMap& map, double f_t, double tau, double s_ref) noexcept {
+  if (map.valid && map.inside && s_ref > 0.0 && s_ref <= 1.0 && std::isfinite(f_t) && std::isfinite(tau)) {
+    const double ft = std::fabs(f_t);
+    // solve()'s first root, the one its check would accept
+    const double f = map.root(s_ref);
+    if (std::isfinite(f) && general_branch(f, ft, tau) && general_branch(map.f0, ft, tau)) return f;
+  }
+  return solve(map, f_t, tau, s_ref).force;
+}
+
+double StaticForceSolver::force(double f_t, double tau, double s_ref) noexcept {
+  if (std::isfinite(f_t) && std::isfinite(tau) && s_ref > 0.0 && s_ref <= 1.0 && (f_t != 0.0 || tau != 0.0))
+    return force(map(f_t, tau), f_t, tau, s_ref);
+  return solve(f_t, tau, s_ref).force;
 }
 
 double StaticLoadMap::slippage(double f_n) const noexcept {
@@ -1028,7 +1063,7 @@ StaticForceResult StaticForceSolver::solve(const StaticLoadMap& map, double f_t,
     const double f = m.root(s_ref);
     if (!(std::isfinite(f) && f > 0.0)) break;
     ++r.iterations;
-    CorOutput o;
+    CorOutput& o = scratch_;
     const double s = evaluate(f, ft, tau, o);
     if (!(std::isfinite(s) && s > 0.0)) break;
     start = f;

@@ -10,6 +10,12 @@
 #include "field_checks.hpp"
 #include "format.hpp"
 
+#if defined(__GNUC__)
+#define LUGRIP_OBSERVER_INLINE __attribute__((always_inline))
+#else
+#define LUGRIP_OBSERVER_INLINE
+#endif
+
 namespace lugrip {
 
 namespace {
@@ -170,7 +176,7 @@ Status Observer::step(const ObserverInput& in, ObserverOutput& out) noexcept {
     }
   }
   const double tau_cor = std::copysign(std::fabs(tau_f), side);
-  CorOutput co;
+  CorOutput& co = co_;  // every field is written by evaluate()
   const double ft_cor = s_.filter_force ? ft_f : in.f_t;
   if (init) cor_.reset();  // a twin that never saw a rejected sample re-initialises here too
   const Status cor_status = cor_.evaluate(CorInput{in.f_n, ft_cor, tau_cor}, co);
@@ -267,9 +273,9 @@ Status Observer::step(const ObserverInput& in, ObserverOutput& out) noexcept {
   invalid_run_ = 0;
   need_init_ = false;
   kinetic_ = kinetic && status != Status::Reinitialized;
-  // Written field by field to last_ and out (no zero-initialised temporary, no struct copy
-  // through the stack).
-  auto fill = [&](ObserverOutput& r) {
+  // Written field by field to last_ and out, inline (no zero-initialised temporary, no struct
+  // copy: the compiler makes that a byte-wise string move).
+  auto fill = [&](ObserverOutput& r) LUGRIP_OBSERVER_INLINE {
     r.omega_hat = report ? omega_ : 0.0;
     r.omega_state = omega_;
     r.kinetic = kinetic_;
@@ -304,3 +310,5 @@ Status Observer::step(const ObserverInput& in, ObserverOutput& out) noexcept {
 }
 
 }  // namespace lugrip
+
+#undef LUGRIP_OBSERVER_INLINE

@@ -35,7 +35,9 @@ double rotor_stiffness(double omega, const RotorCoefficients& c) noexcept {
   return std::max(c.gain * (c.sigma_z + c.sigma_1), c.sigma0 * std::fabs(omega) / c.g);
 }
 
-double rosenbrock_rate(double z, double omega, double h, const RotorCoefficients& c) noexcept {
+namespace {
+// rosenbrock_rate(), inline in rotor_advance's adaptive rule (two calls per sample)
+inline double rosenbrock_rate_inline(double z, double omega, double h, const RotorCoefficients& c) noexcept {
   const double a = c.sigma0 * std::fabs(omega) / c.g;  // bristle rate -d zdot / dz
   // The omega mode: decoupled at the rate gain sigma_1 once z saturates, weighted by the share
   // min(1, h a) of the step in that regime; scaled so that h_sub gain sigma_1 <= kRosenbrockOmegaStep.
@@ -46,6 +48,11 @@ double rosenbrock_rate(double z, double omega, double h, const RotorCoefficients
   // Distance of z from its sliding steady state sgn g / sigma0, in units of g / sigma0 (0..2).
   const double b = std::min(2.0, std::max(0.0, 1.0 - c.sigma0 * z * sgn / c.g));
   return std::max(a * b, r_omega);
+}
+}  // namespace
+
+double rosenbrock_rate(double z, double omega, double h, const RotorCoefficients& c) noexcept {
+  return rosenbrock_rate_inline(z, omega, h, c);
 }
 
 namespace {
@@ -110,12 +117,12 @@ bool rotor_advance(double& z, double& omega, double h, const RotorCoefficients& 
       const double s0 = sign(probe.w_start);
       if (sign(probe.w_stage) != s0 || sign(w) != s0) {
         const double wm = std::max(std::fabs(probe.w_start), std::max(std::fabs(probe.w_stage), std::fabs(w)));
-        return std::max(2.0 * c.sigma0 * wm / c.g, rosenbrock_rate(zz, w, hs_now, c));
+        return std::max(2.0 * c.sigma0 * wm / c.g, rosenbrock_rate_inline(zz, w, hs_now, c));
       }
-      return rosenbrock_rate(zz, w, hs_now, c);
+      return rosenbrock_rate_inline(zz, w, hs_now, c);
     };
     n = adaptive(z, omega, h, c, n_min, max_substeps, kRosenbrockRate, 2.0 * kRosenbrockRate, step, rate,
-                 [&](double zz, double w) { return rosenbrock_rate(zz, w, h, c); },
+                 [&](double zz, double w) { return rosenbrock_rate_inline(zz, w, h, c); },
                  [&](int m) { hs_now = h / m; }, projected, cap_hit);
   } else {
     detail::rotor_fixed_pass(z, omega, h, n, c, scheme, projected);

@@ -267,6 +267,9 @@ struct StaticLoadMap {
   double b = 0.0;   //!< translational term at f0, |c| |f_t| / g [-]
   double pw = 1.0;  //!< 1 + gamma
   bool valid = false;
+  //! built by StaticForceSolver::map(): its evaluation lay inside the LS (the load at 80 % of the
+  //! diamond |f~_t| + |tau~| <= 1), where |c~| is the load's own
+  bool inside = false;
   double slippage(double f_n) const noexcept;  //!< S_static at f_n (NaN unless valid, f_n > 0)
   double root(double s_ref) const noexcept;    //!< f_n [N] with slippage(f_n) = s_ref (Newton)
 };
@@ -288,6 +291,15 @@ class StaticForceSolver {
   //! solve() from that load's map (one evaluation checks the map's root): several references
   //! of one load cost one evaluation each.
   StaticForceResult solve(const StaticLoadMap& map, double f_t, double tau, double s_ref) noexcept;
+  //! solve(map, f_t, tau, s_ref).force, the same value, without the checking evaluation where
+  //! the check cannot fail: a map from map() whose root and evaluation both lie in the
+  //! estimator's general branch (a torque, |f~_t| at or above its zero threshold, forces and
+  //! parameters in the ranges where every estimate is finite). There |c~| at the root is the
+  //! map's (sigma does not depend on f_n), so the estimator's S there differs from s_ref by its
+  //! inversion accuracy (1e-12), far inside the check's 1e-10. Otherwise solve().
+  double force(const StaticLoadMap& map, double f_t, double tau, double s_ref) noexcept;
+  //! solve(f_t, tau, s_ref).force through map() and force() (the same value).
+  double force(double f_t, double tau, double s_ref) noexcept;
 
   const ContactModel& model() const noexcept { return est_.model(); }
   //! ContactModel::set_mu on the solver's model (no allocation); false: mu out of range.
@@ -296,7 +308,11 @@ class StaticForceSolver {
  private:
   // S_static at f_n (NaN where invalid) with the estimate it came from in o
   double evaluate(double f_n, double f_t, double tau, CorOutput& o) noexcept;
+  // The estimator at f_n for the load (|f_t| = ft, tau) takes its general branch with finite
+  // outputs (force()'s condition, checked at the map's force and at its root).
+  bool general_branch(double f_n, double ft, double tau) const noexcept;
   CorEstimator est_;
+  CorOutput scratch_;  // the estimate of map() and solve() (every field written: no per-call zeroing)
 };
 
 //! Two-mode grasp-force controller f_n = f_ns + f_nd (eq. 34, docs/model.md 9).

@@ -240,6 +240,9 @@ class Observer {
   bool need_init_ = true;
   bool kinetic_ = false;  // Stribeck term: the capacity is the kinetic one (sliding has started)
   ObserverOutput last_;
+  // The CoR estimate of the sample being processed: a member, so that step() does not
+  // zero-initialise a temporary each call (evaluate() writes every field).
+  CorOutput co_;
 };
 
 }  // namespace lugrip
