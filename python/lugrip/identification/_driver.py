@@ -705,6 +705,10 @@ def _joint_stderr(train, p, free, bnds, at_bound, *, loss, uncertainty, n_bootst
     cov, flat, n_ev = finite_difference_covariance(train, at, steps, loss=loss,
                                                    uncertainty=uncertainty, samples=samples,
                                                    known=known)
+    if samples:
+        for j in np.flatnonzero(np.ptp(np.asarray(samples), axis=0) == 0.0):
+            why.setdefault(names[j], "the bootstrap's joint fits all returned it unchanged: "
+                                     "no spread measured")
     for j in flat:
         why[names[j]] = "the cost is flat along it (not determined by these data)"
     se_log = np.sqrt(np.abs(np.diag(cov)))
