@@ -613,6 +613,7 @@ def _stribeck_joint(train, val, p_hat, curve, free_t, bnds, method, max_iteratio
     if not free:
         return _Joint(p_hat, False, (), (), 0.0,
                       "(d) Stribeck curve: no free parameter to refit with it")
+    p_start = p
     p = _joint_fit(train, p, free, bnds, method, max_iterations, tolerance)
     problems = [train] + ([val] if val is not None else [])
     (before, c_one), (after, c_joint) = _maneuver_mse(problems, p_hat), _maneuver_mse(problems, p)
@@ -642,7 +643,8 @@ def _stribeck_joint(train, val, p_hat, curve, free_t, bnds, method, max_iteratio
     stderr, why, unc_line = _joint_stderr(
         train, p, free, bnds, at_bound, loss=loss, uncertainty=uncertainty,
         n_bootstrap=n_bootstrap, seed=seed, problem_of=problem_of,
-        refit=lambda prob: _joint_fit(prob, p, free, bnds, method, max_iterations, tolerance))
+        refit=lambda prob: _joint_fit(prob, p_start, free, bnds, method, max_iterations,
+                                      tolerance))
     return _Joint(p, True, free, at_bound, elapsed, line, stderr, why, unc_line)
 
 
@@ -652,7 +654,7 @@ def _joint_stderr(train, p, free, bnds, at_bound, *, loss, uncertainty, n_bootst
     coordinates) and the curve (Nelder-Mead coordinates ln(static_ratio - 1), ln
     stribeck_speed), together, from :func:`finite_difference_covariance` of eq. 32 at p
     (sandwich or Gauss-Newton formula), or from ``n_bootstrap`` joint fits on resampled
-    training maneuvers. NaN, with the reason, for a parameter at a bound, along a flat
+    training maneuvers (``refit(problem)``: the whole joint fit from its start). NaN, with the reason, for a parameter at a bound, along a flat
     direction of the cost, or a curve coordinate whose standard error exceeds
     ``STRIBECK_UNDETERMINED`` (the data do not fix it within a factor e). Returns
     ({name: standard error}, {name: why NaN}, the report line)."""
@@ -702,7 +704,7 @@ def _joint_stderr(train, p, free, bnds, at_bound, *, loss, uncertainty, n_bootst
                 * w_sum, train.maneuver_gradients(e)[:, idx] * s,
                 np.asarray(e["gradient"])[idx] * s * w_sum)
 
-    cov, flat, n_ev = finite_difference_covariance(train, at, steps, loss=loss,
+    cov, flat, n_ev, step = finite_difference_covariance(train, at, steps, loss=loss,
                                                    uncertainty=uncertainty, samples=samples,
                                                    known=known)
     if samples:
@@ -735,6 +737,11 @@ def _joint_stderr(train, p, free, bnds, at_bound, *, loss, uncertainty, n_bootst
              else f"{n} {getattr(p, n):.4g} (no standard error: {why[n]})" for n in names]
     line = (f"(d) standard errors of the joint fit ({how}, {time.perf_counter() - t0:.1f} s): "
             + ", ".join(parts))
+    newton = step[len(free):]
+    if np.all(np.isfinite(newton)):
+        line += (f"; the Nelder-Mead result lies {newton[0]:+.2g} in ln({_CURVE_COORD[0]}) and "
+                 f"{newton[1]:+.2g} in ln stribeck_speed from the minimum of the cost's quadratic "
+                 "model (the search's stopping error, not in the standard errors)")
     return stderr, why, line
 
 

@@ -162,10 +162,11 @@ def finite_difference_covariance(problem, at, steps, *, loss: str, uncertainty: 
     * "bootstrap": the covariance of ``samples`` (coordinates of refits on resampled
       maneuvers), nothing evaluated.
 
-    Returns (cov, flat, evaluations): cov over all coordinates (NaN rows/columns for the
+    Returns (cov, flat, evaluations, step): cov over all coordinates (NaN rows/columns for the
     coordinates not used and those along which H is not positive definite, the others
-    conditional on those held), ``flat`` the indices found flat, and the number of cost
-    evaluations spent."""
+    conditional on those held), ``flat`` the indices found flat, the number of cost
+    evaluations spent, and the Newton step -H^-1 grad L from the point to the minimum of the
+    cost's quadratic model (NaN where not available: how far the fit stopped from it)."""
     steps = np.asarray(steps, dtype=float)
     n = steps.size
     cov = np.full((n, n), np.nan)
@@ -174,7 +175,7 @@ def finite_difference_covariance(problem, at, steps, *, loss: str, uncertainty: 
             s = np.asarray(samples, dtype=float)
             ok = np.all(np.isfinite(s), axis=0)
             cov[np.ix_(ok, ok)] = np.atleast_2d(np.cov(s[:, ok].T, ddof=1))
-        return cov, (), 0
+        return cov, (), 0, np.full(n, np.nan)
     owner = problem.segment_owner
     M = len(problem.maneuvers)
     count = [0]
@@ -191,7 +192,7 @@ def finite_difference_covariance(problem, at, steps, *, loss: str, uncertainty: 
                 int(e["scored"]), known(e, q))
 
     base = ev(np.zeros(n))
-    L0, _, sse0, scored, (Hk, Gk, _) = base
+    L0, _, sse0, scored, (Hk, Gk, g0) = base
     k = Hk.shape[0]
     H = np.zeros((n, n))
     G = np.zeros((M, n))
@@ -233,10 +234,13 @@ def finite_difference_covariance(problem, at, steps, *, loss: str, uncertainty: 
         worst = keep[int(np.argmax(np.abs(vec[:, int(np.argmin(lam))])))]
         keep.remove(worst)
         flat.append(worst)
+    step = np.full(n, np.nan)
     if not keep:
-        return cov, tuple(flat), count[0]
+        return cov, tuple(flat), count[0], step
     kk = np.ix_(keep, keep)
     Hi = np.linalg.inv(H[kk])
+    grad = np.concatenate([g0, G[:, k:].sum(axis=0)])  # of L: C++ for the first k, differences
+    step[keep] = -Hi @ grad[keep]
     if uncertainty == "gauss-newton":
         dof = max(scored - len(keep), 1)
         sigma2 = L0 / dof if loss == "squared" else sse0 / dof
@@ -244,4 +248,4 @@ def finite_difference_covariance(problem, at, steps, *, loss: str, uncertainty: 
     else:
         Gs = G[:, keep]
         cov[kk] = Hi @ (Gs.T @ Gs) @ Hi * (M / max(M - 1, 1))
-    return cov, tuple(flat), count[0]
+    return cov, tuple(flat), count[0], step
