@@ -132,6 +132,8 @@ def test_stribeck_stderr_against_the_spread_over_seeds():
             warnings.simplefilter("ignore")
             r = lugrip.identify(data.log)
         assert r.friction_estimates, seed  # the joint fit was kept
+        entry = r.to_dict()["contact"]["stribeck_speed"]  # the params file's entry carries it
+        assert entry["stderr"] == r["stribeck_speed"].stderr and "Stribeck" in entry["note"]
         logs.append([math.log(r[n].value) for n in ("mu", "delta", "beta_a")]
                     + [math.log(r["static_ratio"].value - 1.0),
                        math.log(r["stribeck_speed"].value)])

@@ -151,12 +151,14 @@ class IdentificationResult:
 
     def table(self) -> str:
         """Plain-text parameter table: value, unit, bounds, standard error, start."""
+        rows = self.estimates + self.friction_estimates
+        w = max([10] + [len(e.name) for e in rows])
         head = (
-            f"{'parameter':10s} {'value':>12s} {'std.err':>10s} {'rel':>7s}  "
+            f"{'parameter':{w}s} {'value':>12s} {'std.err':>10s} {'rel':>7s}  "
             f"{'bounds':>23s} {'start':>12s}  unit"
         )
         lines = [head, "-" * len(head)]
-        for e in self.estimates + self.friction_estimates:
+        for e in rows:
             if e.free:
                 se = f"{e.stderr:10.3g}" if math.isfinite(e.stderr) else f"{'n/a':>10s}"
                 rel = f"{100 * e.relative_stderr:6.2f}%" if math.isfinite(e.stderr) else f"{'':>7s}"
@@ -166,7 +168,7 @@ class IdentificationResult:
             else:
                 se, rel, bnd = f"{'fixed':>10s}", f"{'':>7s}", ""
             lines.append(
-                f"{e.name:10s} {e.value:12.6g} {se} {rel}  {bnd:>23s} {e.initial:12.6g}  {e.unit}"
+                f"{e.name:{w}s} {e.value:12.6g} {se} {rel}  {bnd:>23s} {e.initial:12.6g}  {e.unit}"
             )
         return "\n".join(lines)
 
