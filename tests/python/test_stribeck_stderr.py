@@ -78,7 +78,8 @@ def _stderr(problem, at_bound=()):
 def test_quadratic_cost_gives_the_closed_form_sandwich():
     """No plant. For per-maneuver parabolas the sandwich is exact: the variance of x_k is
     sum_m (x_k - c_mk)^2 / M^2 x M / (M - 1), whatever the difference steps; the curve's
-    standard errors are the log ones times (static_ratio - 1) and stribeck_speed."""
+    standard errors are the log ones times (static_ratio - 1) and stribeck_speed; a result
+    off the minimum along the curve gets the exact Newton step to it in the report line."""
     rng = np.random.default_rng(1)
     x = _coordinates(P)
     c = x + rng.normal(0.0, [0.05, 0.04, 0.03, 0.2, 0.15, 0.3], size=(30, 6))
@@ -92,6 +93,11 @@ def test_quadratic_cost_gives_the_closed_form_sandwich():
     assert stderr["static_ratio"] == pytest.approx(0.25 * se_log[4], rel=1e-4)
     assert stderr["stribeck_speed"] == pytest.approx(4e-4 * se_log[5], rel=1e-4)
     assert "standard errors of the joint fit" in line
+    # a result off the minimum along the curve: the report gives the Newton step to it
+    shifted = _QuadraticProblem([5.0, 7.0, 3.0, 1.0, 2.0, 0.5], c + [0, 0, 0, 0, 0.1, -0.2])
+    _, why, line = _stderr(shifted)
+    assert not why
+    assert "lies +0.1 in ln(static_ratio - 1) and -0.2 in ln stribeck_speed" in line
 
 
 def test_flat_speed_and_parameter_at_bound_give_nan():
@@ -103,7 +109,7 @@ def test_flat_speed_and_parameter_at_bound_give_nan():
     c = x + rng.normal(0.0, 0.05, size=(20, 6))
     c -= c.mean(axis=0) - x
     stderr, why, _ = _stderr(_QuadraticProblem([5.0, 7.0, 3.0, 1.0, 2.0, 0.0], c))
-    assert set(why) == {"stribeck_speed"} and "flat" in why["stribeck_speed"]
+    assert set(why) == {"stribeck_speed"} and "not determined" in why["stribeck_speed"]
     assert math.isnan(stderr["stribeck_speed"])
     assert all(math.isfinite(stderr[n]) for n in FREE + ("static_ratio",))
     stderr, why, _ = _stderr(_QuadraticProblem([5.0, 7.0, 3.0, 1.0, 2.0, 0.5], c), ("gamma",))
@@ -118,10 +124,10 @@ def test_stribeck_stderr_against_the_spread_over_seeds():
     0.45, Stribeck speed 0.5 mm/s, viscous shear 2e7 N s/m^3), 100 maneuvers per seed (80
     training). Over four independent seeds, where identify() keeps the joint fit with the
     Stribeck curve, the standard deviation of the estimates' logs (mu, delta, beta_a,
-    static_ratio - 1, stribeck_speed) lies within a factor 4 of the median reported relative
-    standard error (measured on these seeds: spread / standard error about 0.6 for mu, 0.7
-    delta, 0.9 beta_A, 1.9 static_ratio - 1, 2.9 stribeck_speed: the curve's standard errors
-    understate the spread, the Nelder-Mead search's own scatter not being in them)."""
+    static_ratio - 1, stribeck_speed) lies within a factor 3 of the median reported relative
+    standard error (measured on these seeds: spread / standard error 0.52 for mu, 0.60 delta,
+    0.84 beta_A, 1.02 static_ratio - 1, 1.07 stribeck_speed), and the params file's entries
+    carry the curve's standard errors."""
     rig = GridContactRig.viscous(n_grid=17, mu_s=0.63)
     design = RubbingDesign(edge_speed_range=(1e-4, 1e-2), c_tilde_range=(0.05, 20.0),
                            hold_slip=3e-4)
@@ -144,4 +150,4 @@ def test_stribeck_stderr_against_the_spread_over_seeds():
     reported = np.nanmedian(np.array(rel), axis=0)
     assert np.all(np.isfinite(reported))
     ratio = spread / reported
-    assert np.all((ratio > 1 / 4) & (ratio < 4)), ratio
+    assert np.all((ratio > 1 / 3) & (ratio < 3)), ratio

@@ -142,6 +142,18 @@ def covariance(train, ev, mn, free_t, *, loss: str, uncertainty: str, sse, refit
 
 
 
+def _positive_definite(H: np.ndarray) -> bool:
+    """Positive diagonal and scale-free eigenvalues above 1e-8 of the largest (empty: True)."""
+    if H.size == 0:
+        return True
+    dg = np.diag(H)
+    if not np.all(dg > 0.0):
+        return False
+    d = np.sqrt(dg)
+    lam = np.linalg.eigvalsh(H / np.outer(d, d))
+    return bool(lam.min() > 1e-8 * max(lam.max(), 1e-300))
+
+
 def finite_difference_covariance(problem, at, steps, *, loss: str, uncertainty: str,
                                  samples=None, known=None):
     """Covariance of coordinates ``u`` (a point ``at(u)`` -> ContactParams of the problem,
@@ -165,8 +177,10 @@ def finite_difference_covariance(problem, at, steps, *, loss: str, uncertainty: 
     Returns (cov, flat, evaluations, step): cov over all coordinates (NaN rows/columns for the
     coordinates not used and those along which H is not positive definite, the others
     conditional on those held), ``flat`` the indices found flat, the number of cost
-    evaluations spent, and the Newton step -H^-1 grad L from the point to the minimum of the
-    cost's quadratic model (NaN where not available: how far the fit stopped from it)."""
+    evaluations spent, and the Newton step from the point to the minimum of the cost's
+    quadratic model along the differenced coordinates, the first ``len(H)`` held (NaN where
+    not available: how far the fit stopped from it; the C++ gradient, not exact there, is
+    not used)."""
     steps = np.asarray(steps, dtype=float)
     n = steps.size
     cov = np.full((n, n), np.nan)
@@ -192,7 +206,7 @@ def finite_difference_covariance(problem, at, steps, *, loss: str, uncertainty: 
                 int(e["scored"]), known(e, q))
 
     base = ev(np.zeros(n))
-    L0, _, sse0, scored, (Hk, Gk, g0) = base
+    L0, _, sse0, scored, (Hk, Gk, _) = base
     k = Hk.shape[0]
     H = np.zeros((n, n))
     G = np.zeros((M, n))
@@ -225,13 +239,19 @@ def finite_difference_covariance(problem, at, steps, *, loss: str, uncertainty: 
     keep = [j for j in range(n) if j not in bad]
     flat = [j for j in range(k, n) if j in bad and math.isfinite(steps[j])]
     keep = [j for j in keep if np.all(np.isfinite(H[j, keep])) and np.all(np.isfinite(G[:, j]))]
-    while keep:  # drop the coordinate that carries the weakest non-positive direction
+    while keep:  # drop the coordinate that carries the weakest non-positive direction,
+        # a differenced one first (the first block is a Gauss-Newton matrix, positive
+        # semi-definite by construction)
         Hs = H[np.ix_(keep, keep)]
+        if _positive_definite(Hs):
+            break
         d = np.sqrt(np.maximum(np.abs(np.diag(Hs)), 1e-300))
         lam, vec = np.linalg.eigh(Hs / np.outer(d, d))
-        if np.all(np.diag(Hs) > 0.0) and lam.min() > 1e-8 * max(lam.max(), 1e-300):
-            break
-        worst = keep[int(np.argmax(np.abs(vec[:, int(np.argmin(lam))])))]
+        weight = np.abs(vec[:, int(np.argmin(lam))])
+        own = np.array([j >= k for j in keep])  # the differenced coordinates
+        if own.any() and _positive_definite(Hs[np.ix_(~own, ~own)]):
+            weight = np.where(own, weight, -1.0)
+        worst = keep[int(np.argmax(weight))]
         keep.remove(worst)
         flat.append(worst)
     step = np.full(n, np.nan)
@@ -239,8 +259,10 @@ def finite_difference_covariance(problem, at, steps, *, loss: str, uncertainty: 
         return cov, tuple(flat), count[0], step
     kk = np.ix_(keep, keep)
     Hi = np.linalg.inv(H[kk])
-    grad = np.concatenate([g0, G[:, k:].sum(axis=0)])  # of L: C++ for the first k, differences
-    step[keep] = -Hi @ grad[keep]
+    var_kept = [j for j in var if j in keep]
+    if var_kept:  # along the differenced coordinates, the others held (no C++ gradient in it)
+        vv = np.ix_(var_kept, var_kept)
+        step[var_kept] = -np.linalg.solve(H[vv], G[:, var_kept].sum(axis=0))
     if uncertainty == "gauss-newton":
         dof = max(scored - len(keep), 1)
         sigma2 = L0 / dof if loss == "squared" else sse0 / dof
