@@ -97,7 +97,8 @@ def identify(
         loss, huber_scale, weighting, method, max_iterations, tolerance: the eq. 32 fit
             ("squared"/"huber", "maneuver"/"sample", "gauss-newton"/"slsqp"/"trust-constr").
         uncertainty: "sandwich" (default, clustered by maneuver), "gauss-newton" or
-            "bootstrap" (``n_bootstrap`` refits).
+            "bootstrap" (``n_bootstrap`` refits); also the method of the Stribeck joint fit's
+            standard errors (``result.friction_estimates``, docs/identification.md).
         start: "data" or "params0" (default: params0 when given). refine: run eq. 32.
         slip_threshold: |omega| [rad/s] for the all-stick check of a params0 start and the
             clipped-CoR exclusion.
