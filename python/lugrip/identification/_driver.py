@@ -658,10 +658,11 @@ def _joint_stderr(train, p, free, bnds, at_bound, *, loss, uncertainty, n_bootst
     coordinates) and the curve (Nelder-Mead coordinates ln(static_ratio - 1), ln
     stribeck_speed), together, from :func:`finite_difference_covariance` of eq. 32 at p
     (sandwich or Gauss-Newton formula), or from ``n_bootstrap`` joint fits on resampled
-    training maneuvers (``refit(problem)``: the whole joint fit from its start). NaN, with the reason, for a parameter at a bound, along a flat
-    direction of the cost, or a curve coordinate whose standard error exceeds
-    ``STRIBECK_UNDETERMINED`` (the data do not fix it within a factor e). Returns
-    ({name: standard error}, {name: why NaN}, the report line)."""
+    training maneuvers (``refit(problem)``: the whole joint fit from its start). NaN, with
+    the reason, for a parameter at a bound, a curve coordinate along which the cost's
+    curvature is not positive, or one whose standard error exceeds ``STRIBECK_UNDETERMINED``
+    (the data do not fix it within a factor e). Returns ({name: standard error}, {name: why
+    NaN}, the report line)."""
     t0 = time.perf_counter()
     names = free + _CURVE
     x0 = _curve_coordinates(p)
@@ -708,9 +709,8 @@ def _joint_stderr(train, p, free, bnds, at_bound, *, loss, uncertainty, n_bootst
                 * w_sum, train.maneuver_gradients(e)[:, idx] * s,
                 np.asarray(e["gradient"])[idx] * s * w_sum)
 
-    cov, flat, n_ev, step = finite_difference_covariance(train, at, steps, loss=loss,
-                                                   uncertainty=uncertainty, samples=samples,
-                                                   known=known)
+    cov, flat, n_ev, step = finite_difference_covariance(
+        train, at, steps, loss=loss, uncertainty=uncertainty, samples=samples, known=known)
     if samples:
         for j in np.flatnonzero(np.ptp(np.asarray(samples), axis=0) == 0.0):
             why.setdefault(names[j], "the bootstrap's joint fits all returned it unchanged: "

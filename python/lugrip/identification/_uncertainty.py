@@ -56,7 +56,6 @@ def covariance(train, ev, mn, free_t, *, loss: str, uncertainty: str, sse, refit
 
     The regularisation toward the stage values (prior precision) is part of H.
     """
-    import math
 
     from ._common import PARAMETERS
 
