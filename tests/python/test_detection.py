@@ -203,9 +203,9 @@ def test_stribeck_curve_fitted_jointly_on_a_viscous_stribeck_grid(tmp_path, monk
     before = {}
     joint_fit = _driver._stribeck_joint
 
-    def spy(train_p, val_p, p_hat, *args):  # records the parameters the joint fit starts from
+    def spy(train_p, val_p, p_hat, *args, **kw):  # records the joint fit's start parameters
         before["params"] = p_hat
-        return joint_fit(train_p, val_p, p_hat, *args)
+        return joint_fit(train_p, val_p, p_hat, *args, **kw)
 
     monkeypatch.setattr(_driver, "_stribeck_joint", spy)
     with warnings.catch_warnings():

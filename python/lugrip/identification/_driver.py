@@ -26,11 +26,11 @@ from ._common import (
 from ._data import _Maneuver, _observer_settings, _Problem, load_maneuvers
 from ._guess import _clip
 from ._optimize import _refit, minimise
-from ._result import IdentificationResult, estimates_of, evaluate_split
+from ._result import IdentificationResult, ParameterEstimate, estimates_of, evaluate_split
 from ._setup import _bounds, _parse_free, _split, check_options, read_params0
 from ._friction import friction_levels
 from ._start import staged_estimate
-from ._uncertainty import covariance
+from ._uncertainty import covariance, finite_difference_covariance
 
 __all__ = ["identify"]
 
@@ -97,7 +97,8 @@ def identify(
         loss, huber_scale, weighting, method, max_iterations, tolerance: the eq. 32 fit
             ("squared"/"huber", "maneuver"/"sample", "gauss-newton"/"slsqp"/"trust-constr").
         uncertainty: "sandwich" (default, clustered by maneuver), "gauss-newton" or
-            "bootstrap" (``n_bootstrap`` refits).
+            "bootstrap" (``n_bootstrap`` refits); also the method of the Stribeck joint fit's
+            standard errors (``result.friction_estimates``, docs/identification.md).
         start: "data" or "params0" (default: params0 when given). refine: run eq. 32.
         slip_threshold: |omega| [rad/s] for the all-stick check of a params0 start and the
             clipped-CoR exclusion.
@@ -402,6 +403,7 @@ def identify(
             IdentificationWarning,
             stacklevel=2,
         )
+    friction: tuple = ()  # estimates of the Stribeck curve fitted jointly (stage 7)
     if stage is not None and refine:
         # (d) the friction levels S is judged against (break-away, sliding), at the result
         keys = {m.key for m in train_m}
@@ -412,20 +414,26 @@ def identify(
         p_hat = p_hat.replace(static_ratio=levels.static_ratio, kinetic_ratio=levels.kinetic_ratio)
         lines = (levels.line,)
         if levels.curve is not None and stage.speed_observable:
-            joint = _stribeck_joint(train, val, p_hat, levels.curve, free_t, bnds, method,
-                                    max_iterations, tolerance)
+            joint = _stribeck_joint(
+                train, val, p_hat, levels.curve, free_t, bnds, method, max_iterations, tolerance,
+                loss=loss, uncertainty=uncertainty, n_bootstrap=n_bootstrap, seed=seed,
+                problem_of=lambda ms: _Problem(ms, settings, weighting))
             lines += (joint.line,)
             fit_time += joint.fit_time
             if joint.accepted:
                 p_hat = joint.params
+                lines += (joint.stderr_line,)
                 estimates = [
                     dataclasses.replace(
-                        e, value=getattr(p_hat, e.name), stderr=math.nan,
+                        e, value=getattr(p_hat, e.name), stderr=joint.stderr[e.name],
                         note=(e.note + "; " if e.note else "")
-                        + "refitted with the Stribeck curve (stage 7), no standard error")
+                        + "refitted with the Stribeck curve (stage 7)"
+                        + (f", no standard error: {joint.why[e.name]}"
+                           if e.name in joint.why else ""))
                     if e.name in joint.free else e
                     for e in estimates
                 ]
+                friction = _curve_estimates(p_hat, levels, joint)
                 ev, split = evaluate_split(train, val, train_m, val_m, p_hat)
                 at_bound = [(n, "Stribeck joint fit") for n in joint.at_bound]
                 if at_bound:
@@ -483,6 +491,7 @@ def identify(
         validation_trace=split["trace"],
         stages=stage,
         warnings=tuple(data_warnings),
+        friction_estimates=friction,
     )
 
 
@@ -497,6 +506,18 @@ STRIBECK_T_JOINT = 3.0
 STRIBECK_EVALUATIONS = 20
 #: iterations of each Gauss-Newton fit of the joint fit (it starts near its minimum)
 STRIBECK_ITERATIONS = 8
+#: central-difference step of the joint fit's standard errors on the curve's coordinates
+#: ln(static_ratio - 1) and ln(stribeck_speed): the cost is kinked at the joint fit's result
+#: (the observer's switching between modes), so second differences on a small step measure
+#: the kink, not the valley the estimate moves in between data sets (on the viscous Stribeck
+#: grid plant: the spread of ln stribeck_speed over seeds 3.9 times the standard error with
+#: a step of 0.2, 1.3 times with 0.3, 1.6 with 0.4 where the cross terms turn noisy)
+STRIBECK_FD_STEP = 0.3
+#: a curve coordinate (natural log) with a standard error above this is reported as not
+#: determined (NaN): the data do not fix it within a factor e
+STRIBECK_UNDETERMINED = 1.0
+_CURVE = ("static_ratio", "stribeck_speed")
+_CURVE_COORD = ("static_ratio - 1", "stribeck_speed")
 # the ranges of the friction ratios and the Stribeck speed, from the C++ field table
 _LIMITS = {p["name"]: (p["lo"]["value"], p["hi"]["value"]) for p in _core.ContactParams.params}
 _MIN_RATIO, _MAX_RATIO = _LIMITS["static_ratio"]
@@ -511,6 +532,9 @@ class _Joint:
     at_bound: tuple
     fit_time: float
     line: str
+    stderr: dict = dataclasses.field(default_factory=dict)  # name -> standard error (NaN: why)
+    why: dict = dataclasses.field(default_factory=dict)  # name -> why it has none
+    stderr_line: str = ""
 
 
 def _maneuver_mse(problems, params: ContactParams) -> tuple[np.ndarray, float]:
@@ -527,21 +551,62 @@ def _maneuver_mse(problems, params: ContactParams) -> tuple[np.ndarray, float]:
     return np.concatenate(out), cost
 
 
+def _curve_at(q: ContactParams, x) -> ContactParams:
+    """q with the Stribeck curve at the Nelder-Mead coordinates x = (ln(static_ratio - 1),
+    ln stribeck_speed), clipped to their ranges (kinetic_ratio kept at most the rest level)."""
+    r = min(1.0 + math.exp(x[0]), _MAX_RATIO)
+    return q.replace(static_ratio=r, kinetic_ratio=min(q.kinetic_ratio, r),
+                     stribeck_speed=min(math.exp(x[1]), _MAX_STRIBECK))
+
+
+def _curve_coordinates(p: ContactParams) -> np.ndarray:
+    return np.array([math.log(max(p.static_ratio - 1.0, 1.0e-3)), math.log(p.stribeck_speed)])
+
+
+def _joint_fit(train, p, free, bnds, method, max_iterations, tolerance) -> ContactParams:
+    """Eq. 32 over ``free`` and the curve from p (the curve in it): Gauss-Newton over ``free``
+    (``STRIBECK_ITERATIONS``), Nelder-Mead over the curve's coordinates with them held
+    (``STRIBECK_EVALUATIONS``), Gauss-Newton again where the search lowered the cost."""
+    from scipy.optimize import minimize
+
+    def gauss_newton(q):
+        return minimise(train, q, free, bnds, method=method,
+                        max_iterations=min(max_iterations, STRIBECK_ITERATIONS),
+                        tolerance=tolerance).params
+
+    p = gauss_newton(p)
+    q = p
+
+    def cost(x):
+        try:
+            c = float(train.evaluate(_curve_at(q, x), False)["cost"])
+        except ValueError:  # outside the parameters' valid ranges
+            return math.inf
+        return c if math.isfinite(c) else math.inf
+
+    x0 = _curve_coordinates(p)
+    res = minimize(cost, x0, method="Nelder-Mead",
+                   options={"initial_simplex": np.vstack([x0, x0 + [0.3, 0.0], x0 + [0.0, 0.3]]),
+                            "maxfev": STRIBECK_EVALUATIONS, "xatol": 0.02, "fatol": 0.0})
+    if math.isfinite(res.fun) and res.fun < cost(x0):
+        p = gauss_newton(_curve_at(q, res.x))
+    return p
+
+
 def _stribeck_joint(train, val, p_hat, curve, free_t, bnds, method, max_iterations,
-                    tolerance) -> _Joint:
+                    tolerance, *, loss="squared", uncertainty="sandwich", n_bootstrap=20,
+                    seed=0, problem_of=None) -> _Joint:
     """Stage 7's Stribeck curve put into the observer (mu the level at speed, static_ratio the
     level at rest over it, stribeck_speed its speed; kinetic_ratio kept as the same absolute
     level) and eq. 32 minimised again over the sliding level, delta, gamma and beta_A together
-    with the curve, unregularised: Gauss-Newton over those four (``STRIBECK_ITERATIONS``), a
-    Nelder-Mead search of the curve's rest level and speed (values only,
-    ``STRIBECK_EVALUATIONS``) with them held, and Gauss-Newton again. The refinement fitted
-    them with one dry level, which a falling friction biases: a slow slide's excess friction
-    read as speed, the shape and the viscous term bent to absorb it. Kept only where the
-    per-maneuver cost (mean squared omega_hat error of each training and validation maneuver)
-    falls significantly against the refined parameters with the friction levels: the log of
-    its ratio, paired over the maneuvers, with t >= ``STRIBECK_T_JOINT``."""
-    from scipy.optimize import minimize
-
+    with the curve, unregularised (:func:`_joint_fit`). The refinement fitted them with one
+    dry level, which a falling friction biases: a slow slide's excess friction read as speed,
+    the shape and the viscous term bent to absorb it. Kept only where the per-maneuver cost
+    (mean squared omega_hat error of each training and validation maneuver) falls
+    significantly against the refined parameters with the friction levels: the log of its
+    ratio, paired over the maneuvers, with t >= ``STRIBECK_T_JOINT``. Where kept, the standard
+    errors of the refitted parameters and of the curve come from :func:`_joint_stderr`
+    (``problem_of(maneuvers)`` builds a training problem for the bootstrap)."""
     t0 = time.perf_counter()
     a, b, v_s = curve
     rest = min(b / a, _MAX_RATIO)
@@ -552,33 +617,8 @@ def _stribeck_joint(train, val, p_hat, curve, free_t, bnds, method, max_iteratio
     if not free:
         return _Joint(p_hat, False, (), (), 0.0,
                       "(d) Stribeck curve: no free parameter to refit with it")
-
-    def gauss_newton(q):
-        return minimise(train, q, free, bnds, method=method,
-                        max_iterations=min(max_iterations, STRIBECK_ITERATIONS),
-                        tolerance=tolerance).params
-
-    def curve_at(q, x):
-        r = min(1.0 + math.exp(x[0]), _MAX_RATIO)
-        return q.replace(static_ratio=r, kinetic_ratio=min(q.kinetic_ratio, r),
-                         stribeck_speed=min(math.exp(x[1]), _MAX_STRIBECK))
-
-    p = gauss_newton(p)
-    q = p
-
-    def cost(x):
-        try:
-            c = float(train.evaluate(curve_at(q, x), False)["cost"])
-        except ValueError:  # outside the parameters' valid ranges
-            return math.inf
-        return c if math.isfinite(c) else math.inf
-
-    x0 = np.array([math.log(max(p.static_ratio - 1.0, 1.0e-3)), math.log(p.stribeck_speed)])
-    res = minimize(cost, x0, method="Nelder-Mead",
-                   options={"initial_simplex": np.vstack([x0, x0 + [0.3, 0.0], x0 + [0.0, 0.3]]),
-                            "maxfev": STRIBECK_EVALUATIONS, "xatol": 0.02, "fatol": 0.0})
-    if math.isfinite(res.fun) and res.fun < cost(x0):
-        p = gauss_newton(curve_at(q, res.x))
+    p_start = p
+    p = _joint_fit(train, p, free, bnds, method, max_iterations, tolerance)
     problems = [train] + ([val] if val is not None else [])
     (before, c_one), (after, c_joint) = _maneuver_mse(problems, p_hat), _maneuver_mse(problems, p)
     ok = (before > 0.0) & (after > 0.0)  # NaN (nothing scored) compares False
@@ -602,8 +642,134 @@ def _stribeck_joint(train, val, p_hat, curve, free_t, bnds, method, max_iteratio
         f"cost lower with t = {t:.3g} over {d.size} maneuvers: "
         + ("kept" if accepted else f"not kept (needs t >= {STRIBECK_T_JOINT:g})")
     )
-    return _Joint(p if accepted else p_hat, accepted, free, at_bound if accepted else (),
-                  elapsed, line)
+    if not accepted:
+        return _Joint(p_hat, False, free, (), elapsed, line)
+    stderr, why, unc_line = _joint_stderr(
+        train, p, free, bnds, at_bound, loss=loss, uncertainty=uncertainty,
+        n_bootstrap=n_bootstrap, seed=seed, problem_of=problem_of,
+        refit=lambda prob: _joint_fit(prob, p_start, free, bnds, method, max_iterations,
+                                      tolerance))
+    return _Joint(p, True, free, at_bound, elapsed, line, stderr, why, unc_line)
+
+
+def _joint_stderr(train, p, free, bnds, at_bound, *, loss, uncertainty, n_bootstrap, seed,
+                  problem_of, refit):
+    """Standard errors of the joint fit's result p: the refitted parameters ``free`` (log
+    coordinates) and the curve (Nelder-Mead coordinates ln(static_ratio - 1), ln
+    stribeck_speed), together, from :func:`finite_difference_covariance` of eq. 32 at p
+    (sandwich or Gauss-Newton formula), or from ``n_bootstrap`` joint fits on resampled
+    training maneuvers (``refit(problem)``: the whole joint fit from its start). NaN, with
+    the reason, for a parameter at a bound, a curve coordinate along which the cost's
+    curvature is not positive, or one whose standard error exceeds ``STRIBECK_UNDETERMINED``
+    (the data do not fix it within a factor e). Returns ({name: standard error}, {name: why
+    NaN}, the report line)."""
+    t0 = time.perf_counter()
+    names = free + _CURVE
+    x0 = _curve_coordinates(p)
+    # the refitted parameters are not varied (their block is the C++ one): NaN marks a bound
+    steps = np.array([1.0] * len(free) + [STRIBECK_FD_STEP] * 2)
+    why: dict[str, str] = {}
+    for i, n in enumerate(free):
+        if n in at_bound:
+            steps[i] = math.nan
+            why[n] = "at a bound"
+    limits = (math.log(_MAX_RATIO - 1.0), math.log(_MAX_STRIBECK))
+    for j in range(2):
+        if not x0[j] + steps[len(free) + j] < limits[j]:
+            steps[len(free) + j] = math.nan
+            why[_CURVE[j]] = "at (or within the difference step of) the top of its range"
+
+    def at(u):
+        q = p.replace(**{n: getattr(p, n) * math.exp(u[i]) for i, n in enumerate(free)})
+        return _curve_at(q, x0 + u[len(free):])
+
+    def coordinates(q):
+        return np.concatenate([np.log([getattr(q, n) / getattr(p, n) for n in free]),
+                               _curve_coordinates(q) - x0])
+
+    samples = None
+    if uncertainty == "bootstrap":
+        ms = train.maneuvers
+        if problem_of is not None and len(ms) >= 2:
+            rng = np.random.default_rng(seed + 1)
+            samples = [coordinates(refit(problem_of([ms[i] for i in rng.integers(0, len(ms),
+                                                                                 len(ms))])))
+                       for _ in range(int(n_bootstrap))]
+        else:
+            why.update({n: "the bootstrap needs two or more training maneuvers"
+                        for n in names if n not in why})
+    # the refitted parameters' block: the C++ Gauss-Newton matrix, per-maneuver gradients and
+    # gradient (pathwise; the curve's factor on the speed state is not differentiated)
+    idx = [PARAMETERS.index(n) for n in free]
+
+    def known(e, q):
+        s = np.array([getattr(q, n) for n in free])
+        w_sum = float(e["weight_sum"])
+        return (np.asarray(e["gauss_newton"]).reshape(6, 6)[np.ix_(idx, idx)] * np.outer(s, s)
+                * w_sum, train.maneuver_gradients(e)[:, idx] * s,
+                np.asarray(e["gradient"])[idx] * s * w_sum)
+
+    cov, flat, n_ev, step = finite_difference_covariance(
+        train, at, steps, loss=loss, uncertainty=uncertainty, samples=samples, known=known)
+    if samples:
+        for j in np.flatnonzero(np.ptp(np.asarray(samples), axis=0) == 0.0):
+            why.setdefault(names[j], "the bootstrap's joint fits all returned it unchanged: "
+                                     "no spread measured")
+    for j in flat:
+        why[names[j]] = ("not determined by these data: the cost's curvature is not positive "
+                         "along it (flat, or rougher than curved on the difference step)")
+    se_log = np.sqrt(np.abs(np.diag(cov)))
+    for j, n in enumerate(_CURVE):
+        s = se_log[len(free) + j]
+        if n not in why and math.isfinite(s) and s > STRIBECK_UNDETERMINED:
+            why[n] = (f"not determined by these data: one standard error of ln({_CURVE_COORD[j]}) "
+                      f"is {s:.2g} (a factor {math.exp(s):.3g})")
+    stderr = {}
+    for j, n in enumerate(names):
+        if n in why or not math.isfinite(se_log[j]):
+            why.setdefault(n, "no standard error: the covariance is not finite")
+            stderr[n] = math.nan
+        elif n in free:
+            stderr[n] = getattr(p, n) * float(se_log[j])
+        else:  # d static_ratio = (r - 1) d ln(r - 1), d v_s = v_s d ln v_s
+            scale = p.static_ratio - 1.0 if n == "static_ratio" else p.stribeck_speed
+            stderr[n] = scale * float(se_log[j])
+    how = (f"{int(n_bootstrap)} joint fits on resampled training maneuvers" if samples
+           else f"{uncertainty}: the refitted parameters' block from the Gauss-Newton matrix, "
+                f"the curve's rows from central differences of eq. 32 at the result ({n_ev} "
+                "cost evaluations)")
+    parts = [f"{n} {getattr(p, n):.4g} +- {stderr[n]:.2g}" if math.isfinite(stderr[n])
+             else f"{n} {getattr(p, n):.4g} (no standard error: {why[n]})" for n in names]
+    line = (f"(d) standard errors of the joint fit ({how}, {time.perf_counter() - t0:.1f} s): "
+            + ", ".join(parts))
+    newton = step[len(free):]
+    if np.all(np.isfinite(newton)):
+        line += (f"; the Nelder-Mead result lies {newton[0]:+.2g} in ln({_CURVE_COORD[0]}) and "
+                 f"{newton[1]:+.2g} in ln stribeck_speed from the minimum of the cost's quadratic "
+                 "model along the curve, the other parameters held (the search's stopping error, "
+                 "not in the standard errors)")
+    return stderr, why, line
+
+
+def _curve_estimates(p: ContactParams, levels, joint: _Joint) -> tuple:
+    """The joint fit's Stribeck curve as estimates: the rest level static_ratio and the speed,
+    started from stage 7's curve of the runs' dry levels, with the joint fit's standard
+    errors."""
+    from .._params import _UNITS
+
+    a, b, v_s = levels.curve
+    start = {"static_ratio": min(b / a, _MAX_RATIO), "stribeck_speed": v_s}
+    top = {"static_ratio": _MAX_RATIO, "stribeck_speed": _MAX_STRIBECK}
+    out = []
+    for n in _CURVE:
+        v = getattr(p, n)
+        note = "Stribeck curve of stage 7, fitted with eq. 32 jointly with the model parameters"
+        if n in joint.why:
+            note += f"; no standard error: {joint.why[n]}"
+        out.append(ParameterEstimate(
+            n, _UNITS[n], v, start[n], 1.0 if n == "static_ratio" else 0.0, top[n], True,
+            "upper" if math.isclose(v, top[n], rel_tol=1e-9) else None, joint.stderr[n], note))
+    return tuple(out)
 
 
 def _data_warnings(split: dict, stage) -> list[str]:

@@ -86,6 +86,10 @@ class IdentificationResult:
             (params0 start).
         warnings: warnings that look at the data and the fit (also issued as
             :class:`IdentificationWarning`).
+        friction_estimates: where stage 7 put a Stribeck curve into the observer and kept the
+            joint fit, its rest level ``static_ratio`` and ``stribeck_speed`` as estimates
+            with the joint fit's standard errors (NaN with the reason in ``note`` where the
+            data do not determine them); empty otherwise.
     """
 
     status: str
@@ -117,6 +121,7 @@ class IdentificationResult:
     samples_saturated: int = 0
     stages: Any = None
     warnings: tuple[str, ...] = ()
+    friction_estimates: tuple[ParameterEstimate, ...] = ()
 
     @property
     def success(self) -> bool:
@@ -139,19 +144,21 @@ class IdentificationResult:
         return Observer(self.params, **self.observer)
 
     def __getitem__(self, name: str) -> ParameterEstimate:
-        for e in self.estimates:
+        for e in self.estimates + self.friction_estimates:
             if e.name == name:
                 return e
         raise KeyError(name)
 
     def table(self) -> str:
         """Plain-text parameter table: value, unit, bounds, standard error, start."""
+        rows = self.estimates + self.friction_estimates
+        w = max([10] + [len(e.name) for e in rows])
         head = (
-            f"{'parameter':10s} {'value':>12s} {'std.err':>10s} {'rel':>7s}  "
+            f"{'parameter':{w}s} {'value':>12s} {'std.err':>10s} {'rel':>7s}  "
             f"{'bounds':>23s} {'start':>12s}  unit"
         )
         lines = [head, "-" * len(head)]
-        for e in self.estimates:
+        for e in rows:
             if e.free:
                 se = f"{e.stderr:10.3g}" if math.isfinite(e.stderr) else f"{'n/a':>10s}"
                 rel = f"{100 * e.relative_stderr:6.2f}%" if math.isfinite(e.stderr) else f"{'':>7s}"
@@ -161,7 +168,7 @@ class IdentificationResult:
             else:
                 se, rel, bnd = f"{'fixed':>10s}", f"{'':>7s}", ""
             lines.append(
-                f"{e.name:10s} {e.value:12.6g} {se} {rel}  {bnd:>23s} {e.initial:12.6g}  {e.unit}"
+                f"{e.name:{w}s} {e.value:12.6g} {se} {rel}  {bnd:>23s} {e.initial:12.6g}  {e.unit}"
             )
         return "\n".join(lines)
 
@@ -224,6 +231,7 @@ class IdentificationResult:
             # ContactParams.to_yaml does: only when not at their default
             | {
                 name: {"value": getattr(self.params, name), "unit": _UNITS[name]}
+                | self._curve_entry(name)
                 for name, default in _OPTIONAL.items()
                 if getattr(self.params, name) != default
             },
@@ -263,6 +271,14 @@ class IdentificationResult:
                 "settings": self.settings,
             },
         }
+
+    def _curve_entry(self, name: str) -> dict:
+        """The standard error and note of a friction-level field the joint fit estimated."""
+        for e in self.friction_estimates:
+            if e.name == name:
+                return {"stderr": e.stderr if math.isfinite(e.stderr) else None,
+                        "note": e.note}
+        return {}
 
     def save_yaml(self, path: str | Path) -> Path:
         """Write the identified parameters with units, standard errors, bounds, the

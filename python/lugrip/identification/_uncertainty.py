@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import math
 from collections.abc import Mapping, Sequence
 
 import numpy as np
@@ -55,7 +56,6 @@ def covariance(train, ev, mn, free_t, *, loss: str, uncertainty: str, sse, refit
 
     The regularisation toward the stage values (prior precision) is part of H.
     """
-    import math
 
     from ._common import PARAMETERS
 
@@ -139,3 +139,134 @@ def covariance(train, ev, mn, free_t, *, loss: str, uncertainty: str, sse, refit
                 )
     return stderr_log, corr, tuple(weak), notes
 
+
+
+def _positive_definite(H: np.ndarray) -> bool:
+    """Positive diagonal and scale-free eigenvalues above 1e-8 of the largest (empty: True)."""
+    if H.size == 0:
+        return True
+    dg = np.diag(H)
+    if not np.all(dg > 0.0):
+        return False
+    d = np.sqrt(dg)
+    lam = np.linalg.eigvalsh(H / np.outer(d, d))
+    return bool(lam.min() > 1e-8 * max(lam.max(), 1e-300))
+
+
+def finite_difference_covariance(problem, at, steps, *, loss: str, uncertainty: str,
+                                 samples=None, known=None):
+    """Covariance of coordinates ``u`` (a point ``at(u)`` -> ContactParams of the problem,
+    u = 0 the estimate) of eq. 32 where the C++ derivatives cover only the first ones (the
+    refitted model parameters, in log) and the others (the Stribeck curve's ln(static_ratio -
+    1) and ln stribeck_speed) are varied by central differences with ``steps`` (NaN: the
+    coordinate is not used, at a bound).
+
+    ``known(ev, params)`` -> (H, G, g): from a C++ evaluation with derivatives, the
+    Gauss-Newton block of L (the weighted loss sum, cost x weight sum) over the first
+    ``len(H)`` coordinates, their per-maneuver gradients (M x k) and the gradient of L. The
+    curve's block of the Hessian comes from second differences of L, its cross terms with the
+    first coordinates from central differences of their gradient g, its per-maneuver
+    gradients from central differences of each maneuver's part of L. Then
+
+    * "sandwich": H^-1 (sum_m g_m g_m^T) H^-1 M / (M - 1) (clustered by maneuver);
+    * "gauss-newton": 2 sigma^2 H^-1, sigma^2 the residual variance (the main fit's formula);
+    * "bootstrap": the covariance of ``samples`` (coordinates of refits on resampled
+      maneuvers), nothing evaluated.
+
+    Returns (cov, flat, evaluations, step): cov over all coordinates (NaN rows/columns for the
+    coordinates not used and those along which H is not positive definite, the others
+    conditional on those held), ``flat`` the indices found flat, the number of cost
+    evaluations spent, and the Newton step from the point to the minimum of the cost's
+    quadratic model along the differenced coordinates, the first ``len(H)`` held (NaN where
+    not available: how far the fit stopped from it; the C++ gradient, not exact there, is
+    not used)."""
+    steps = np.asarray(steps, dtype=float)
+    n = steps.size
+    cov = np.full((n, n), np.nan)
+    if uncertainty == "bootstrap":
+        if samples is not None and len(samples) >= 2:
+            s = np.asarray(samples, dtype=float)
+            ok = np.all(np.isfinite(s), axis=0)
+            cov[np.ix_(ok, ok)] = np.atleast_2d(np.cov(s[:, ok].T, ddof=1))
+        return cov, (), 0, np.full(n, np.nan)
+    owner = problem.segment_owner
+    M = len(problem.maneuvers)
+    count = [0]
+
+    def ev(u):
+        count[0] += 1
+        try:
+            q = at(np.asarray(u, dtype=float))
+            e = problem.evaluate(q, True)
+        except ValueError:  # outside the parameters' valid ranges
+            return None
+        per = np.bincount(owner, weights=np.asarray(e["segment_loss"]), minlength=M)
+        return (float(e["cost"]) * float(e["weight_sum"]), per, float(np.sum(e["segment_sse"])),
+                int(e["scored"]), known(e, q))
+
+    base = ev(np.zeros(n))
+    L0, _, sse0, scored, (Hk, Gk, _) = base
+    k = Hk.shape[0]
+    H = np.zeros((n, n))
+    G = np.zeros((M, n))
+    H[:k, :k], G[:, :k] = Hk, Gk
+    plus, minus = {}, {}
+    bad: list[int] = [j for j in range(n) if not math.isfinite(steps[j])]
+    for j in range(k, n):
+        if j in bad:
+            continue
+        e = np.zeros(n)
+        e[j] = steps[j]
+        plus[j], minus[j] = ev(e), ev(-e)
+        if plus[j] is None or minus[j] is None:
+            bad.append(j)
+            continue
+        H[j, j] = (plus[j][0] + minus[j][0] - 2.0 * L0) / steps[j] ** 2
+        G[:, j] = (plus[j][1] - minus[j][1]) / (2.0 * steps[j])
+        H[:k, j] = H[j, :k] = (plus[j][4][2] - minus[j][4][2]) / (2.0 * steps[j])
+    var = [j for j in range(k, n) if j not in bad]
+    for a, j in enumerate(var):
+        for i in var[a + 1:]:
+            e = np.zeros(n)
+            e[j], e[i] = steps[j], steps[i]
+            pp, mm = ev(e), ev(-e)
+            if pp is None or mm is None:
+                H[j, i] = H[i, j] = math.nan
+                continue
+            H[j, i] = H[i, j] = (pp[0] - plus[j][0] - plus[i][0] + 2.0 * L0 - minus[j][0]
+                                 - minus[i][0] + mm[0]) / (2.0 * steps[j] * steps[i])
+    keep = [j for j in range(n) if j not in bad]
+    flat = [j for j in range(k, n) if j in bad and math.isfinite(steps[j])]
+    keep = [j for j in keep if np.all(np.isfinite(H[j, keep])) and np.all(np.isfinite(G[:, j]))]
+    while keep:  # drop the coordinate that carries the weakest non-positive direction,
+        # a differenced one first (the first block is a Gauss-Newton matrix, positive
+        # semi-definite by construction)
+        Hs = H[np.ix_(keep, keep)]
+        if _positive_definite(Hs):
+            break
+        d = np.sqrt(np.maximum(np.abs(np.diag(Hs)), 1e-300))
+        lam, vec = np.linalg.eigh(Hs / np.outer(d, d))
+        weight = np.abs(vec[:, int(np.argmin(lam))])
+        own = np.array([j >= k for j in keep])  # the differenced coordinates
+        if own.any() and _positive_definite(Hs[np.ix_(~own, ~own)]):
+            weight = np.where(own, weight, -1.0)
+        worst = keep[int(np.argmax(weight))]
+        keep.remove(worst)
+        flat.append(worst)
+    step = np.full(n, np.nan)
+    if not keep:
+        return cov, tuple(flat), count[0], step
+    kk = np.ix_(keep, keep)
+    Hi = np.linalg.inv(H[kk])
+    var_kept = [j for j in var if j in keep]
+    if var_kept:  # along the differenced coordinates, the others held (no C++ gradient in it)
+        vv = np.ix_(var_kept, var_kept)
+        step[var_kept] = -np.linalg.solve(H[vv], G[:, var_kept].sum(axis=0))
+    if uncertainty == "gauss-newton":
+        dof = max(scored - len(keep), 1)
+        sigma2 = L0 / dof if loss == "squared" else sse0 / dof
+        cov[kk] = 2.0 * sigma2 * Hi
+    else:
+        Gs = G[:, keep]
+        cov[kk] = Hi @ (Gs.T @ Gs) @ Hi * (M / max(M - 1, 1))
+    return cov, tuple(flat), count[0], step
