@@ -767,3 +767,24 @@ def test_presliding_sigma_z_significant_or_set_by_the_stick_damping_rule(sigma_z
         assert pre.sigma_z > 2.0 * pre.stderr["sigma_z"]
         assert est.free
         assert est.value == pytest.approx(sigma_z, rel=0.5)
+
+
+def test_standard_errors_say_they_hold_the_stage_shape():
+    """Consistency plant (lugrip's lumped model under prescribed rubbing, 24 maneuvers): where
+    stage (a) chose the limit-surface shape, the identifiability notes say that the standard
+    errors hold it fixed (eq. 32 does not fit k, and on an independent plant the shape's choice
+    moves delta and beta_A by many times their errors: docs/identification.md); with k held
+    by the caller there is no such note."""
+    from lugrip.rigs import RubbingDesign
+    from lugrip.rigs.model_rigs import LumpedRig
+
+    data = LumpedRig(params="aluminium_can").simulate(RubbingDesign(), n=24, seed=4)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        staged = lugrip.identify(data.log, validation=0.0)
+        held = lugrip.identify(data.log, validation=0.0, k=4.0)
+    note = [n for n in staged.identifiability if "hold the limit-surface shape" in n]
+    assert len(note) == 1
+    k = staged.params.k
+    assert ("elliptic" in note[0]) if k == 0.0 else (f"k = {k:.3g}" in note[0])
+    assert not any("hold the limit-surface shape" in n for n in held.identifiability)

@@ -372,6 +372,14 @@ def identify(
         p_hat, p0, free_t, mn, bnds, stderr_log, guess_notes, fixed_notes, stage
     )
     ident += bound_notes
+    if stage is not None and kk is None and free_t and any(n in free_t for n in ("delta", "beta_a")):
+        ident.append(
+            f"the standard errors hold the limit-surface shape of stage (a) fixed ("
+            f"{'the elliptic limit surface' if p_hat.k == 0.0 else f'k = {p_hat.k:.3g}'}): "
+            "they do not include its uncertainty. Where the pressure lies outside the family "
+            "the shape chosen varies between data sets, and delta and beta_A with it, by many "
+            "times their standard errors (docs/identification.md); hold k (--k) to compare"
+        )
     at_bound = [(e.name, e.at_bound) for e in estimates if e.at_bound]
     if stage is not None:
         at_bound += [

@@ -277,8 +277,11 @@ def _fit_ls(pts, fix_gamma, k, lines: list, fix_delta=None) -> LimitSurfaceFit:
     keep = ellipse if ellipse.residual_rms < pressure.residual_rms else pressure
     rms = {"pressure": pressure.residual_rms, "ellipse": ellipse.residual_rms}
     bound = f" (at its bound: {', '.join(pressure.at_bound)})" if pressure.at_bound else ""
+    se_inv = pressure.stderr.get("inv_k", math.nan) if pressure is free else math.nan
+    k_se = (f", 1/k {1.0 / pressure.k:.3g} +- {se_inv:.2g}"
+            if math.isfinite(se_inv) and 0.0 < pressure.k < math.inf else "")
     lines.append(
-        f"(a) limit-surface shape: pressure family (k {_k_text(pressure.k)}){bound} RMS "
+        f"(a) limit-surface shape: pressure family (k {_k_text(pressure.k)}{k_se}){bound} RMS "
         f"distance {rms['pressure']:.3g}, elliptic limit surface {rms['ellipse']:.3g}: "
         + ("the ellipse is kept" if keep is ellipse else "the pressure family is kept")
     )
