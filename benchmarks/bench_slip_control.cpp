@@ -11,6 +11,7 @@
 // two builds can be shown to compute the same numbers. The same source builds against any lugrip
 // version with this API, so a baseline can be built from another checkout and run beside it:
 //   bench_slip_control [--quick] [--observe]
+// Last, every call is timed alone: the median call, and apart the calls that compute a command.
 // --observe times SlipControl::observe() instead (the two observers without the controller).
 #include <cmath>
 #include <cstdint>
@@ -110,16 +111,39 @@ int main(int argc, char** argv) {
   }
   std::sort(per_step.begin(), per_step.end());
   BitHash hash;
+  std::vector<char> issued(static_cast<size_t>(n));  // the calls that compute a command
   sc.reset(3.0);
   for (int k = 0; k < n; ++k) {
     sc.step(stream[static_cast<size_t>(k)], out);
     hash.add_all(out);
+    issued[static_cast<size_t>(k)] = out.controller.command_issued ? 1 : 0;
   }
+  // Every call timed alone (one pass after a warm-up, the timer's overhead subtracted): the
+  // median call, and apart the calls that compute a command (every command_ratio-th) and the
+  // others, which only observe and accumulate.
+  const double overhead = lugrip_bench::timer_overhead_ns();
+  const std::vector<double> each = lugrip_bench::time_each_ns(
+      n, 1, overhead, true, [&] { sc.reset(3.0); },
+      [&](int k) {
+        if (observe_only)
+          sc.observe(stream[static_cast<size_t>(k)], out);
+        else
+          sc.step(stream[static_cast<size_t>(k)], out);
+      });
+  std::vector<double> all = each, at_command, between;
+  for (int k = 0; k < n; ++k) (issued[static_cast<size_t>(k)] ? at_command : between).push_back(each[static_cast<size_t>(k)]);
+  for (std::vector<double>* v : {&all, &at_command, &between}) std::sort(v->begin(), v->end());
   std::printf("SlipControl::%s, two fingers: median %.1f ns per step, best %.1f ns, worst %.1f ns "
               "(%d repetitions of %d steps); allocations in the timed loops: %ld; build %s (%s); "
               "outputs' bit hash %016llx%s\n",
               observe_only ? "observe" : "step", per_step[per_step.size() / 2], per_step.front(), per_step.back(), reps, n, allocs,
               LUGRIP_BENCH_BUILD_TYPE, LUGRIP_BENCH_CXX_FLAGS, static_cast<unsigned long long>(hash.h),
               sink > 0 ? "" : " ");
+  std::printf("each call timed alone: median %.1f ns, p99 %.1f ns, worst %.1f ns; calls that compute a "
+              "command (%zu): median %.1f ns, p99 %.1f ns; the others (%zu): median %.1f ns, p99 %.1f ns "
+              "(timer overhead %.1f ns subtracted)\n",
+              lugrip_bench::percentile(all, 0.5), lugrip_bench::percentile(all, 0.99), all.back(),
+              at_command.size(), lugrip_bench::percentile(at_command, 0.5), lugrip_bench::percentile(at_command, 0.99),
+              between.size(), lugrip_bench::percentile(between, 0.5), lugrip_bench::percentile(between, 0.99), overhead);
   return 0;
 }
