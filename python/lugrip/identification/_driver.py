@@ -30,7 +30,7 @@ from ._result import IdentificationResult, ParameterEstimate, estimates_of, eval
 from ._setup import _bounds, _parse_free, _split, check_options, read_params0
 from ._friction import friction_levels
 from ._start import staged_estimate
-from ._uncertainty import covariance, finite_difference_covariance
+from ._uncertainty import covariance, finite_difference_covariance, resampled
 
 __all__ = ["identify"]
 
@@ -699,10 +699,8 @@ def _joint_stderr(train, p, free, bnds, at_bound, *, loss, uncertainty, n_bootst
     if uncertainty == "bootstrap":
         ms = train.maneuvers
         if problem_of is not None and len(ms) >= 2:
-            rng = np.random.default_rng(seed + 1)
-            samples = [coordinates(refit(problem_of([ms[i] for i in rng.integers(0, len(ms),
-                                                                                 len(ms))])))
-                       for _ in range(int(n_bootstrap))]
+            samples = [coordinates(refit(problem_of(draw)))
+                       for draw in resampled(ms, n_bootstrap, seed)]
         else:
             why.update({n: "the bootstrap needs two or more training maneuvers"
                         for n in names if n not in why})

@@ -56,7 +56,6 @@ def covariance(train, ev, mn, free_t, *, loss: str, uncertainty: str, sse, refit
 
     The regularisation toward the stage values (prior precision) is part of H.
     """
-
     from ._common import PARAMETERS
 
     idx = [PARAMETERS.index(n) for n in free_t]
@@ -80,19 +79,13 @@ def covariance(train, ev, mn, free_t, *, loss: str, uncertainty: str, sse, refit
             cov[ii] = 2.0 * sigma2 / wsum * np.linalg.inv((H + P)[ii])
         elif uncertainty == "sandwich":
             G = train.maneuver_gradients(ev)[:, idx] * s_free
-            Hi = np.linalg.inv((H + P)[ii] * wsum)
-            M = G.shape[0]
-            cov[ii] = Hi @ (G[:, inner].T @ G[:, inner]) @ Hi * (M / max(M - 1, 1))
+            cov[ii] = sandwich(np.linalg.inv((H + P)[ii] * wsum), G[:, inner])
     except np.linalg.LinAlgError:
         notes.append("Gauss-Newton matrix singular: standard errors not available")
     if uncertainty == "bootstrap":
         if refit is not None and len(train.maneuvers) >= 2:
-            rng = np.random.default_rng(seed + 1)
-            samples = []
-            for _ in range(int(n_bootstrap)):
-                pick = rng.integers(0, len(train.maneuvers), size=len(train.maneuvers))
-                pb = refit([train.maneuvers[i] for i in pick])
-                samples.append(np.log([getattr(pb, n) for n in free_t]))
+            samples = [np.log([getattr(refit(ms), n) for n in free_t])
+                       for ms in resampled(train.maneuvers, n_bootstrap, seed)]
             cov = np.atleast_2d(np.cov(np.array(samples).T, ddof=1))
         else:
             notes.append("bootstrap needs two or more training maneuvers")
@@ -139,6 +132,20 @@ def covariance(train, ev, mn, free_t, *, loss: str, uncertainty: str, sse, refit
                 )
     return stderr_log, corr, tuple(weak), notes
 
+
+def sandwich(Hi: np.ndarray, G: np.ndarray) -> np.ndarray:
+    """H^-1 (sum_m g_m g_m^T) H^-1 M / (M - 1): the covariance clustered by maneuver, from the
+    inverse Hessian ``Hi`` and the per-maneuver gradients ``G`` (M x k)."""
+    M = G.shape[0]
+    return Hi @ (G.T @ G) @ Hi * (M / max(M - 1, 1))
+
+
+def resampled(maneuvers: Sequence, n_bootstrap: int, seed: int):
+    """The bootstrap's training sets: ``n_bootstrap`` draws of as many maneuvers with
+    replacement (numpy's default_rng(seed + 1))."""
+    rng = np.random.default_rng(seed + 1)
+    for _ in range(int(n_bootstrap)):
+        yield [maneuvers[i] for i in rng.integers(0, len(maneuvers), size=len(maneuvers))]
 
 
 def _positive_definite(H: np.ndarray) -> bool:
@@ -267,6 +274,5 @@ def finite_difference_covariance(problem, at, steps, *, loss: str, uncertainty: 
         sigma2 = L0 / dof if loss == "squared" else sse0 / dof
         cov[kk] = 2.0 * sigma2 * Hi
     else:
-        Gs = G[:, keep]
-        cov[kk] = Hi @ (Gs.T @ Gs) @ Hi * (M / max(M - 1, 1))
+        cov[kk] = sandwich(Hi, G[:, keep])
     return cov, tuple(flat), count[0], step
